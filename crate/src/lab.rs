@@ -1,0 +1,284 @@
+//! # The lab session
+//!
+//! [`Lab`] is the one object the page and the command line drive (through
+//! the thin [`crate::bindings`] layer): it holds the scenario the user is
+//! editing, the simulation once it runs, and the image it renders.
+//!
+//! Nothing the user made is lost on a bad input: a scenario that fails to
+//! parse leaves the current one in place; one whose robots are badly placed
+//! is kept (so the page can show the problem) but refuses to run until fixed.
+
+use crate::render::{render_world, RenderOptions};
+use crate::report::{Report, Timings};
+use crate::scenario::{Scenario, ScenarioError, MAX_DURATION_S};
+use crate::sensors::laser::beam_bearing;
+use crate::sim::{Simulation, LASER_LOG_NO_RETURN};
+use serde::Serialize;
+use std::fmt::Write;
+use tiny_skia::Pixmap;
+
+/// A lab session: a scenario, and its simulation once started.
+pub struct Lab {
+    scenario: Scenario,
+    sim: Option<Simulation>,
+    view: RenderOptions,
+    pixmap: Option<Pixmap>,
+}
+
+/// Live figures for the page's readouts.
+#[derive(Serialize)]
+pub struct LabState {
+    pub time_s: f64,
+    pub steps: usize,
+    pub total_steps: usize,
+    pub running: bool,
+    pub finished: bool,
+    pub robots: Vec<RobotState>,
+}
+
+#[derive(Serialize)]
+pub struct RobotState {
+    pub name: String,
+    pub follow: String,
+    pub mode: String,
+    /// True pose, world frame `[x, y, theta]`.
+    pub truth: [f64; 3],
+    /// Believed pose, odometry frame.
+    pub odometry: [f64; 3],
+    pub sonar_m: [f64; 8],
+    pub sonar_no_echo: [bool; 8],
+    /// Nearest laser return: range (m) and bearing (deg); null if none.
+    pub laser_min: Option<[f64; 2]>,
+    pub laser_returns: usize,
+    pub bumps: u32,
+    pub v_mps: f64,
+    pub omega_radps: f64,
+    pub odometry_error_m: f64,
+}
+
+impl Lab {
+    /// A session on the scenario `json`. Fails only if it cannot be parsed
+    /// (badly placed robots are allowed while editing).
+    pub fn new(json: &str) -> Result<Lab, ScenarioError> {
+        let scenario = Scenario::parse(json)?;
+        let mut view = RenderOptions::default();
+        view.fit(&scenario);
+        Ok(Lab {
+            scenario,
+            sim: None,
+            view,
+            pixmap: None,
+        })
+    }
+
+    pub fn scenario(&self) -> &Scenario {
+        &self.scenario
+    }
+
+    pub fn simulation(&self) -> Option<&Simulation> {
+        self.sim.as_ref()
+    }
+
+    /// Replaces the scenario (and stops any run). On error the current
+    /// scenario stays.
+    pub fn set_scenario(&mut self, json: &str) -> Result<(), ScenarioError> {
+        let s = Scenario::parse(json)?;
+        self.scenario = s;
+        self.sim = None;
+        Ok(())
+    }
+
+    /// Placement problems that keep the scenario from running.
+    pub fn problems(&self) -> Vec<ScenarioError> {
+        self.scenario.placement_problems()
+    }
+
+    pub fn set_seed(&mut self, seed: u64) {
+        self.scenario.seed = seed;
+        self.sim = None;
+    }
+
+    pub fn set_duration(&mut self, duration_s: f64) -> Result<(), ScenarioError> {
+        if !(duration_s.is_finite() && (0.1..=MAX_DURATION_S).contains(&duration_s)) {
+            return Err(ScenarioError {
+                field: "duration_s".into(),
+                message: format!("{duration_s} is outside [0.1, {MAX_DURATION_S}]"),
+            });
+        }
+        self.scenario.duration_s = duration_s;
+        if let Some(sim) = &mut self.sim {
+            sim.scenario.duration_s = duration_s;
+        }
+        Ok(())
+    }
+
+    /// Back to time 0 (the editing view).
+    pub fn reset(&mut self) {
+        self.sim = None;
+    }
+
+    /// Starts the simulation if it is not running.
+    pub fn start(&mut self) -> Result<&mut Simulation, ScenarioError> {
+        let sim = match self.sim.take() {
+            Some(s) => s,
+            None => Simulation::new(&self.scenario)?,
+        };
+        Ok(self.sim.insert(sim))
+    }
+
+    /// Advances up to `n` steps (fewer at the end of the run); returns how
+    /// many were taken.
+    pub fn step(&mut self, n: usize) -> Result<usize, ScenarioError> {
+        let sim = self.start()?;
+        let before = sim.steps();
+        for _ in 0..n {
+            if sim.finished() {
+                break;
+            }
+            sim.step();
+        }
+        Ok(sim.steps() - before)
+    }
+
+    /// Runs to the end of the scenario's duration.
+    pub fn run_to_end(&mut self) -> Result<(), ScenarioError> {
+        self.start()?.run_to_end();
+        Ok(())
+    }
+
+    pub fn state(&self) -> LabState {
+        let robots = match &self.sim {
+            Some(sim) => sim
+                .robots
+                .iter()
+                .map(|r| {
+                    let o = r.odometry.pose();
+                    let scan = &r.last_scan;
+                    let mut laser_min: Option<[f64; 2]> = None;
+                    let mut returns = 0;
+                    for (i, &rg) in scan.ranges_m.iter().enumerate() {
+                        if scan.max_range[i] {
+                            continue;
+                        }
+                        returns += 1;
+                        if laser_min.is_none_or(|m| rg < m[0]) {
+                            laser_min = Some([rg, beam_bearing(i).to_degrees()]);
+                        }
+                    }
+                    let believed = r.spec.start_pose().compose(&o);
+                    RobotState {
+                        name: r.spec.name.clone(),
+                        follow: format!("{:?}", r.spec.follow).to_lowercase(),
+                        mode: r.mode().name().into(),
+                        truth: [r.truth.x, r.truth.y, r.truth.theta],
+                        odometry: [o.x, o.y, o.theta],
+                        sonar_m: r.last_sonar.ranges_m,
+                        sonar_no_echo: r.last_sonar.no_echo,
+                        laser_min,
+                        laser_returns: returns,
+                        bumps: r.bumps,
+                        v_mps: r.last_command.v_mps,
+                        omega_radps: r.last_command.omega_radps,
+                        odometry_error_m: (believed.position() - r.truth.position()).length(),
+                    }
+                })
+                .collect(),
+            None => Vec::new(),
+        };
+        let (steps, total) = match &self.sim {
+            Some(s) => (s.steps(), s.total_steps()),
+            None => (
+                0,
+                (self.scenario.duration_s / crate::kinematics::CONTROL_DT_S).round() as usize,
+            ),
+        };
+        LabState {
+            time_s: steps as f64 * crate::kinematics::CONTROL_DT_S,
+            steps,
+            total_steps: total,
+            running: self.sim.is_some(),
+            finished: steps >= total,
+            robots,
+        }
+    }
+
+    pub fn view(&self) -> &RenderOptions {
+        &self.view
+    }
+
+    /// Sets the view (size, centre, zoom, layers, overlays).
+    pub fn set_view(&mut self, view: RenderOptions) -> Result<(), String> {
+        view.validate()?;
+        self.view = view;
+        Ok(())
+    }
+
+    /// Fits the view to the scenario at the given canvas size.
+    pub fn fit_view(&mut self, width: u32, height: u32) -> Result<&RenderOptions, String> {
+        let mut v = self.view.clone();
+        v.width = width;
+        v.height = height;
+        v.validate()?;
+        v.fit(&self.scenario);
+        self.view = v;
+        Ok(&self.view)
+    }
+
+    /// Renders the current view; returns the pixmap (straight RGBA, opaque).
+    pub fn render(&mut self) -> Result<&Pixmap, String> {
+        let (w, h) = (self.view.width, self.view.height);
+        let reuse = matches!(&self.pixmap, Some(p) if p.width() == w && p.height() == h);
+        if !reuse {
+            self.pixmap =
+                Some(Pixmap::new(w, h).ok_or_else(|| format!("cannot make a {w}x{h} image"))?);
+        }
+        let pm = self.pixmap.as_mut().ok_or("no image")?;
+        render_world(pm, &self.scenario, self.sim.as_ref(), &self.view);
+        Ok(pm)
+    }
+
+    /// The run report; the simulation must have been started.
+    pub fn report(&self, timings: Timings) -> Result<Report, String> {
+        let sim = self
+            .sim
+            .as_ref()
+            .ok_or("nothing has run yet: run the scenario first")?;
+        Ok(Report::from_sim(sim, timings))
+    }
+
+    /// One robot's log as CSV, in the thesis's layout (§6.2.1): time,
+    /// odometry pose, 8 sonars, 181 laser ranges; then the true pose.
+    /// Max-range laser beams are written as empty cells.
+    pub fn log_csv(&self, robot: usize) -> Result<String, String> {
+        let sim = self.sim.as_ref().ok_or("nothing has run yet")?;
+        let r = sim
+            .robots
+            .get(robot)
+            .ok_or_else(|| format!("no robot with index {robot}"))?;
+        let mut out = String::from("t_s,odom_x_m,odom_y_m,odom_theta_rad");
+        for i in 1..=8 {
+            let _ = write!(out, ",sonar{i}_m");
+        }
+        for i in 0..181 {
+            let _ = write!(out, ",laser{i}_m");
+        }
+        out.push_str(",true_x_m,true_y_m,true_theta_rad\n");
+        for row in &r.log.sensors {
+            let k = row.step;
+            let (t, o, g) = (r.log.times_s[k], r.log.odometry[k], r.log.truth[k]);
+            let _ = write!(out, "{t:.1},{:.4},{:.4},{:.5}", o.x, o.y, o.theta);
+            for s in row.sonar_m {
+                let _ = write!(out, ",{s:.3}");
+            }
+            for l in row.laser_mm {
+                if l == LASER_LOG_NO_RETURN {
+                    out.push(',');
+                } else {
+                    let _ = write!(out, ",{:.3}", l as f64 / 1000.0);
+                }
+            }
+            let _ = writeln!(out, ",{:.4},{:.4},{:.5}", g.x, g.y, g.theta);
+        }
+        Ok(out)
+    }
+}

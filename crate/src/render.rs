@@ -1,0 +1,514 @@
+//! # Drawing the world with tiny-skia
+//!
+//! The page shows the world from above: a metric grid, the walls (tinted with
+//! a hint of their texture's colour), each robot's body and heading, its laser
+//! rays and sonar cones, and two trajectories per robot — the **true** path
+//! (solid) and the path its **odometry** believes (dashed, drawn from the true
+//! start pose so that drift shows as the two paths parting).
+//!
+//! Rendering is pure: a [`RenderOptions`] (view, layers, editing overlays)
+//! plus the scenario and, when one is running, the simulation, into an RGBA
+//! [`Pixmap`]. World coordinates have y up; this is the one place y is
+//! flipped. The background is opaque, so tiny-skia's premultiplied pixels
+//! equal the straight RGBA a canvas `ImageData` expects.
+
+use crate::geom::Pose2;
+use crate::kinematics::P2dx;
+use crate::scenario::Scenario;
+use crate::sensors::laser::beam_bearing;
+use crate::sensors::sonar::SONAR_COUNT;
+use crate::sensors::Sonar;
+use crate::sim::Simulation;
+use glam::DVec2;
+use serde::Deserialize;
+use tiny_skia::{
+    Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Rect, Stroke, StrokeDash,
+    Transform,
+};
+
+/// Robot colours, by robot index (the page's legend uses the same list).
+pub const ROBOT_COLOURS: [[u8; 3]; 8] = [
+    [31, 119, 180],
+    [230, 110, 20],
+    [44, 160, 44],
+    [200, 40, 60],
+    [148, 103, 189],
+    [140, 86, 75],
+    [220, 100, 180],
+    [23, 170, 190],
+];
+
+/// Which layers to draw.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Layers {
+    pub grid: bool,
+    pub laser: bool,
+    pub sonar: bool,
+    pub truth_path: bool,
+    pub odometry_path: bool,
+}
+
+impl Default for Layers {
+    fn default() -> Self {
+        Layers {
+            grid: true,
+            laser: true,
+            sonar: false,
+            truth_path: true,
+            odometry_path: true,
+        }
+    }
+}
+
+/// What to draw and where.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RenderOptions {
+    pub width: u32,
+    pub height: u32,
+    /// World point at the centre of the image (m).
+    pub center: [f64; 2],
+    /// Zoom (pixels per metre).
+    pub scale: f64,
+    pub layers: Layers,
+    /// A wall to highlight (selection in the editor).
+    pub selected_wall: Option<usize>,
+    /// A robot to highlight.
+    pub selected_robot: Option<usize>,
+    /// A wall being drawn: `[x0, y0, x1, y1]`.
+    pub preview_wall: Option<[f64; 4]>,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            width: 960,
+            height: 720,
+            center: [10.0, 7.5],
+            scale: 40.0,
+            layers: Layers::default(),
+            selected_wall: None,
+            selected_robot: None,
+            preview_wall: None,
+        }
+    }
+}
+
+impl RenderOptions {
+    /// Checks sizes and numbers; returns a message naming the bad field.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.width == 0 || self.height == 0 || self.width > 4096 || self.height > 4096 {
+            return Err(format!(
+                "view size {}x{} must be between 1x1 and 4096x4096",
+                self.width, self.height
+            ));
+        }
+        if !(self.scale.is_finite() && self.scale > 0.01 && self.scale < 10_000.0) {
+            return Err(format!(
+                "view scale {} must be in (0.01, 10000) px/m",
+                self.scale
+            ));
+        }
+        if !(self.center[0].is_finite() && self.center[1].is_finite()) {
+            return Err("view center must be finite".into());
+        }
+        Ok(())
+    }
+
+    /// Fits the view to the scenario's extent with a margin.
+    pub fn fit(&mut self, scenario: &Scenario) {
+        let (lo, hi) = scenario.bounds();
+        let size = (hi - lo).max(DVec2::splat(1.0)) + DVec2::splat(2.0);
+        self.center = [(lo.x + hi.x) / 2.0, (lo.y + hi.y) / 2.0];
+        self.scale = (self.width as f64 / size.x).min(self.height as f64 / size.y);
+    }
+
+    /// World point to pixel.
+    pub fn to_px(&self, p: DVec2) -> (f32, f32) {
+        (
+            ((p.x - self.center[0]) * self.scale + self.width as f64 / 2.0) as f32,
+            (self.height as f64 / 2.0 - (p.y - self.center[1]) * self.scale) as f32,
+        )
+    }
+}
+
+/// FNV-1a: a stable hash of a texture name for its hint colour.
+fn name_hash(s: &str) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in s.bytes() {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
+}
+
+/// The hint colour for a wall's texture (a muted hue from the name; plain
+/// walls are grey).
+pub fn texture_hint(name: Option<&str>, wall_index: usize, seed: u64) -> [u8; 3] {
+    let key = match name {
+        Some("plain") => return [150, 150, 150],
+        Some(n) => name_hash(n),
+        None => name_hash(&format!("wall#{wall_index}/{seed}")),
+    };
+    let hue = (key % 360) as f64;
+    hsl_to_rgb(hue, 0.45, 0.45)
+}
+
+fn hsl_to_rgb(h: f64, s: f64, l: f64) -> [u8; 3] {
+    let c = (1.0 - (2.0 * l - 1.0).abs()) * s;
+    let hp = h / 60.0;
+    let x = c * (1.0 - (hp % 2.0 - 1.0).abs());
+    let (r, g, b) = match hp as u32 {
+        0 => (c, x, 0.0),
+        1 => (x, c, 0.0),
+        2 => (0.0, c, x),
+        3 => (0.0, x, c),
+        4 => (x, 0.0, c),
+        _ => (c, 0.0, x),
+    };
+    let m = l - c / 2.0;
+    [
+        ((r + m) * 255.0).round() as u8,
+        ((g + m) * 255.0).round() as u8,
+        ((b + m) * 255.0).round() as u8,
+    ]
+}
+
+fn paint(rgb: [u8; 3], alpha: f32) -> Paint<'static> {
+    let mut p = Paint::default();
+    p.set_color(Color::from_rgba8(
+        rgb[0],
+        rgb[1],
+        rgb[2],
+        (alpha.clamp(0.0, 1.0) * 255.0) as u8,
+    ));
+    p.anti_alias = true;
+    p
+}
+
+fn stroke(width: f32) -> Stroke {
+    Stroke {
+        width,
+        line_cap: LineCap::Round,
+        line_join: LineJoin::Round,
+        ..Stroke::default()
+    }
+}
+
+/// Draws a polyline of world points.
+fn polyline(
+    pm: &mut Pixmap,
+    o: &RenderOptions,
+    pts: impl Iterator<Item = DVec2>,
+    p: &Paint,
+    s: &Stroke,
+) {
+    let mut pb = PathBuilder::new();
+    let mut first = true;
+    for w in pts {
+        let (x, y) = o.to_px(w);
+        if first {
+            pb.move_to(x, y);
+            first = false;
+        } else {
+            pb.line_to(x, y);
+        }
+    }
+    if let Some(path) = pb.finish() {
+        pm.stroke_path(&path, p, s, Transform::identity(), None);
+    }
+}
+
+fn polygon(
+    pm: &mut Pixmap,
+    o: &RenderOptions,
+    pts: &[DVec2],
+    fill: Option<&Paint>,
+    line: Option<(&Paint, &Stroke)>,
+) {
+    let mut pb = PathBuilder::new();
+    for (i, &w) in pts.iter().enumerate() {
+        let (x, y) = o.to_px(w);
+        if i == 0 {
+            pb.move_to(x, y);
+        } else {
+            pb.line_to(x, y);
+        }
+    }
+    pb.close();
+    if let Some(path) = pb.finish() {
+        if let Some(f) = fill {
+            pm.fill_path(&path, f, FillRule::Winding, Transform::identity(), None);
+        }
+        if let Some((p, s)) = line {
+            pm.stroke_path(&path, p, s, Transform::identity(), None);
+        }
+    }
+}
+
+fn nice_step(target_m: f64) -> f64 {
+    let mut step = 0.1;
+    for s in [
+        0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0,
+    ] {
+        step = s;
+        if s >= target_m {
+            break;
+        }
+    }
+    step
+}
+
+/// Grid spacing (m) for a zoom: lines about 40 px apart or more.
+pub fn grid_step_m(scale_px_per_m: f64) -> f64 {
+    nice_step(40.0 / scale_px_per_m)
+}
+
+/// Scale-bar length (m) for a zoom: the longest round length that fits in
+/// 120 px.
+pub fn scale_bar_m(scale_px_per_m: f64) -> f64 {
+    let mut best = 0.1;
+    for s in [
+        0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0,
+    ] {
+        if s * scale_px_per_m <= 120.0 {
+            best = s;
+        }
+    }
+    best
+}
+
+/// Renders the scenario (and the running simulation, if any) into `pm`,
+/// which must be `opts.width × opts.height`.
+pub fn render_world(
+    pm: &mut Pixmap,
+    scenario: &Scenario,
+    sim: Option<&Simulation>,
+    opts: &RenderOptions,
+) {
+    pm.fill(Color::from_rgba8(250, 250, 247, 255));
+    let o = opts;
+    let (w, h) = (o.width as f64, o.height as f64);
+    let world_lo = DVec2::new(
+        o.center[0] - w / 2.0 / o.scale,
+        o.center[1] - h / 2.0 / o.scale,
+    );
+    let world_hi = DVec2::new(
+        o.center[0] + w / 2.0 / o.scale,
+        o.center[1] + h / 2.0 / o.scale,
+    );
+
+    if o.layers.grid {
+        let step = grid_step_m(o.scale);
+        let minor = paint([225, 225, 220], 1.0);
+        let major = paint([200, 200, 195], 1.0);
+        let s1 = stroke(1.0);
+        let mut x = (world_lo.x / step).floor() * step;
+        while x <= world_hi.x {
+            let is_major = ((x / step).round() as i64) % 5 == 0;
+            polyline(
+                pm,
+                o,
+                [DVec2::new(x, world_lo.y), DVec2::new(x, world_hi.y)].into_iter(),
+                if is_major { &major } else { &minor },
+                &s1,
+            );
+            x += step;
+        }
+        let mut y = (world_lo.y / step).floor() * step;
+        while y <= world_hi.y {
+            let is_major = ((y / step).round() as i64) % 5 == 0;
+            polyline(
+                pm,
+                o,
+                [DVec2::new(world_lo.x, y), DVec2::new(world_hi.x, y)].into_iter(),
+                if is_major { &major } else { &minor },
+                &s1,
+            );
+            y += step;
+        }
+    }
+
+    // Trajectories under everything else.
+    if let Some(sim) = sim {
+        for (i, r) in sim.robots.iter().enumerate() {
+            let c = ROBOT_COLOURS[i % ROBOT_COLOURS.len()];
+            if o.layers.odometry_path && r.log.odometry.len() > 1 {
+                let start = r.spec.start_pose();
+                let mut s = stroke(1.6);
+                s.dash = StrokeDash::new(vec![6.0, 4.0], 0.0);
+                let dark = [c[0] / 2, c[1] / 2, c[2] / 2];
+                polyline(
+                    pm,
+                    o,
+                    r.log.odometry.iter().map(|p| start.compose(p).position()),
+                    &paint(dark, 0.8),
+                    &s,
+                );
+            }
+            if o.layers.truth_path && r.log.truth.len() > 1 {
+                polyline(
+                    pm,
+                    o,
+                    r.log.truth.iter().map(|p| p.position()),
+                    &paint(c, 0.75),
+                    &stroke(2.0),
+                );
+            }
+        }
+    }
+
+    // Walls.
+    let wall_px = (0.06 * o.scale).clamp(2.0, 8.0) as f32;
+    let outline = paint([40, 40, 40], 1.0);
+    for (i, wall) in scenario.walls.iter().enumerate() {
+        let seg = [DVec2::from(wall.from), DVec2::from(wall.to)];
+        if o.selected_wall == Some(i) {
+            polyline(
+                pm,
+                o,
+                seg.into_iter(),
+                &paint([255, 200, 0], 0.9),
+                &stroke(wall_px + 8.0),
+            );
+        }
+        polyline(pm, o, seg.into_iter(), &outline, &stroke(wall_px + 2.0));
+        let hint = texture_hint(wall.texture.as_deref(), i, scenario.seed);
+        polyline(pm, o, seg.into_iter(), &paint(hint, 1.0), &stroke(wall_px));
+    }
+
+    if let Some(p) = o.preview_wall {
+        let mut s = stroke(3.0);
+        s.dash = StrokeDash::new(vec![8.0, 5.0], 0.0);
+        polyline(
+            pm,
+            o,
+            [DVec2::new(p[0], p[1]), DVec2::new(p[2], p[3])].into_iter(),
+            &paint([30, 90, 200], 0.9),
+            &s,
+        );
+    }
+
+    // Sensors, then robots on top.
+    let poses: Vec<Pose2> = match sim {
+        Some(sim) => sim.robots.iter().map(|r| r.truth).collect(),
+        None => scenario.robots.iter().map(|r| r.start_pose()).collect(),
+    };
+    if let Some(sim) = sim {
+        for r in &sim.robots {
+            if o.layers.sonar {
+                let half = (r.sonar_cone_rad() / 2.0).max(0.02);
+                for k in 0..SONAR_COUNT {
+                    let (origin, axis) = Sonar::axis(&r.truth, k);
+                    let range = r.last_sonar.ranges_m[k];
+                    let mut pts = vec![origin];
+                    for j in 0..=6 {
+                        let a = axis - half + 2.0 * half * j as f64 / 6.0;
+                        pts.push(origin + DVec2::new(a.cos(), a.sin()) * range);
+                    }
+                    let echo = !r.last_sonar.no_echo[k];
+                    polygon(
+                        pm,
+                        o,
+                        &pts,
+                        Some(&paint(
+                            if echo { [60, 170, 90] } else { [160, 200, 170] },
+                            0.18,
+                        )),
+                        Some((&paint([40, 130, 70], 0.5), &stroke(1.0))),
+                    );
+                }
+            }
+            if o.layers.laser {
+                let hit = paint([220, 40, 40], 0.22);
+                let miss = paint([220, 40, 40], 0.07);
+                let s1 = stroke(1.0);
+                let origin = r.truth.position();
+                let mut dots = PathBuilder::new();
+                for b in 0..r.last_scan.ranges_m.len() {
+                    let a = r.truth.theta + beam_bearing(b);
+                    let end = origin + DVec2::new(a.cos(), a.sin()) * r.last_scan.ranges_m[b];
+                    let max = r.last_scan.max_range[b];
+                    polyline(
+                        pm,
+                        o,
+                        [origin, end].into_iter(),
+                        if max { &miss } else { &hit },
+                        &s1,
+                    );
+                    if !max {
+                        let (x, y) = o.to_px(end);
+                        if let Some(rect) = Rect::from_xywh(x - 1.5, y - 1.5, 3.0, 3.0) {
+                            dots.push_rect(rect);
+                        }
+                    }
+                }
+                if let Some(path) = dots.finish() {
+                    pm.fill_path(
+                        &path,
+                        &paint([200, 20, 20], 0.9),
+                        FillRule::Winding,
+                        Transform::identity(),
+                        None,
+                    );
+                }
+            }
+        }
+    }
+    let problems: Vec<usize> = if sim.is_none() {
+        scenario
+            .placement_problems()
+            .iter()
+            .filter_map(|p| {
+                p.field
+                    .strip_prefix("robots[")
+                    .and_then(|s| s.split(']').next())
+                    .and_then(|s| s.parse().ok())
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
+    for (i, pose) in poses.iter().enumerate() {
+        let c = ROBOT_COLOURS[i % ROBOT_COLOURS.len()];
+        let body = P2dx::body(pose);
+        if o.selected_robot == Some(i) {
+            polygon(
+                pm,
+                o,
+                &body.corners,
+                None,
+                Some((&paint([255, 200, 0], 0.9), &stroke(6.0))),
+            );
+        }
+        let edge = if problems.contains(&i) {
+            (paint([230, 0, 0], 1.0), stroke(3.0))
+        } else {
+            (paint([20, 20, 20], 1.0), stroke(1.2))
+        };
+        polygon(
+            pm,
+            o,
+            &body.corners,
+            Some(&paint(c, 1.0)),
+            Some((&edge.0, &edge.1)),
+        );
+        // Heading: a white arrow head at the front.
+        let hl = P2dx::BODY_LENGTH_M / 2.0;
+        let tri = [
+            pose.transform_point(DVec2::new(hl - 0.02, 0.0)),
+            pose.transform_point(DVec2::new(hl - 0.17, 0.09)),
+            pose.transform_point(DVec2::new(hl - 0.17, -0.09)),
+        ];
+        polygon(pm, o, &tri, Some(&paint([255, 255, 255], 1.0)), None);
+    }
+
+    // Scale bar, bottom left (its label is drawn by the page).
+    let bar_m = scale_bar_m(o.scale);
+    let bar_px = (bar_m * o.scale) as f32;
+    let y0 = o.height as f32 - 18.0;
+    if let Some(rect) = Rect::from_xywh(14.0, y0, bar_px, 5.0) {
+        pm.fill_rect(rect, &paint([30, 30, 30], 1.0), Transform::identity(), None);
+    }
+}

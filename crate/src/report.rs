@@ -1,0 +1,121 @@
+//! # The run report
+//!
+//! `node web/cli.mjs run SCENARIO.json --json` prints this report; its field
+//! names are fixed by `shared/docs/interfaces.md` and only ever extended.
+//! Trajectories are `[t, x, y, theta]` rows, one per control step, all
+//! aligned on the same times: `truth` in the world frame, `odometry` in the
+//! robot's own odometry frame (origin at its start pose).
+//!
+//! Besides the fixed fields, each robot carries the figures a student looks
+//! at first: how far it drove, how far its odometry ended from the truth.
+
+use crate::geom::{wrap_angle, Pose2};
+use crate::sim::Simulation;
+use serde::Serialize;
+
+/// Rounds to micrometres / microradians: enough for any figure we report,
+/// and it keeps the JSON a third of the size.
+fn r6(x: f64) -> f64 {
+    (x * 1e6).round() / 1e6
+}
+
+fn rows(times: &[f64], poses: &[Pose2]) -> Vec<[f64; 4]> {
+    times
+        .iter()
+        .zip(poses)
+        .map(|(&t, p)| [r6(t), r6(p.x), r6(p.y), r6(p.theta)])
+        .collect()
+}
+
+/// Final error of dead reckoning against the truth.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct PoseError {
+    pub position_m: f64,
+    pub heading_deg: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct RobotReport {
+    pub name: String,
+    pub follow: String,
+    pub truth: Vec<[f64; 4]>,
+    pub odometry: Vec<[f64; 4]>,
+    pub bumps: u32,
+    /// Length of the true path (m).
+    pub path_length_m: f64,
+    /// Where odometry ended up, against the truth (both in the world frame).
+    pub odometry_final_error: PoseError,
+}
+
+/// Wall-clock timings measured by the caller (ms).
+#[derive(Clone, Debug, Serialize, Default, serde::Deserialize)]
+#[serde(default)]
+pub struct Timings {
+    pub simulate: f64,
+    pub total: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    pub scenario: String,
+    pub seed: u64,
+    pub duration_s: f64,
+    pub steps: usize,
+    pub robots: Vec<RobotReport>,
+    pub timings_ms: Timings,
+}
+
+/// Odometry's final pose in the world frame compared with the true one.
+pub fn odometry_final_error(start: &Pose2, odom: &Pose2, truth: &Pose2) -> PoseError {
+    let believed = start.compose(odom);
+    PoseError {
+        position_m: r6((believed.position() - truth.position()).length()),
+        heading_deg: r6(wrap_angle(believed.theta - truth.theta).to_degrees()),
+    }
+}
+
+impl Report {
+    pub fn from_sim(sim: &Simulation, timings: Timings) -> Report {
+        let robots = sim
+            .robots
+            .iter()
+            .map(|r| {
+                let log = &r.log;
+                let path_length_m = log
+                    .truth
+                    .windows(2)
+                    .map(|w| (w[1].position() - w[0].position()).length())
+                    .sum::<f64>();
+                let last = log.truth.len() - 1;
+                RobotReport {
+                    name: r.spec.name.clone(),
+                    follow: match r.spec.follow {
+                        crate::scenario::FollowSide::Left => "left".into(),
+                        crate::scenario::FollowSide::Right => "right".into(),
+                    },
+                    truth: rows(&log.times_s, &log.truth),
+                    odometry: rows(&log.times_s, &log.odometry),
+                    bumps: r.bumps,
+                    path_length_m: r6(path_length_m),
+                    odometry_final_error: odometry_final_error(
+                        &r.spec.start_pose(),
+                        &log.odometry[last],
+                        &log.truth[last],
+                    ),
+                }
+            })
+            .collect();
+        Report {
+            scenario: sim.scenario.name.clone(),
+            seed: sim.scenario.seed,
+            duration_s: sim.time_s(),
+            steps: sim.steps(),
+            robots,
+            timings_ms: timings,
+        }
+    }
+
+    pub fn to_json(&self) -> String {
+        serde_json::to_string(self).unwrap_or_else(|e| format!("{{\"error\":\"{e}\"}}"))
+    }
+}

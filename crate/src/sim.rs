@@ -1,0 +1,334 @@
+//! # The simulation: a fixed-step loop over sense, decide, move
+//!
+//! The thesis ran its robots in USARSim and read their sensors from MATLAB
+//! (§3.2, §6.1.3); here the whole loop is one deterministic function of the
+//! scenario and its seed. Every control step of [`CONTROL_DT_S`]:
+//!
+//! 1. **decide** — each robot's [`WallFollower`] turns the latest odometry
+//!    pose, sonar and laser into a wheel-speed command. It never sees the
+//!    truth.
+//! 2. **move** — the wheels follow the command within their limits; the true
+//!    pose moves on the exact arc. If the body would touch a wall or another
+//!    robot, it moves only as far as it can (to within a millimetre of the
+//!    contact), its wheels stall, and a *bump* is counted once per contact;
+//!    the encoders read only the travel that happened.
+//! 3. **odometry** — the encoders read the wheel travels with noise and the
+//!    robot integrates its believed pose.
+//! 4. **sense** — sonar and laser are cast from the true pose against the
+//!    walls and the other robots' bodies.
+//! 5. **log** — one row per robot, as the thesis recorded them (§6.2.1):
+//!    time, odometry pose, 8 sonar ranges, 181 laser ranges; the true pose is
+//!    kept beside it, for scoring only.
+//!
+//! Row 0 is the start (time 0); a run of `n` steps has `n + 1` rows.
+
+use crate::follower::{Command, FollowerMode, WallFollower};
+use crate::geom::{ConvexPolygon, Pose2, Segment};
+use crate::kinematics::{integrate_wheels, wheel_speeds, P2dx, WheelState, CONTROL_DT_S};
+use crate::odometry::Odometry;
+use crate::rng::{Rng, Stream};
+use crate::scenario::{RobotSpec, Scenario, ScenarioError};
+use crate::sensors::{Laser, LaserScan, RangeScene, Sonar, SonarReading, LASER_BEAMS, SONAR_COUNT};
+use crate::world::World;
+use std::collections::VecDeque;
+
+/// The log keeps at most this many sensor rows per robot (20 simulated
+/// minutes at 10 Hz, about 4.5 MB). Older sensor rows are dropped first;
+/// poses (a few bytes a row) are always kept whole.
+pub const LOG_SENSOR_CAP: usize = 12_000;
+
+/// Laser ranges are logged in millimetres; this value marks a max-range
+/// (no return) beam.
+pub const LASER_LOG_NO_RETURN: u16 = u16::MAX;
+
+/// One robot's sensor row as logged.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SensorRow {
+    pub step: usize,
+    /// Sonar ranges 1..8 (m).
+    pub sonar_m: [f32; SONAR_COUNT],
+    /// Laser ranges (mm), [`LASER_LOG_NO_RETURN`] for no return.
+    pub laser_mm: [u16; LASER_BEAMS],
+}
+
+/// Everything recorded about one robot, one row per control step.
+#[derive(Clone, Debug, Default)]
+pub struct RobotLog {
+    pub times_s: Vec<f64>,
+    /// What the robot believes (its odometry frame).
+    pub odometry: Vec<Pose2>,
+    /// Where it really was (world frame). For scoring and display only.
+    pub truth: Vec<Pose2>,
+    /// The most recent sensor rows, at most [`LOG_SENSOR_CAP`].
+    pub sensors: VecDeque<SensorRow>,
+    /// Sensor rows dropped because of the cap.
+    pub sensors_dropped: usize,
+}
+
+/// One simulated robot: its true state, its noisy senses, and its controller.
+#[derive(Clone, Debug)]
+pub struct RobotSim {
+    pub spec: RobotSpec,
+    /// True pose in the world frame (never shown to the controller).
+    pub truth: Pose2,
+    wheels: WheelState,
+    pub odometry: Odometry,
+    sonar: Sonar,
+    laser: Laser,
+    pub follower: WallFollower,
+    pub bumps: u32,
+    in_contact: bool,
+    bumped_last_step: bool,
+    pub last_sonar: SonarReading,
+    pub last_scan: LaserScan,
+    pub last_command: Command,
+    pub log: RobotLog,
+}
+
+impl RobotSim {
+    pub fn body(&self) -> ConvexPolygon {
+        P2dx::body(&self.truth)
+    }
+
+    /// Full opening of each sonar cone (rad).
+    pub fn sonar_cone_rad(&self) -> f64 {
+        self.sonar.cone_rad
+    }
+
+    pub fn mode(&self) -> FollowerMode {
+        self.follower.mode()
+    }
+
+    fn log_row(&mut self, step: usize, t: f64) {
+        self.log.times_s.push(t);
+        self.log.odometry.push(self.odometry.pose());
+        self.log.truth.push(self.truth);
+        let mut sonar_m = [0f32; SONAR_COUNT];
+        for (o, r) in sonar_m.iter_mut().zip(self.last_sonar.ranges_m) {
+            *o = r as f32;
+        }
+        let mut laser_mm = [0u16; LASER_BEAMS];
+        for (i, o) in laser_mm.iter_mut().enumerate() {
+            *o = if self.last_scan.max_range[i] {
+                LASER_LOG_NO_RETURN
+            } else {
+                (self.last_scan.ranges_m[i] * 1000.0).round().min(65_000.0) as u16
+            };
+        }
+        if self.log.sensors.len() == LOG_SENSOR_CAP {
+            self.log.sensors.pop_front();
+            self.log.sensors_dropped += 1;
+        }
+        self.log.sensors.push_back(SensorRow {
+            step,
+            sonar_m,
+            laser_mm,
+        });
+    }
+}
+
+/// The whole multi-robot simulation.
+#[derive(Clone, Debug)]
+pub struct Simulation {
+    pub scenario: Scenario,
+    pub world: World,
+    pub robots: Vec<RobotSim>,
+    steps: usize,
+}
+
+impl Simulation {
+    /// Builds a simulation at time 0. Fails, naming the field, if a robot
+    /// starts inside or touching a wall or another robot.
+    pub fn new(scenario: &Scenario) -> Result<Simulation, ScenarioError> {
+        if let Some(p) = scenario.placement_problems().into_iter().next() {
+            return Err(p);
+        }
+        let world = World::new(scenario.walls.iter().map(|w| w.segment()).collect());
+        let seed = scenario.seed;
+        let robots = scenario
+            .robots
+            .iter()
+            .enumerate()
+            .map(|(i, spec)| {
+                let n = &scenario.noise;
+                let s = &scenario.sensors;
+                RobotSim {
+                    spec: spec.clone(),
+                    truth: spec.start_pose(),
+                    wheels: WheelState::default(),
+                    odometry: Odometry::new(n, Rng::stream(seed, i, Stream::Odometry)),
+                    sonar: Sonar::new(
+                        s.sonar_range_m,
+                        s.sonar_cone_deg,
+                        n.sonar_std_m,
+                        Rng::stream(seed, i, Stream::Sonar),
+                    ),
+                    laser: Laser::new(
+                        s.laser_range_m,
+                        n.laser_std_m,
+                        Rng::stream(seed, i, Stream::Laser),
+                    ),
+                    follower: WallFollower::new(spec.follow, spec.distance, spec.speed),
+                    bumps: 0,
+                    in_contact: false,
+                    bumped_last_step: false,
+                    last_sonar: SonarReading::default(),
+                    last_scan: LaserScan {
+                        ranges_m: vec![0.0; LASER_BEAMS],
+                        max_range: vec![true; LASER_BEAMS],
+                        reflective: vec![false; LASER_BEAMS],
+                        range_max_m: s.laser_range_m,
+                    },
+                    last_command: Command::default(),
+                    log: RobotLog::default(),
+                }
+            })
+            .collect();
+        let mut sim = Simulation {
+            scenario: scenario.clone(),
+            world,
+            robots,
+            steps: 0,
+        };
+        sim.sense();
+        for r in &mut sim.robots {
+            r.log_row(0, 0.0);
+        }
+        Ok(sim)
+    }
+
+    /// Control steps taken so far.
+    pub fn steps(&self) -> usize {
+        self.steps
+    }
+
+    /// Simulated time (s).
+    pub fn time_s(&self) -> f64 {
+        self.steps as f64 * CONTROL_DT_S
+    }
+
+    /// Total steps the scenario's duration asks for.
+    pub fn total_steps(&self) -> usize {
+        (self.scenario.duration_s / CONTROL_DT_S).round() as usize
+    }
+
+    pub fn finished(&self) -> bool {
+        self.steps >= self.total_steps()
+    }
+
+    /// Body edges of every robot except `skip`.
+    fn obstacles_except(&self, skip: usize) -> Vec<Segment> {
+        self.robots
+            .iter()
+            .enumerate()
+            .filter(|(j, _)| *j != skip)
+            .flat_map(|(_, r)| r.body().edges().collect::<Vec<_>>())
+            .collect()
+    }
+
+    fn sense(&mut self) {
+        for i in 0..self.robots.len() {
+            let obstacles = self.obstacles_except(i);
+            let scene = RangeScene {
+                world: &self.world,
+                obstacles: &obstacles,
+            };
+            let r = &mut self.robots[i];
+            r.last_sonar = r.sonar.read(&scene, &r.truth);
+            r.last_scan = r.laser.scan(&scene, &r.truth);
+        }
+    }
+
+    /// Advances one control step. Does nothing once the duration is reached.
+    pub fn step(&mut self) {
+        self.step_with(&[]);
+    }
+
+    /// Advances one control step with some robots driven by hand:
+    /// `overrides[i]`, when given and `Some`, replaces robot `i`'s follower
+    /// command (teleoperation, and tests of the physics).
+    pub fn step_with(&mut self, overrides: &[Option<Command>]) {
+        if self.finished() {
+            return;
+        }
+        let t = self.time_s();
+        // 1. decide
+        for (i, r) in self.robots.iter_mut().enumerate() {
+            let odom = r.odometry.pose();
+            let auto = r
+                .follower
+                .update(t, &odom, &r.last_sonar, &r.last_scan, r.bumped_last_step);
+            r.last_command = overrides.get(i).copied().flatten().unwrap_or(auto);
+        }
+        // 2-3. move and read encoders
+        for i in 0..self.robots.len() {
+            let others: Vec<ConvexPolygon> = self
+                .robots
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| *j != i)
+                .map(|(_, r)| r.body())
+                .collect();
+            let world = &self.world;
+            let r = &mut self.robots[i];
+            let (cl, cr) = wheel_speeds(
+                r.last_command.v_mps,
+                r.last_command.omega_radps,
+                P2dx::WHEEL_BASE_M,
+            );
+            let mut probe = r.wheels;
+            let (dl, dr) = probe.advance(cl, cr, CONTROL_DT_S);
+            let free = |f: f64| {
+                let body = P2dx::body(&integrate_wheels(
+                    &r.truth,
+                    f * dl,
+                    f * dr,
+                    P2dx::WHEEL_BASE_M,
+                ));
+                !(world.body_hits_wall(&body) || others.iter().any(|o| o.touches(&body)))
+            };
+            if free(1.0) {
+                r.in_contact = false;
+                r.bumped_last_step = false;
+                r.wheels = probe;
+                r.truth = integrate_wheels(&r.truth, dl, dr, P2dx::WHEEL_BASE_M);
+                r.odometry.update(dl, dr);
+            } else {
+                // Blocked: move as far as the body can go (to within 1 mm of
+                // the contact), then stall. One bump per contact.
+                let (mut lo, mut hi) = (0.0, 1.0);
+                while (hi - lo) * dl.abs().max(dr.abs()) > 0.001 {
+                    let mid = 0.5 * (lo + hi);
+                    if free(mid) {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                if !r.in_contact {
+                    r.bumps += 1;
+                }
+                r.in_contact = true;
+                r.bumped_last_step = true;
+                r.wheels.stop();
+                r.truth = integrate_wheels(&r.truth, lo * dl, lo * dr, P2dx::WHEEL_BASE_M);
+                r.odometry.update(lo * dl, lo * dr);
+            }
+        }
+        self.steps += 1;
+        // 4. sense
+        self.sense();
+        // 5. log
+        let (step, t) = (self.steps, self.time_s());
+        for r in &mut self.robots {
+            r.log_row(step, t);
+        }
+    }
+
+    /// Runs to the end of the scenario's duration.
+    pub fn run_to_end(&mut self) {
+        while !self.finished() {
+            self.step();
+        }
+    }
+}

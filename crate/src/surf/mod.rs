@@ -1,0 +1,1 @@
+//! SURF: detection, description, matching and MSAC (being built; see issue 4).

@@ -1,0 +1,229 @@
+// End-to-end test of the page (index.html + web/) in headless Chromium.
+//
+// Serves the repository root from a tiny static server of its own (on a free
+// port of 127.0.0.1), drives /usr/bin/chromium with playwright-core, and
+// walks through what a student does: load a preset, draw a wall, run, pause,
+// step, read the sensors, reset, reload (autosave), and survive a corrupt
+// save. Screenshots go to test-artifacts/.
+//
+// Needs the wasm build in web/pkg (`./build.sh build`). Run alone with
+//   node --test tests/page.test.mjs
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import http from 'node:http';
+import { readFile, mkdir, access } from 'node:fs/promises';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+const ROOT = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
+const ARTIFACTS = path.join(ROOT, 'test-artifacts');
+const CHROMIUM_FLAGS = [
+  '--headless',
+  '--no-sandbox',
+  '--disable-gpu',
+  '--disable-quic',
+  '--no-first-run',
+  '--disable-background-networking',
+  '--disable-component-update',
+  '--disable-sync',
+];
+const MIME = {
+  '.html': 'text/html; charset=utf-8',
+  '.js': 'text/javascript; charset=utf-8',
+  '.mjs': 'text/javascript; charset=utf-8',
+  '.css': 'text/css; charset=utf-8',
+  '.json': 'application/json',
+  '.wasm': 'application/wasm',
+  '.png': 'image/png',
+  '.svg': 'image/svg+xml',
+  '.ts': 'text/plain; charset=utf-8',
+};
+const STORAGE_KEY = 'slamlab.scenario.v1';
+
+/** A static file server for the repository root; resolves to {server, url}. */
+function serveRoot() {
+  const server = http.createServer(async (req, res) => {
+    try {
+      const url = new URL(req.url, 'http://localhost');
+      let rel = decodeURIComponent(url.pathname);
+      if (rel.endsWith('/')) rel += 'index.html';
+      const file = path.resolve(ROOT, `.${rel}`);
+      if (!file.startsWith(ROOT + path.sep)) {
+        res.writeHead(403).end();
+        return;
+      }
+      const body = await readFile(file);
+      res.writeHead(200, {
+        'Content-Type': MIME[path.extname(file)] ?? 'application/octet-stream',
+        'Cache-Control': 'no-store',
+      });
+      res.end(body);
+    } catch {
+      res.writeHead(404, { 'Content-Type': 'text/plain' }).end('not found');
+    }
+  });
+  return new Promise((resolve, reject) => {
+    server.once('error', reject);
+    server.listen(0, '127.0.0.1', () => resolve({ server, url: `http://127.0.0.1:${server.address().port}/` }));
+  });
+}
+
+let server;
+let baseUrl;
+let browser;
+
+before(async () => {
+  await access(path.join(ROOT, 'web/pkg/slamlab_bg.wasm')).catch(() => {
+    throw new Error('web/pkg is missing: run ./build.sh build first');
+  });
+  await mkdir(ARTIFACTS, { recursive: true });
+  ({ server, url: baseUrl } = await serveRoot());
+  browser = await chromium.launch({ executablePath: '/usr/bin/chromium', args: CHROMIUM_FLAGS });
+});
+
+after(async () => {
+  await browser?.close();
+  await new Promise((resolve) => (server ? server.close(resolve) : resolve()));
+});
+
+async function waitReady(page) {
+  await page.waitForFunction(() => window.slamlab?.ready === true && document.body.dataset.ready === 'true', null, {
+    timeout: 15000,
+  });
+}
+
+const state = (page) => page.evaluate(() => window.slamlab.state());
+const scenario = (page) => page.evaluate(() => window.slamlab.scenario());
+const statusText = (page) => page.locator('#status').innerText();
+
+/** A left-button drag between two world points (m), with intermediate moves. */
+async function dragWorld(page, from, to) {
+  const a = await page.evaluate(([x, y]) => window.slamlab.worldToClient(x, y), from);
+  const b = await page.evaluate(([x, y]) => window.slamlab.worldToClient(x, y), to);
+  await page.mouse.move(a[0], a[1]);
+  await page.mouse.down();
+  await page.mouse.move(b[0], b[1], { steps: 8 });
+  await page.mouse.up();
+}
+
+test('the lab page: edit, run, step, read sensors, reset, autosave, corrupt save', { timeout: 60000 }, async () => {
+  const context = await browser.newContext({ viewport: { width: 1280, height: 720 } });
+  const page = await context.newPage();
+  const problems = [];
+  page.on('console', (m) => {
+    if (m.type() === 'error') problems.push(`console error: ${m.text()} (${m.location().url})`);
+  });
+  page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
+
+  await page.goto(baseUrl);
+  await waitReady(page);
+
+  // Load a preset, then the thesis preset, through the select.
+  await page.selectOption('#preset', 'maze');
+  await page.waitForFunction(() => window.slamlab.scenario().name === 'maze');
+  await page.selectOption('#preset', 'thesis');
+  await page.waitForFunction(() => window.slamlab.scenario().name === 'thesis');
+  const thesis = await scenario(page);
+  assert.equal(thesis.walls.length, 19, 'the thesis preset has 19 walls');
+  assert.equal(thesis.robots.length, 2);
+
+  // Draw a wall with the Wall tool: the ends snap to 0.1 m and the direction
+  // to 15 degrees (this drag is 0.3 degrees off horizontal).
+  await page.getByRole('button', { name: 'Wall drawing tool (W)' }).click();
+  await dragWorld(page, [7.03, 12.46], [11.04, 12.52]);
+  let s = await scenario(page);
+  assert.equal(s.walls.length, 20, 'one more wall after the drag');
+  assert.deepEqual(s.walls[19].from, [7, 12.5]);
+  assert.deepEqual(s.walls[19].to, [11, 12.5]);
+  // The Lab got the same scenario (canonical JSON from wasm).
+  const inLab = await page.evaluate(() => JSON.parse(window.slamlab.lab.scenarioJson()).walls.length);
+  assert.equal(inLab, 20);
+
+  // A click without a drag makes no wall.
+  const p = await page.evaluate(() => window.slamlab.worldToClient(8.5, 11.5));
+  await page.mouse.click(p[0], p[1]);
+  s = await scenario(page);
+  assert.equal(s.walls.length, 20, 'a zero-length drag makes no wall');
+  await page.keyboard.press('Escape'); // back to the Select tool
+
+  // Run until simulated time advances, take a mid-run screenshot, pause.
+  await page.getByRole('button', { name: 'Run', exact: true }).click();
+  await page.waitForFunction(() => window.slamlab.state().time_s >= 3, null, { timeout: 15000 });
+  await page.screenshot({ path: path.join(ARTIFACTS, 'page-running.png') });
+  await page.getByRole('button', { name: 'Pause', exact: true }).click();
+  const paused = (await state(page)).time_s;
+  assert.ok(paused >= 3, `time advanced while running (t = ${paused})`);
+  await page.waitForTimeout(250);
+  assert.equal((await state(page)).time_s, paused, 'time stands still while paused');
+
+  // Step: exactly one 0.1 s control step.
+  await page.getByRole('button', { name: 'Step', exact: true }).click();
+  const stepped = await state(page);
+  assert.ok(Math.abs(stepped.time_s - (paused + 0.1)) < 1e-9, `Step advanced ${stepped.time_s - paused} s`);
+  assert.equal(stepped.robots.length, 2);
+  for (const r of stepped.robots) assert.equal(r.bumps, 0, `${r.name} bumped`);
+
+  // Readouts: 8 sonar values per robot, numbers within the 2 m range, at
+  // least one echo; the clock shows the time.
+  await page.waitForFunction(
+    (t) => document.querySelector('#clock').textContent.includes(`t = ${t.toFixed(1)} s`),
+    stepped.time_s,
+  );
+  const sonar = await page.$$eval('.robot-card', (cards) =>
+    cards.map((c) => [...c.querySelectorAll('.sonar-cell .v')].map((v) => Number(v.textContent))),
+  );
+  assert.equal(sonar.length, 2, 'one readout card per robot');
+  for (const values of sonar) {
+    assert.equal(values.length, 8, 'eight sonars per robot');
+    for (const v of values) assert.ok(Number.isFinite(v) && v >= 0 && v <= 2.0 + 1e-9, `sonar value ${v}`);
+    assert.ok(values.some((v) => v < 1.95), 'a wall-follower hears its wall');
+  }
+  const modes = await page.$$eval('.robot-card .readout .mode', (els) => els.map((e) => e.textContent));
+  assert.ok(modes.every((m) => m && m !== 'not started' && m !== '–'), `modes: ${modes}`);
+
+  await page.screenshot({ path: path.join(ARTIFACTS, 'page.png') });
+  await page.setViewportSize({ width: 1600, height: 900 });
+  await page.waitForTimeout(150);
+  await page.screenshot({ path: path.join(ARTIFACTS, 'page-1600x900.png') });
+  await page.setViewportSize({ width: 1280, height: 720 });
+
+  // Reset: back to t = 0 and the editing view.
+  await page.getByRole('button', { name: 'Reset', exact: true }).click();
+  const r0 = await state(page);
+  assert.equal(r0.time_s, 0);
+  assert.equal(r0.running, false);
+  assert.match(await page.locator('#clock').innerText(), /t = 0\.0 s/);
+
+  // Autosave: a reload brings back the edited scenario.
+  await page.reload();
+  await waitReady(page);
+  s = await scenario(page);
+  assert.equal(s.walls.length, 20, 'the drawn wall survives a reload');
+  assert.match(await statusText(page), /Restored/);
+
+  // A corrupt save is reported, the thesis preset loads and the page works.
+  await page.evaluate((key) => localStorage.setItem(key, '{"version":1,"scenario":{"walls":[{"from":'), STORAGE_KEY);
+  await page.reload();
+  await waitReady(page);
+  const status = await statusText(page);
+  assert.match(status, /could not be restored/i);
+  assert.equal(await page.locator('#status').getAttribute('class'), 'status warn');
+  s = await scenario(page);
+  assert.equal(s.name, 'thesis');
+  assert.equal(s.walls.length, 19);
+  await page.getByRole('button', { name: 'Step', exact: true }).click();
+  assert.ok(Math.abs((await state(page)).time_s - 0.1) < 1e-9, 'Step works after a corrupt save');
+
+  // A save that is valid JSON but not a valid scenario is reported by field.
+  await page.evaluate(
+    (key) => localStorage.setItem(key, JSON.stringify({ version: 1, scenario: { walls: [], robots: [] } })),
+    STORAGE_KEY,
+  );
+  await page.reload();
+  await waitReady(page);
+  assert.match(await statusText(page), /could not be restored: robots/i);
+
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});

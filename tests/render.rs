@@ -1,0 +1,128 @@
+//! Rendering: golden images and pixel checks.
+//!
+//! Golden images are compared with a small tolerance (anti-aliased edges may
+//! differ by a few levels between tiny-skia's SIMD and scalar paths). To
+//! regenerate them after an intended change:
+//! `SLAMLAB_BLESS=1 cargo test -p slamlab --test render`.
+
+use slamlab::lab::Lab;
+use slamlab::render::{grid_step_m, scale_bar_m, Layers, RenderOptions};
+use wasm_bindgen_test::wasm_bindgen_test;
+
+const THESIS: &str = include_str!("../scenarios/thesis.json");
+const GOLDEN_EDIT: &[u8] = include_bytes!("golden/thesis_edit_320x240.png");
+const GOLDEN_RUN: &[u8] = include_bytes!("golden/thesis_run20s_320x240.png");
+
+fn view(w: u32, h: u32, lab: &mut Lab) {
+    let mut v = RenderOptions {
+        width: w,
+        height: h,
+        layers: Layers {
+            sonar: true,
+            ..Layers::default()
+        },
+        ..RenderOptions::default()
+    };
+    v.fit(lab.scenario());
+    lab.set_view(v).unwrap();
+}
+
+fn pixel(data: &[u8], w: u32, x: u32, y: u32) -> [u8; 4] {
+    let i = ((y * w + x) * 4) as usize;
+    [data[i], data[i + 1], data[i + 2], data[i + 3]]
+}
+
+/// Compares with a golden PNG: at most 0.5 % of pixels may differ, none by
+/// more than 48 levels in any channel.
+fn compare_golden(name: &str, golden: &[u8], rgba: &[u8], w: u32, h: u32) {
+    if std::env::var("SLAMLAB_BLESS").is_ok() {
+        let path = format!("{}/../tests/golden/{name}", env!("CARGO_MANIFEST_DIR"));
+        image::save_buffer(&path, rgba, w, h, image::ColorType::Rgba8).unwrap();
+        return;
+    }
+    let img = image::load_from_memory(golden).unwrap().to_rgba8();
+    assert_eq!((img.width(), img.height()), (w, h));
+    let mut differ = 0;
+    for (a, b) in img.as_raw().chunks(4).zip(rgba.chunks(4)) {
+        let d = a.iter().zip(b).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
+        assert!(d <= 48, "{name}: a pixel differs by {d}");
+        if d > 2 {
+            differ += 1;
+        }
+    }
+    assert!(
+        differ * 200 <= (w * h) as usize,
+        "{name}: {differ} pixels differ"
+    );
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn editing_view_matches_golden_image() {
+    let mut lab = Lab::new(THESIS).unwrap();
+    view(320, 240, &mut lab);
+    let data = lab.render().unwrap().data().to_vec();
+    compare_golden("thesis_edit_320x240.png", GOLDEN_EDIT, &data, 320, 240);
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn running_view_matches_golden_image() {
+    let mut lab = Lab::new(THESIS).unwrap();
+    view(320, 240, &mut lab);
+    lab.step(200).unwrap();
+    let data = lab.render().unwrap().data().to_vec();
+    compare_golden("thesis_run20s_320x240.png", GOLDEN_RUN, &data, 320, 240);
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn robots_walls_and_background_land_where_the_view_says() {
+    let mut lab = Lab::new(THESIS).unwrap();
+    let v = RenderOptions {
+        width: 400,
+        height: 300,
+        center: [10.0, 7.5],
+        scale: 20.0,
+        layers: Layers {
+            grid: false,
+            ..Layers::default()
+        },
+        ..RenderOptions::default()
+    };
+    lab.set_view(v.clone()).unwrap();
+    let data = lab.render().unwrap().data().to_vec();
+    // robot1 starts at (2, 7.5): pixel ((2-10)*20+200, 150-(0)*20) = (40, 150).
+    let (x, y) = v.to_px(glam::DVec2::new(2.0, 7.5));
+    assert_eq!((x, y), (40.0, 150.0));
+    // Just behind its centre (the white heading arrow is at the front).
+    let p = pixel(&data, 400, 40, 153);
+    assert_eq!(&p[..3], &[31, 119, 180], "robot1 body colour");
+    // The bottom outer wall y = 0 is at row 300 - 0 => 150 + 7.5*20 = 300: off
+    // the image; the left wall x = 0 is at column 0 + 200 - 200 = 0. The wall
+    // (0,5)-(5,5) crosses row 150 - (5-7.5)*20 = 200 at column 60.
+    let wall = pixel(&data, 400, 60, 200);
+    assert!(wall[0] < 200 && wall[1] < 200, "wall drawn: {wall:?}");
+    // Open floor is the background colour and opaque.
+    assert_eq!(pixel(&data, 400, 200, 60), [250, 250, 247, 255]);
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn bad_views_are_refused_with_a_message() {
+    let mut lab = Lab::new(THESIS).unwrap();
+    let bad = RenderOptions {
+        width: 0,
+        ..RenderOptions::default()
+    };
+    assert!(lab.set_view(bad).unwrap_err().contains("view size"));
+    let bad = RenderOptions {
+        scale: f64::NAN,
+        ..RenderOptions::default()
+    };
+    assert!(lab.set_view(bad).unwrap_err().contains("scale"));
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn grid_and_scale_bar_steps_are_round_numbers() {
+    assert_eq!(grid_step_m(40.0), 1.0);
+    assert_eq!(grid_step_m(10.0), 5.0);
+    assert_eq!(scale_bar_m(40.0), 2.0);
+    assert_eq!(scale_bar_m(200.0), 0.5);
+}

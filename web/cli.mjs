@@ -1,0 +1,167 @@
+#!/usr/bin/env node
+// The lab's command line: the same wasm build as the page, run headless in node.
+//
+//   node web/cli.mjs run SCENARIO.json [--seed N] [--duration S] [--json]
+//
+// Progress goes to stderr; with --json the report is the only thing on stdout.
+// Exit status: 0 when the run completed, 2 on bad input (message on stderr),
+// 1 on an internal error (a bug: please report it).
+// Further commands (features, match, bench-surf, ...) come from web/cli/*.mjs.
+import { readFile } from 'node:fs/promises';
+import { performance } from 'node:perf_hooks';
+import { loadWasm } from './cli/wasm.mjs';
+
+/** An input error: exit status 2 with this message. */
+export class UsageError extends Error {}
+
+const USAGE = `usage:
+  node web/cli.mjs run SCENARIO.json [--seed N] [--duration S] [--json]
+      run the scenario headless and print a report (JSON with --json)`;
+
+/**
+ * Splits argv into positionals and --options. `spec` maps option names to
+ * 'flag' (no value) or 'value'. Unknown options are input errors.
+ */
+export function parseArgs(argv, spec) {
+  const positional = [];
+  const options = {};
+  for (let i = 0; i < argv.length; i++) {
+    const a = argv[i];
+    if (a.startsWith('--')) {
+      const [name, inline] = a.slice(2).split(/=(.*)/s, 2);
+      if (!(name in spec)) throw new UsageError(`unknown option --${name}`);
+      if (spec[name] === 'flag') {
+        options[name] = true;
+      } else {
+        const v = inline ?? argv[++i];
+        if (v === undefined) throw new UsageError(`--${name} needs a value`);
+        options[name] = v;
+      }
+    } else {
+      positional.push(a);
+    }
+  }
+  return { positional, options };
+}
+
+async function readText(path, what) {
+  try {
+    return await readFile(path, 'utf8');
+  } catch (e) {
+    throw new UsageError(`cannot read ${what} '${path}': ${e.code ?? e.message}`);
+  }
+}
+
+/** Calls into wasm; an Error thrown there is a problem with the input. */
+function wasmCall(f) {
+  try {
+    return f();
+  } catch (e) {
+    if (e instanceof WebAssembly.RuntimeError) throw e; // a trap is a bug
+    throw new UsageError(e.message ?? String(e));
+  }
+}
+
+async function run(argv, wasm) {
+  const { positional, options } = parseArgs(argv, {
+    seed: 'value', duration: 'value', json: 'flag', method: 'value',
+  });
+  if (positional.length !== 1) throw new UsageError('run: expected exactly one SCENARIO.json');
+  if (options.method !== undefined) {
+    throw new UsageError('--method: map merging is not available in this build yet');
+  }
+  const t0 = performance.now();
+  const text = await readText(positional[0], 'scenario');
+  const lab = wasmCall(() => new wasm.Lab(text));
+  if (options.seed !== undefined) {
+    const seed = Number(options.seed);
+    if (!/^\d+$/.test(options.seed) || !Number.isSafeInteger(seed)) {
+      throw new UsageError(`--seed: '${options.seed}' is not a whole number from 0 to 2^53`);
+    }
+    wasmCall(() => lab.setSeed(seed));
+  }
+  if (options.duration !== undefined) {
+    const d = Number(options.duration);
+    if (options.duration.trim() === '' || !Number.isFinite(d)) {
+      throw new UsageError(`--duration: '${options.duration}' is not a number of seconds`);
+    }
+    wasmCall(() => lab.setDuration(d));
+  }
+  // Refuse badly placed robots before running (the message names the field).
+  const problems = JSON.parse(lab.problemsJson());
+  if (problems.length > 0) throw new UsageError(problems[0].text);
+
+  const state0 = JSON.parse(lab.stateJson());
+  const total = state0.total_steps;
+  const tSim = performance.now();
+  let done = 0;
+  let lastReport = tSim;
+  while (done < total) {
+    const n = wasmCall(() => lab.step(Math.min(500, total - done)));
+    if (n === 0) break;
+    done += n;
+    const now = performance.now();
+    if (now - lastReport > 1000 || done === total) {
+      process.stderr.write(`simulated ${(done / 10).toFixed(1)} / ${(total / 10).toFixed(1)} s\n`);
+      lastReport = now;
+    }
+  }
+  const simulateMs = performance.now() - tSim;
+  const totalMs = performance.now() - t0;
+  const report = wasmCall(() => lab.reportJson(JSON.stringify({ simulate: simulateMs, total: totalMs })));
+  if (options.json) {
+    process.stdout.write(report + '\n');
+  } else {
+    const r = JSON.parse(report);
+    console.log(`scenario ${r.scenario}, seed ${r.seed}: ${r.steps} steps (${r.duration_s.toFixed(1)} s simulated) in ${simulateMs.toFixed(0)} ms`);
+    for (const robot of r.robots) {
+      const e = robot.odometry_final_error;
+      console.log(`  ${robot.name} (follows ${robot.follow} wall): path ${robot.path_length_m.toFixed(1)} m, ` +
+        `bumps ${robot.bumps}, odometry off by ${e.position_m.toFixed(2)} m and ${e.heading_deg.toFixed(1)} deg at the end`);
+    }
+  }
+  return 0;
+}
+
+const commands = { run };
+const usages = [USAGE];
+
+// Commands contributed by other capabilities (each module exports `commands`
+// and optionally `usage`).
+for (const mod of ['./cli/surf.mjs']) {
+  try {
+    const m = await import(mod);
+    Object.assign(commands, m.commands);
+    if (m.usage) usages.push(m.usage);
+  } catch (e) {
+    if (e.code !== 'ERR_MODULE_NOT_FOUND') throw e;
+  }
+}
+
+async function main() {
+  const [cmd, ...rest] = process.argv.slice(2);
+  if (!cmd || cmd === '--help' || cmd === '-h' || cmd === 'help') {
+    console.error(usages.join('\n'));
+    return cmd ? 0 : 2;
+  }
+  const f = commands[cmd];
+  if (!f) {
+    console.error(`unknown command '${cmd}'\n${usages.join('\n')}`);
+    return 2;
+  }
+  const wasm = await loadWasm();
+  return await f(rest, wasm);
+}
+
+main().then(
+  (code) => { process.exitCode = code ?? 0; },
+  (e) => {
+    if (e instanceof UsageError) {
+      console.error(`error: ${e.message}`);
+      process.exitCode = 2;
+    } else {
+      console.error(`internal error: ${e.stack ?? e}`);
+      process.exitCode = 1;
+    }
+  },
+);
