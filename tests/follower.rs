@@ -97,12 +97,7 @@ fn every_preset_is_toured_without_a_bump() {
         sim.run_to_end();
         for r in &sim.robots {
             assert_eq!(r.bumps, 0, "{name}/{} bumped", r.spec.name);
-            let path: f64 = r
-                .log
-                .truth
-                .windows(2)
-                .map(|w| (w[1].position() - w[0].position()).length())
-                .sum();
+            let path = r.log.path_length_m();
             // Cruise 0.35 m/s: a real tour covers most of the possible distance.
             let possible = 0.35 * s.duration_s;
             assert!(
@@ -237,12 +232,7 @@ fn random_user_drawn_mazes_are_toured_without_a_bump() {
                 r.spec.name,
                 s.to_json_pretty()
             );
-            let path: f64 = r
-                .log
-                .truth
-                .windows(2)
-                .map(|w| (w[1].position() - w[0].position()).length())
-                .sum();
+            let path = r.log.path_length_m();
             assert!(
                 path > 40.0,
                 "maze seed {seed}: {} drove only {path:.1} m",

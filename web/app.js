@@ -16,7 +16,7 @@
 // Every call into wasm that can throw runs inside `guard`, which shows the
 // message in the status line: the page never throws an uncaught exception.
 
-import init, { Lab, validateScenario, version, simdEnabled } from './pkg/slamlab.js';
+import init, { Lab, validateScenario, version, simdEnabled, robotColours } from './pkg/slamlab.js';
 import {
   View,
   clamp,
@@ -31,7 +31,7 @@ import {
   wallEnd,
   wrapAngle,
 } from './geometry.js';
-import { RobotsPanel, robotColour } from './robots-panel.js';
+import { RobotsPanel, robotColour, setRobotColours } from './robots-panel.js';
 
 const STORAGE_KEY = 'slamlab.scenario.v1';
 const LAYERS_KEY = 'slamlab.layers.v1';
@@ -1400,6 +1400,7 @@ function frame(now) {
 async function main() {
   try {
     await init();
+    setRobotColours(JSON.parse(robotColours()));
   } catch (e) {
     setStatus(`Could not load the wasm module (web/pkg): run ./build.sh build, then reload. ${message(e)}`, 'error');
     return;

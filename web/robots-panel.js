@@ -13,17 +13,12 @@
 
 import { deg, fmt } from './geometry.js';
 
-/** Robot colours by index, the list the renderer uses. */
-export const ROBOT_COLOURS = [
-  [31, 119, 180],
-  [230, 110, 20],
-  [44, 160, 44],
-  [200, 40, 60],
-  [148, 103, 189],
-  [140, 86, 75],
-  [220, 100, 180],
-  [23, 170, 190],
-];
+/** Robot colours by index: the renderer's own list, set once the wasm is up. */
+export const ROBOT_COLOURS = [[80, 80, 80]];
+
+export function setRobotColours(list) {
+  ROBOT_COLOURS.splice(0, ROBOT_COLOURS.length, ...list);
+}
 
 export function robotColour(i, alpha = 1) {
   const [r, g, b] = ROBOT_COLOURS[i % ROBOT_COLOURS.length];

@@ -249,7 +249,14 @@ impl WallFollower {
         let mut dir = match nearest {
             None => {
                 self.mode = FollowerMode::Seek;
-                DVec2::X
+                match self.wall_line {
+                    // Just after an encounter the wall may be hidden behind
+                    // the other robot: head back to where we left it.
+                    Some((a, _)) if t_s < self.reacquire_until_s => {
+                        odom.inverse_transform_point(a).normalize_or(DVec2::X)
+                    }
+                    _ => DVec2::X,
+                }
             }
             Some((r_laser, q)) => {
                 let n = q / r_laser.max(1e-6);

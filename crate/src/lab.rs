@@ -31,7 +31,8 @@ pub struct LabState {
     pub time_s: f64,
     pub steps: usize,
     pub total_steps: usize,
-    pub running: bool,
+    /// A simulation exists (time may still be 0 right after a reset-run).
+    pub started: bool,
     pub finished: bool,
     pub robots: Vec<RobotState>,
 }
@@ -196,7 +197,7 @@ impl Lab {
             time_s: steps as f64 * crate::kinematics::CONTROL_DT_S,
             steps,
             total_steps: total,
-            running: self.sim.is_some(),
+            started: self.sim.is_some(),
             finished: steps >= total,
             robots,
         }

@@ -196,6 +196,44 @@ fn stroke(width: f32) -> Stroke {
     }
 }
 
+/// Draws a long polyline (a trajectory), dropping points closer than 1.5 px
+/// to the last one kept: the picture is the same, the path far shorter.
+fn trajectory(
+    pm: &mut Pixmap,
+    o: &RenderOptions,
+    pts: impl Iterator<Item = DVec2>,
+    p: &Paint,
+    s: &Stroke,
+) {
+    let mut pb = PathBuilder::new();
+    let mut last: Option<(f32, f32)> = None;
+    let mut pending: Option<(f32, f32)> = None;
+    for w in pts {
+        let (x, y) = o.to_px(w);
+        match last {
+            None => {
+                pb.move_to(x, y);
+                last = Some((x, y));
+            }
+            Some((lx, ly)) => {
+                if (x - lx).powi(2) + (y - ly).powi(2) >= 2.25 {
+                    pb.line_to(x, y);
+                    last = Some((x, y));
+                    pending = None;
+                } else {
+                    pending = Some((x, y));
+                }
+            }
+        }
+    }
+    if let Some((x, y)) = pending {
+        pb.line_to(x, y);
+    }
+    if let Some(path) = pb.finish() {
+        pm.stroke_path(&path, p, s, Transform::identity(), None);
+    }
+}
+
 /// Draws a polyline of world points.
 fn polyline(
     pm: &mut Pixmap,
@@ -244,6 +282,20 @@ fn polygon(
         if let Some((p, s)) = line {
             pm.stroke_path(&path, p, s, Transform::identity(), None);
         }
+    }
+}
+
+/// Strokes many world segments as one path (one rasterisation pass).
+fn segments(pm: &mut Pixmap, o: &RenderOptions, segs: &[(DVec2, DVec2)], p: &Paint, s: &Stroke) {
+    let mut pb = PathBuilder::new();
+    for &(a, b) in segs {
+        let (x0, y0) = o.to_px(a);
+        let (x1, y1) = o.to_px(b);
+        pb.move_to(x0, y0);
+        pb.line_to(x1, y1);
+    }
+    if let Some(path) = pb.finish() {
+        pm.stroke_path(&path, p, s, Transform::identity(), None);
     }
 }
 
@@ -300,32 +352,36 @@ pub fn render_world(
     );
 
     if o.layers.grid {
+        // Axis-aligned 1 px lines: filled as pixel-aligned rectangles, which
+        // is an order of magnitude cheaper than stroking long thin paths.
         let step = grid_step_m(o.scale);
-        let minor = paint([225, 225, 220], 1.0);
-        let major = paint([200, 200, 195], 1.0);
-        let s1 = stroke(1.0);
+        let (minor, major) = (paint([225, 225, 220], 1.0), paint([200, 200, 195], 1.0));
         let mut x = (world_lo.x / step).floor() * step;
         while x <= world_hi.x {
+            let (px, _) = o.to_px(DVec2::new(x, 0.0));
             let is_major = ((x / step).round() as i64) % 5 == 0;
-            polyline(
-                pm,
-                o,
-                [DVec2::new(x, world_lo.y), DVec2::new(x, world_hi.y)].into_iter(),
-                if is_major { &major } else { &minor },
-                &s1,
-            );
+            if let Some(r) = Rect::from_xywh(px.floor(), 0.0, 1.0, o.height as f32) {
+                pm.fill_rect(
+                    r,
+                    if is_major { &major } else { &minor },
+                    Transform::identity(),
+                    None,
+                );
+            }
             x += step;
         }
         let mut y = (world_lo.y / step).floor() * step;
         while y <= world_hi.y {
+            let (_, py) = o.to_px(DVec2::new(0.0, y));
             let is_major = ((y / step).round() as i64) % 5 == 0;
-            polyline(
-                pm,
-                o,
-                [DVec2::new(world_lo.x, y), DVec2::new(world_hi.x, y)].into_iter(),
-                if is_major { &major } else { &minor },
-                &s1,
-            );
+            if let Some(r) = Rect::from_xywh(0.0, py.floor(), o.width as f32, 1.0) {
+                pm.fill_rect(
+                    r,
+                    if is_major { &major } else { &minor },
+                    Transform::identity(),
+                    None,
+                );
+            }
             y += step;
         }
     }
@@ -336,10 +392,12 @@ pub fn render_world(
             let c = ROBOT_COLOURS[i % ROBOT_COLOURS.len()];
             if o.layers.odometry_path && r.log.odometry.len() > 1 {
                 let start = r.spec.start_pose();
-                let mut s = stroke(1.6);
+                let mut s = stroke(1.0);
+                s.line_join = LineJoin::Bevel;
+                s.line_cap = LineCap::Butt;
                 s.dash = StrokeDash::new(vec![6.0, 4.0], 0.0);
                 let dark = [c[0] / 2, c[1] / 2, c[2] / 2];
-                polyline(
+                trajectory(
                     pm,
                     o,
                     r.log.odometry.iter().map(|p| start.compose(p).position()),
@@ -348,12 +406,16 @@ pub fn render_world(
                 );
             }
             if o.layers.truth_path && r.log.truth.len() > 1 {
-                polyline(
+                trajectory(
                     pm,
                     o,
                     r.log.truth.iter().map(|p| p.position()),
                     &paint(c, 0.75),
-                    &stroke(2.0),
+                    &Stroke {
+                        width: 2.0,
+                        line_join: LineJoin::Bevel,
+                        ..Stroke::default()
+                    },
                 );
             }
         }
@@ -421,29 +483,26 @@ pub fn render_world(
                 }
             }
             if o.layers.laser {
-                let hit = paint([220, 40, 40], 0.22);
-                let miss = paint([220, 40, 40], 0.07);
-                let s1 = stroke(1.0);
                 let origin = r.truth.position();
+                let (mut hits, mut misses) = (Vec::new(), Vec::new());
                 let mut dots = PathBuilder::new();
                 for b in 0..r.last_scan.ranges_m.len() {
                     let a = r.truth.theta + beam_bearing(b);
                     let end = origin + DVec2::new(a.cos(), a.sin()) * r.last_scan.ranges_m[b];
-                    let max = r.last_scan.max_range[b];
-                    polyline(
-                        pm,
-                        o,
-                        [origin, end].into_iter(),
-                        if max { &miss } else { &hit },
-                        &s1,
-                    );
-                    if !max {
+                    if r.last_scan.max_range[b] {
+                        misses.push((origin, end));
+                    } else {
+                        hits.push((origin, end));
                         let (x, y) = o.to_px(end);
                         if let Some(rect) = Rect::from_xywh(x - 1.5, y - 1.5, 3.0, 3.0) {
                             dots.push_rect(rect);
                         }
                     }
                 }
+                let mut s1 = stroke(1.0);
+                s1.line_cap = LineCap::Butt;
+                segments(pm, o, &misses, &paint([220, 40, 40], 0.07), &s1);
+                segments(pm, o, &hits, &paint([220, 40, 40], 0.22), &s1);
                 if let Some(path) = dots.finish() {
                     pm.fill_path(
                         &path,

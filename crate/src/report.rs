@@ -81,11 +81,7 @@ impl Report {
             .iter()
             .map(|r| {
                 let log = &r.log;
-                let path_length_m = log
-                    .truth
-                    .windows(2)
-                    .map(|w| (w[1].position() - w[0].position()).length())
-                    .sum::<f64>();
+                let path_length_m = log.path_length_m();
                 let last = log.truth.len() - 1;
                 RobotReport {
                     name: r.spec.name.clone(),

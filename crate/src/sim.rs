@@ -65,6 +65,16 @@ pub struct RobotLog {
     pub sensors_dropped: usize,
 }
 
+impl RobotLog {
+    /// Length of the true path so far (m).
+    pub fn path_length_m(&self) -> f64 {
+        self.truth
+            .windows(2)
+            .map(|w| (w[1].position() - w[0].position()).length())
+            .sum()
+    }
+}
+
 /// One simulated robot: its true state, its noisy senses, and its controller.
 #[derive(Clone, Debug)]
 pub struct RobotSim {

@@ -6,6 +6,8 @@
 //! function returns `Result<_, JsError>` so bad input reaches JavaScript as
 //! an exception with a message, never as a panic or a trap.
 
+pub mod surf;
+
 use crate::lab;
 use crate::render::{grid_step_m, scale_bar_m, RenderOptions};
 use crate::report::Timings;
@@ -36,6 +38,13 @@ pub fn validate_scenario(json: &str) -> Result<String, JsError> {
 #[wasm_bindgen]
 pub fn version() -> String {
     env!("CARGO_PKG_VERSION").to_string()
+}
+
+/// The robot colours the renderer uses, by robot index, as JSON
+/// `[[r, g, b], ...]` (the page's legend and readouts use the same).
+#[wasm_bindgen(js_name = robotColours)]
+pub fn robot_colours() -> String {
+    serde_json::to_string(&crate::render::ROBOT_COLOURS).unwrap_or_else(|_| "[]".into())
 }
 
 /// Whether this build was compiled with wasm SIMD128.
@@ -173,6 +182,13 @@ impl Lab {
         .map_err(|_| JsError::new("could not make ImageData"))?;
         ctx.put_image_data(&img, 0.0, 0.0)
             .map_err(|_| JsError::new("could not draw into the canvas"))
+    }
+
+    /// Renders the view into the lab's own image without copying it out
+    /// (for benchmarks; `draw` and `renderRgba` render too).
+    #[wasm_bindgen(js_name = renderFrame)]
+    pub fn render_frame(&mut self) -> Result<(), JsError> {
+        self.inner.render().map(|_| ()).map_err(js_err)
     }
 
     /// Renders the view and returns its RGBA pixels (width*height*4 bytes).

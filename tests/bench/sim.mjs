@@ -1,0 +1,39 @@
+// Benchmark of the simulation and renderer in the wasm build, in node
+// (BENCHMARKS.md). Run by `./build.sh bench` after `./build.sh build`.
+//
+// Simulation: each preset for its full duration, all sensors on, as
+// robot-steps per second. Rendering: ms per 960 x 720 frame of the thesis
+// preset mid-run (laser rays, paths, grid), rendered inside wasm.
+import { readFileSync } from 'node:fs';
+import { performance } from 'node:perf_hooks';
+import { loadWasm } from '../../web/cli/wasm.mjs';
+
+const wasm = await loadWasm();
+const median = (v) => v.sort((a, b) => a - b)[Math.floor(v.length / 2)];
+const build = wasm.simdEnabled() ? 'SIMD128' : 'scalar';
+
+for (const name of ['thesis', 'office', 'loop', 'maze']) {
+  const text = readFileSync(new URL(`../../scenarios/${name}.json`, import.meta.url), 'utf8');
+  const rates = [];
+  for (let k = 0; k < 5; k++) {
+    const lab = new wasm.Lab(text);
+    const t0 = performance.now();
+    lab.runToEnd();
+    const dt = (performance.now() - t0) / 1000;
+    const st = JSON.parse(lab.stateJson());
+    rates.push((st.steps * st.robots.length) / dt);
+    lab.free();
+  }
+  console.log(`wasm (${build}) simulate ${name.padEnd(7)} ${median(rates).toFixed(0).padStart(9)} robot-steps/s`);
+}
+
+const lab = new wasm.Lab(readFileSync(new URL('../../scenarios/thesis.json', import.meta.url), 'utf8'));
+lab.fitView(960, 720);
+lab.step(1500);
+const times = [];
+for (let k = 0; k < 200; k++) {
+  const t0 = performance.now();
+  lab.renderFrame();
+  times.push(performance.now() - t0);
+}
+console.log(`wasm (${build}) render 960x720 ${median(times).toFixed(2)} ms/frame`);
