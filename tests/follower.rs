@@ -9,6 +9,13 @@ use slamlab::rng::Rng;
 use slamlab::scenario::{FollowSide, Scenario};
 use slamlab::sensors::{RangeScene, Sonar};
 use slamlab::sim::Simulation;
+
+/// A simulation without camera capture: these tests are about motion.
+fn sim_of(s: &Scenario) -> Simulation {
+    let mut sim = Simulation::new(s).unwrap();
+    sim.set_capture(false);
+    sim
+}
 use wasm_bindgen_test::wasm_bindgen_test;
 
 const PRESETS: [(&str, &str); 4] = [
@@ -55,7 +62,7 @@ fn corridor_holds_distance(side: FollowSide) {
         wall([-1.0, 2.4], [40.0, 2.4]),
     ];
     let robot = format!(r#"{{"name": "r", "start": [1, {y_start}, 0], "follow": "{follow}"}}"#);
-    let mut sim = Simulation::new(&scenario(&walls, &[robot], 90.0, 3)).unwrap();
+    let mut sim = sim_of(&scenario(&walls, &[robot], 90.0, 3));
     let mut readings = Vec::new();
     while !sim.finished() {
         sim.step();
@@ -93,7 +100,7 @@ fn wall_follower_keeps_0_6_m_in_corridor_right() {
 fn every_preset_is_toured_without_a_bump() {
     for (name, text) in PRESETS {
         let s = Scenario::from_json(text).unwrap();
-        let mut sim = Simulation::new(&s).unwrap();
+        let mut sim = sim_of(&s);
         sim.run_to_end();
         for r in &sim.robots {
             assert_eq!(r.bumps, 0, "{name}/{} bumped", r.spec.name);
@@ -134,7 +141,7 @@ fn robot_started_in_open_space_finds_a_wall_and_follows_it() {
     ];
     for (k, heading) in [0.3f64, 2.0, -2.5].iter().enumerate() {
         let robot = format!(r#"{{"name": "r", "start": [10, 10, {heading}], "follow": "right"}}"#);
-        let mut sim = Simulation::new(&scenario(&walls, &[robot], 120.0, k as u64)).unwrap();
+        let mut sim = sim_of(&scenario(&walls, &[robot], 120.0, k as u64));
         sim.run_to_end();
         let r = &sim.robots[0];
         assert_eq!(r.bumps, 0);
@@ -222,7 +229,7 @@ fn random_maze(seed: u64) -> Scenario {
 fn random_user_drawn_mazes_are_toured_without_a_bump() {
     for seed in 1..=8 {
         let s = random_maze(seed);
-        let mut sim = Simulation::new(&s).unwrap();
+        let mut sim = sim_of(&s);
         sim.run_to_end();
         for r in &sim.robots {
             assert_eq!(
@@ -254,7 +261,7 @@ fn robots_meeting_head_on_pass_each_other() {
         r#"{"name": "east", "start": [2, 2.26, 0], "follow": "left"}"#.to_string(),
         r#"{"name": "west", "start": [26, 2.26, 3.14159], "follow": "right"}"#.to_string(),
     ];
-    let mut sim = Simulation::new(&scenario(&walls, &robots, 120.0, 5)).unwrap();
+    let mut sim = sim_of(&scenario(&walls, &robots, 120.0, 5));
     sim.run_to_end();
     let (e, w) = (&sim.robots[0], &sim.robots[1]);
     assert_eq!((e.bumps, w.bumps), (0, 0));
@@ -269,7 +276,7 @@ fn robots_meeting_head_on_pass_each_other() {
 fn a_bump_stops_the_robot_and_is_counted_once_per_contact() {
     let walls = [wall([2.0, -3.0], [2.0, 3.0])];
     let robots = [r#"{"name": "r", "start": [0, 0, 0], "follow": "left"}"#.to_string()];
-    let mut sim = Simulation::new(&scenario(&walls, &robots, 60.0, 1)).unwrap();
+    let mut sim = sim_of(&scenario(&walls, &robots, 60.0, 1));
     let drive = Command {
         v_mps: 0.4,
         omega_radps: 0.0,
@@ -311,7 +318,7 @@ fn runs_are_a_function_of_scenario_and_seed() {
         let mut s = Scenario::from_json(text).unwrap();
         s.seed = seed;
         s.duration_s = 60.0;
-        let mut sim = Simulation::new(&s).unwrap();
+        let mut sim = sim_of(&s);
         sim.run_to_end();
         sim
     };
@@ -329,7 +336,7 @@ fn zero_noise_odometry_tracks_truth_exactly_over_a_tour() {
     let mut s = Scenario::from_json(PRESETS[0].1).unwrap();
     s.noise = slamlab::scenario::NoiseSpec::zero();
     s.duration_s = 120.0;
-    let mut sim = Simulation::new(&s).unwrap();
+    let mut sim = sim_of(&s);
     sim.run_to_end();
     for r in &sim.robots {
         let start = r.spec.start_pose();
@@ -343,7 +350,7 @@ fn zero_noise_odometry_tracks_truth_exactly_over_a_tour() {
 #[wasm_bindgen_test(unsupported = test)]
 fn default_noise_makes_odometry_visibly_drift_over_a_thesis_length_run() {
     let s = Scenario::from_json(PRESETS[0].1).unwrap();
-    let mut sim = Simulation::new(&s).unwrap();
+    let mut sim = sim_of(&s);
     sim.run_to_end();
     for r in &sim.robots {
         let n = r.log.truth.len() - 1;
@@ -362,7 +369,7 @@ fn default_noise_makes_odometry_visibly_drift_over_a_thesis_length_run() {
 fn logs_have_one_row_per_step_in_the_thesis_layout() {
     let mut s = Scenario::from_json(PRESETS[0].1).unwrap();
     s.duration_s = 10.0;
-    let mut sim = Simulation::new(&s).unwrap();
+    let mut sim = sim_of(&s);
     sim.run_to_end();
     for r in &sim.robots {
         assert_eq!(r.log.times_s.len(), 101);
@@ -382,7 +389,7 @@ fn a_robot_that_never_moves_keeps_a_bounded_log() {
     // Memory stays bounded on long runs: sensor rows are capped.
     let walls = [wall([0.0, 0.0], [1.0, 0.0])];
     let robots = [r#"{"name": "r", "start": [0.5, 1, 0], "follow": "left"}"#.to_string()];
-    let mut sim = Simulation::new(&scenario(&walls, &robots, 1300.0, 1)).unwrap();
+    let mut sim = sim_of(&scenario(&walls, &robots, 1300.0, 1));
     let stop = Command::default();
     while !sim.finished() {
         sim.step_with(&[Some(stop)]);

@@ -192,7 +192,7 @@ test('the lab page: edit, run, step, read sensors, reset, autosave, corrupt save
   await page.getByRole('button', { name: 'Reset', exact: true }).click();
   const r0 = await state(page);
   assert.equal(r0.time_s, 0);
-  assert.equal(r0.running, false);
+  assert.equal(r0.started, false);
   assert.match(await page.locator('#clock').innerText(), /t = 0\.0 s/);
 
   // Autosave: a reload brings back the edited scenario.

@@ -32,6 +32,7 @@ import {
   wrapAngle,
 } from './geometry.js';
 import { RobotsPanel, robotColour, setRobotColours } from './robots-panel.js';
+import { CameraPanel } from './camera-panel.js';
 
 const STORAGE_KEY = 'slamlab.scenario.v1';
 const LAYERS_KEY = 'slamlab.layers.v1';
@@ -394,6 +395,9 @@ function pushView() {
       selected_wall: sel && sel.kind === 'wall' ? sel.index : null,
       selected_robot: sel && sel.kind === 'robot' ? sel.index : null,
       preview_wall: app.preview,
+      // Where the camera frame picked in a film strip was taken.
+      marker: app.marker ? app.marker.pose : null,
+      marker_fov: app.marker ? (app.marker.fovDeg * Math.PI) / 180 : Math.PI / 3,
     }),
   );
 }
@@ -578,8 +582,19 @@ function reportProblems() {
   if (app.problems.length) setStatus(`${app.problems[0].text}: move it clear before running.`, 'warn');
 }
 
+// Camera views and film strips (web/camera-panel.js).
+const cameraPanel = new CameraPanel($('cameras'), {
+  lab: () => app.lab,
+  onMarker: (m) => {
+    app.marker = m;
+    app.dirty = true;
+  },
+  onError: (e) => setStatus(message(e), 'error'),
+});
+
 function refreshPanels() {
   if (!app.scenario) return;
+  cameraPanel.sync(app.scenario);
   const ed = editable();
   robotsPanel.sonarRange = app.scenario.sensors?.sonar_range_m ?? 2;
   robotsPanel.sync(app.scenario, {
@@ -1388,7 +1403,9 @@ function frame(now) {
   if (!app.lab) return;
   try {
     if (app.running) advance(now);
+    const changed = app.dirty;
     if (app.dirty) draw();
+    cameraPanel.update(now, changed || app.running);
     if (app.running) updateReadouts(false);
   } catch (e) {
     app.running = false;

@@ -10,39 +10,13 @@
 import { readFile } from 'node:fs/promises';
 import { performance } from 'node:perf_hooks';
 import { loadWasm } from './cli/wasm.mjs';
+import { UsageError, parseArgs } from './cli/args.mjs';
 
-/** An input error: exit status 2 with this message. */
-export class UsageError extends Error {}
+export { UsageError, parseArgs };
 
 const USAGE = `usage:
   node web/cli.mjs run SCENARIO.json [--seed N] [--duration S] [--json]
       run the scenario headless and print a report (JSON with --json)`;
-
-/**
- * Splits argv into positionals and --options. `spec` maps option names to
- * 'flag' (no value) or 'value'. Unknown options are input errors.
- */
-export function parseArgs(argv, spec) {
-  const positional = [];
-  const options = {};
-  for (let i = 0; i < argv.length; i++) {
-    const a = argv[i];
-    if (a.startsWith('--')) {
-      const [name, inline] = a.slice(2).split(/=(.*)/s, 2);
-      if (!(name in spec)) throw new UsageError(`unknown option --${name}`);
-      if (spec[name] === 'flag') {
-        options[name] = true;
-      } else {
-        const v = inline ?? argv[++i];
-        if (v === undefined) throw new UsageError(`--${name} needs a value`);
-        options[name] = v;
-      }
-    } else {
-      positional.push(a);
-    }
-  }
-  return { positional, options };
-}
 
 async function readText(path, what) {
   try {
@@ -128,7 +102,7 @@ const usages = [USAGE];
 
 // Commands contributed by other capabilities (each module exports `commands`
 // and optionally `usage`).
-for (const mod of ['./cli/surf.mjs']) {
+for (const mod of ['./cli/camera.mjs', './cli/surf.mjs']) {
   try {
     const m = await import(mod);
     Object.assign(commands, m.commands);

@@ -8,11 +8,15 @@
 //! parse leaves the current one in place; one whose robots are badly placed
 //! is kept (so the page can show the problem) but refuses to run until fixed.
 
-use crate::render::{render_world, RenderOptions};
+use crate::camera::capture::CapturedFrame;
+use crate::camera::texture::{ImageTexture, TextureBank};
+use crate::camera::{render as render_camera, CameraImage, PinholeCamera, RobotBox};
+use crate::render::{render_world, RenderOptions, ROBOT_COLOURS};
 use crate::report::{Report, Timings};
 use crate::scenario::{Scenario, ScenarioError, MAX_DURATION_S};
 use crate::sensors::laser::beam_bearing;
 use crate::sim::{Simulation, LASER_LOG_NO_RETURN};
+use crate::world::World;
 use serde::Serialize;
 use std::fmt::Write;
 use tiny_skia::Pixmap;
@@ -23,6 +27,10 @@ pub struct Lab {
     sim: Option<Simulation>,
     view: RenderOptions,
     pixmap: Option<Pixmap>,
+    /// Texture cache and loaded pictures while no simulation holds them.
+    textures: Option<TextureBank>,
+    /// The world of the scenario being edited (for camera previews).
+    preview_world: Option<World>,
 }
 
 /// Live figures for the page's readouts.
@@ -69,6 +77,8 @@ impl Lab {
             sim: None,
             view,
             pixmap: None,
+            textures: None,
+            preview_world: None,
         })
     }
 
@@ -85,7 +95,8 @@ impl Lab {
     pub fn set_scenario(&mut self, json: &str) -> Result<(), ScenarioError> {
         let s = Scenario::parse(json)?;
         self.scenario = s;
-        self.sim = None;
+        self.stop();
+        self.preview_world = None;
         Ok(())
     }
 
@@ -96,7 +107,25 @@ impl Lab {
 
     pub fn set_seed(&mut self, seed: u64) {
         self.scenario.seed = seed;
-        self.sim = None;
+        self.stop();
+    }
+
+    /// Drops the simulation, keeping its texture bank for the next run.
+    fn stop(&mut self) {
+        if let Some(sim) = self.sim.take() {
+            self.textures = Some(sim.textures);
+        }
+    }
+
+    /// The texture bank for the current scenario: the kept one if it was
+    /// made for the same seed and wall height (its pictures always carry over).
+    fn take_textures(&mut self) -> TextureBank {
+        let (seed, h) = (self.scenario.seed, self.scenario.camera.wall_height_m);
+        match self.textures.take() {
+            Some(bank) if bank.seed() == seed && bank.wall_height_m() == h => bank,
+            Some(old) => old.renewed(seed, h),
+            None => TextureBank::new(seed, h),
+        }
     }
 
     pub fn set_duration(&mut self, duration_s: f64) -> Result<(), ScenarioError> {
@@ -115,14 +144,26 @@ impl Lab {
 
     /// Back to time 0 (the editing view).
     pub fn reset(&mut self) {
-        self.sim = None;
+        self.stop();
     }
 
     /// Starts the simulation if it is not running.
     pub fn start(&mut self) -> Result<&mut Simulation, ScenarioError> {
         let sim = match self.sim.take() {
             Some(s) => s,
-            None => Simulation::new(&self.scenario)?,
+            None => {
+                let bank = self.take_textures();
+                match Simulation::with_textures(&self.scenario, bank) {
+                    Ok(s) => s,
+                    Err(e) => {
+                        self.textures = Some(TextureBank::new(
+                            self.scenario.seed,
+                            self.scenario.camera.wall_height_m,
+                        ));
+                        return Err(e);
+                    }
+                }
+            }
         };
         Ok(self.sim.insert(sim))
     }
@@ -245,6 +286,95 @@ impl Lab {
             .as_ref()
             .ok_or("nothing has run yet: run the scenario first")?;
         Ok(Report::from_sim(sim, timings))
+    }
+
+    /// Puts a picture (PNG or JPEG bytes) on walls whose texture is
+    /// `image:NAME`. Refused with a message if it is not a usable image.
+    pub fn add_image_texture(&mut self, name: &str, bytes: &[u8]) -> Result<(), String> {
+        if name.is_empty() || name.len() > 64 {
+            return Err("a picture's name must have 1 to 64 characters".into());
+        }
+        let img = ImageTexture::decode(bytes)?;
+        match &mut self.sim {
+            Some(sim) => sim.textures.add_image(name, img.clone()),
+            None => {
+                let mut bank = self.take_textures();
+                bank.add_image(name, img.clone());
+                self.textures = Some(bank);
+            }
+        }
+        // Keep it for later runs too.
+        if let Some(bank) = &mut self.textures {
+            bank.add_image(name, img);
+        }
+        Ok(())
+    }
+
+    /// What robot `i`'s camera sees now (its start pose before a run),
+    /// without noise, in colour if asked.
+    pub fn camera_view(&mut self, i: usize, colour: bool) -> Result<CameraImage, String> {
+        if i >= self.scenario.robots.len() {
+            return Err(format!("no robot with index {i}"));
+        }
+        if let Some(sim) = &mut self.sim {
+            return sim
+                .camera_view(i, colour)
+                .ok_or_else(|| format!("no robot with index {i}"));
+        }
+        let world = self.preview_world.get_or_insert_with(|| {
+            World::new(self.scenario.walls.iter().map(|w| w.segment()).collect())
+        });
+        let robots: Vec<RobotBox> = self
+            .scenario
+            .robots
+            .iter()
+            .enumerate()
+            .filter(|(j, _)| *j != i)
+            .map(|(j, r)| RobotBox {
+                corners: crate::kinematics::P2dx::body(&r.start_pose()).corners,
+                rgb: ROBOT_COLOURS[j % ROBOT_COLOURS.len()],
+            })
+            .collect();
+        let mut bank = self.textures.take().unwrap_or_else(|| {
+            TextureBank::new(self.scenario.seed, self.scenario.camera.wall_height_m)
+        });
+        if bank.seed() != self.scenario.seed
+            || bank.wall_height_m() != self.scenario.camera.wall_height_m
+        {
+            bank = bank.renewed(self.scenario.seed, self.scenario.camera.wall_height_m);
+        }
+        let img = render_camera(
+            &PinholeCamera::new(&self.scenario.camera),
+            &self.scenario.robots[i].start_pose(),
+            world,
+            &self.scenario.walls,
+            &robots,
+            &mut bank,
+            colour,
+            None,
+        );
+        self.textures = Some(bank);
+        Ok(img)
+    }
+
+    /// Robot `i`'s captured frames (empty before a run).
+    pub fn frames(&self, i: usize) -> Result<&[CapturedFrame], String> {
+        if i >= self.scenario.robots.len() {
+            return Err(format!("no robot with index {i}"));
+        }
+        Ok(match &self.sim {
+            Some(sim) => &sim.robots[i].frames.frames,
+            None => &[],
+        })
+    }
+
+    /// Robot `i`'s frame with capture index `index`.
+    pub fn frame(&self, i: usize, index: usize) -> Result<&CapturedFrame, String> {
+        let frames = self.frames(i)?;
+        frames
+            .binary_search_by_key(&index, |f| f.index)
+            .map(|k| &frames[k])
+            .map_err(|_| format!("robot {i} has no frame {index}"))
     }
 
     /// One robot's log as CSV, in the thesis's layout (§6.2.1): time,

@@ -18,6 +18,7 @@
 //! | [`kinematics`] | differential-drive motion of a P2DX |
 //! | [`odometry`] | wheel encoders with slip and bias: what the robot believes |
 //! | [`sensors`] | the sonar ring and the laser range finder |
+//! | [`camera`] | the pinhole camera, wall textures, frame capture |
 //! | [`follower`] | the thesis's wall-following controller |
 //! | [`sim`] | the fixed-step simulation and its per-robot logs |
 //! | [`render`] | tiny-skia drawing of the world, robots and sensors |
@@ -29,6 +30,7 @@
 //! y up, θ counter-clockwise from +x. Only the renderer flips y.
 
 pub mod bindings;
+pub mod camera;
 pub mod follower;
 pub mod geom;
 pub mod kinematics;

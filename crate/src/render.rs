@@ -78,6 +78,11 @@ pub struct RenderOptions {
     pub selected_robot: Option<usize>,
     /// A wall being drawn: `[x0, y0, x1, y1]`.
     pub preview_wall: Option<[f64; 4]>,
+    /// Where a camera frame was taken, `[x, y, theta]`: drawn as the
+    /// camera's field of view.
+    pub marker: Option<[f64; 3]>,
+    /// The camera's horizontal field of view, for the marker (rad).
+    pub marker_fov: f64,
 }
 
 impl Default for RenderOptions {
@@ -91,6 +96,8 @@ impl Default for RenderOptions {
             selected_wall: None,
             selected_robot: None,
             preview_wall: None,
+            marker: None,
+            marker_fov: 60f64.to_radians(),
         }
     }
 }
@@ -561,6 +568,36 @@ pub fn render_world(
             pose.transform_point(DVec2::new(hl - 0.17, -0.09)),
         ];
         polygon(pm, o, &tri, Some(&paint([255, 255, 255], 1.0)), None);
+    }
+
+    if let Some([x, y, th]) = o.marker {
+        let p = DVec2::new(x, y);
+        let reach = 2.5;
+        let h = o.marker_fov / 2.0;
+        let wedge = [
+            p,
+            p + DVec2::from_angle(th + h) * reach,
+            p + DVec2::from_angle(th - h) * reach,
+        ];
+        polygon(
+            pm,
+            o,
+            &wedge,
+            Some(&paint([255, 190, 0], 0.25)),
+            Some((&paint([200, 120, 0], 1.0), &stroke(2.0))),
+        );
+        let (cx, cy) = o.to_px(p);
+        let mut pb = PathBuilder::new();
+        pb.push_circle(cx, cy, 6.0);
+        if let Some(path) = pb.finish() {
+            pm.fill_path(
+                &path,
+                &paint([200, 120, 0], 1.0),
+                FillRule::Winding,
+                Transform::identity(),
+                None,
+            );
+        }
     }
 
     // Scale bar, bottom left (its label is drawn by the page).

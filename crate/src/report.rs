@@ -41,6 +41,10 @@ pub struct RobotReport {
     pub truth: Vec<[f64; 4]>,
     pub odometry: Vec<[f64; 4]>,
     pub bumps: u32,
+    /// Camera frames captured.
+    pub frames: usize,
+    /// Of those, frames dropped to stay within the frame memory budget.
+    pub frames_dropped: usize,
     /// Length of the true path (m).
     pub path_length_m: f64,
     /// Where odometry ended up, against the truth (both in the world frame).
@@ -92,6 +96,8 @@ impl Report {
                     truth: rows(&log.times_s, &log.truth),
                     odometry: rows(&log.times_s, &log.odometry),
                     bumps: r.bumps,
+                    frames: r.frames.next_index(),
+                    frames_dropped: r.frames.dropped,
                     path_length_m: r6(path_length_m),
                     odometry_final_error: odometry_final_error(
                         &r.spec.start_pose(),

@@ -174,6 +174,41 @@ impl Default for SensorSpec {
     }
 }
 
+/// The robots' camera (all robots carry the same model).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CameraSpec {
+    /// Image size in pixels (16 … 640 × 16 … 480).
+    pub width: u32,
+    pub height: u32,
+    /// Horizontal field of view (degrees).
+    pub hfov_deg: f64,
+    /// Height of the optical centre above the floor (m).
+    pub mount_height_m: f64,
+    /// Height of every wall (m).
+    pub wall_height_m: f64,
+    /// Per-pixel Gaussian noise, standard deviation in grey levels.
+    pub pixel_noise_std: f64,
+    /// Per-frame exposure change: standard deviation of the gain around 1.
+    pub exposure_jitter: f64,
+    /// A frame is captured every this many simulated seconds.
+    pub period_s: f64,
+}
+
+impl Default for CameraSpec {
+    fn default() -> Self {
+        CameraSpec {
+            width: 320,
+            height: 240,
+            hfov_deg: 60.0,
+            mount_height_m: 0.4,
+            wall_height_m: 2.5,
+            pixel_noise_std: 2.0,
+            exposure_jitter: 0.03,
+            period_s: 1.0,
+        }
+    }
+}
+
 /// A whole scenario, with every default filled in.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Scenario {
@@ -184,6 +219,7 @@ pub struct Scenario {
     pub robots: Vec<RobotSpec>,
     pub noise: NoiseSpec,
     pub sensors: SensorSpec,
+    pub camera: CameraSpec,
 }
 
 pub const DEFAULT_NAME: &str = "untitled";
@@ -327,6 +363,7 @@ impl Scenario {
                 "robots",
                 "noise",
                 "sensors",
+                "camera",
             ],
         )?;
 
@@ -527,6 +564,65 @@ impl Scenario {
                 sensors.laser_range_m = number_in(v, "sensors.laser_range_m", 0.5, 30.0)?;
             }
         }
+        let mut camera = CameraSpec::default();
+        if let Some(v) = opt(root, "camera") {
+            let m = as_object(v, "camera")?;
+            check_keys(
+                m,
+                "camera",
+                &[
+                    "width",
+                    "height",
+                    "hfov_deg",
+                    "mount_height_m",
+                    "wall_height_m",
+                    "pixel_noise_std",
+                    "exposure_jitter",
+                    "period_s",
+                ],
+            )?;
+            let whole = |v: &Value, path: &str, lo: u32, hi: u32| -> Result<u32, ScenarioError> {
+                let x = number_in(v, path, lo as f64, hi as f64)?;
+                if x.fract() != 0.0 {
+                    return Err(ScenarioError::new(path, format!("{x} is not a whole number of pixels")));
+                }
+                Ok(x as u32)
+            };
+            if let Some(v) = m.get("width") {
+                camera.width = whole(v, "camera.width", 16, 640)?;
+            }
+            if let Some(v) = m.get("height") {
+                camera.height = whole(v, "camera.height", 16, 480)?;
+            }
+            if let Some(v) = m.get("hfov_deg") {
+                camera.hfov_deg = number_in(v, "camera.hfov_deg", 20.0, 150.0)?;
+            }
+            if let Some(v) = m.get("wall_height_m") {
+                camera.wall_height_m = number_in(v, "camera.wall_height_m", 0.5, 10.0)?;
+            }
+            if let Some(v) = m.get("mount_height_m") {
+                camera.mount_height_m = number_in(v, "camera.mount_height_m", 0.05, 5.0)?;
+            }
+            if camera.mount_height_m >= camera.wall_height_m {
+                return Err(ScenarioError::new(
+                    "camera.mount_height_m",
+                    format!(
+                        "{} m is not below the walls' height of {} m",
+                        camera.mount_height_m, camera.wall_height_m
+                    ),
+                ));
+            }
+            if let Some(v) = m.get("pixel_noise_std") {
+                camera.pixel_noise_std = number_in(v, "camera.pixel_noise_std", 0.0, 50.0)?;
+            }
+            if let Some(v) = m.get("exposure_jitter") {
+                camera.exposure_jitter = number_in(v, "camera.exposure_jitter", 0.0, 0.5)?;
+            }
+            if let Some(v) = m.get("period_s") {
+                camera.period_s = number_in(v, "camera.period_s", 0.1, 60.0)?;
+            }
+        }
+
         for (i, r) in robots.iter().enumerate() {
             if r.distance + 0.2 > sensors.sonar_range_m {
                 return Err(ScenarioError::new(
@@ -547,6 +643,7 @@ impl Scenario {
             robots,
             noise,
             sensors,
+            camera,
         })
     }
 

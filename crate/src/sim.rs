@@ -22,6 +22,9 @@
 //!
 //! Row 0 is the start (time 0); a run of `n` steps has `n + 1` rows.
 
+use crate::camera::capture::{CapturedFrame, FrameStore};
+use crate::camera::texture::TextureBank;
+use crate::camera::{render as render_camera, CameraImage, CameraNoise, PinholeCamera, RobotBox};
 use crate::follower::{Command, FollowerMode, WallFollower};
 use crate::geom::{ConvexPolygon, Pose2, Segment};
 use crate::kinematics::{integrate_wheels, wheel_speeds, P2dx, WheelState, CONTROL_DT_S};
@@ -93,6 +96,9 @@ pub struct RobotSim {
     pub last_scan: LaserScan,
     pub last_command: Command,
     pub log: RobotLog,
+    /// Frames captured by the camera.
+    pub frames: FrameStore,
+    camera_rng: Rng,
 }
 
 impl RobotSim {
@@ -144,15 +150,36 @@ pub struct Simulation {
     pub world: World,
     pub robots: Vec<RobotSim>,
     steps: usize,
+    pub camera: PinholeCamera,
+    pub textures: TextureBank,
+    /// Whether frames are captured (off only for experiments that need no
+    /// images, e.g. controller tests; it changes nothing else in the run).
+    capture: bool,
 }
 
 impl Simulation {
     /// Builds a simulation at time 0. Fails, naming the field, if a robot
     /// starts inside or touching a wall or another robot.
     pub fn new(scenario: &Scenario) -> Result<Simulation, ScenarioError> {
+        Self::with_textures(
+            scenario,
+            TextureBank::new(scenario.seed, scenario.camera.wall_height_m),
+        )
+    }
+
+    /// Like [`Simulation::new`], with a texture bank that may hold pictures
+    /// the user loaded.
+    pub fn with_textures(
+        scenario: &Scenario,
+        textures: TextureBank,
+    ) -> Result<Simulation, ScenarioError> {
         if let Some(p) = scenario.placement_problems().into_iter().next() {
             return Err(p);
         }
+        let camera = PinholeCamera::new(&scenario.camera);
+        let frame_bytes = (camera.width * camera.height) as usize;
+        let period_steps = ((scenario.camera.period_s / CONTROL_DT_S).round() as usize).max(1);
+        let n_robots = scenario.robots.len();
         let world = World::new(scenario.walls.iter().map(|w| w.segment()).collect());
         let seed = scenario.seed;
         let robots = scenario
@@ -191,6 +218,8 @@ impl Simulation {
                     },
                     last_command: Command::default(),
                     log: RobotLog::default(),
+                    frames: FrameStore::new(frame_bytes, n_robots, period_steps),
+                    camera_rng: Rng::stream(seed, i, Stream::Camera),
                 }
             })
             .collect();
@@ -199,11 +228,15 @@ impl Simulation {
             world,
             robots,
             steps: 0,
+            camera,
+            textures,
+            capture: true,
         };
         sim.sense();
         for r in &mut sim.robots {
             r.log_row(0, 0.0);
         }
+        sim.capture_due_frames();
         Ok(sim)
     }
 
@@ -332,6 +365,89 @@ impl Simulation {
         let (step, t) = (self.steps, self.time_s());
         for r in &mut self.robots {
             r.log_row(step, t);
+        }
+        // 6. camera frames, once per capture period
+        self.capture_due_frames();
+    }
+
+    /// The other robots as boxes for robot `skip`'s camera.
+    fn robot_boxes_except(&self, skip: usize) -> Vec<RobotBox> {
+        self.robots
+            .iter()
+            .enumerate()
+            .filter(|(j, _)| *j != skip)
+            .map(|(j, r)| RobotBox {
+                corners: r.body().corners,
+                rgb: crate::render::ROBOT_COLOURS[j % crate::render::ROBOT_COLOURS.len()],
+            })
+            .collect()
+    }
+
+    /// What robot `i`'s camera sees now, noise-free (for display), in
+    /// colour if asked.
+    pub fn camera_view(&mut self, i: usize, colour: bool) -> Option<CameraImage> {
+        let boxes = self.robot_boxes_except(i);
+        let pose = self.robots.get(i)?.truth;
+        Some(render_camera(
+            &self.camera,
+            &pose,
+            &self.world,
+            &self.scenario.walls,
+            &boxes,
+            &mut self.textures,
+            colour,
+            None,
+        ))
+    }
+
+    /// Turns frame capture off or on. Capture draws no random numbers the
+    /// robots use, so the run is otherwise the same.
+    pub fn set_capture(&mut self, on: bool) {
+        self.capture = on;
+    }
+
+    fn capture_due_frames(&mut self) {
+        if !self.capture {
+            return;
+        }
+        let step = self.steps;
+        for i in 0..self.robots.len() {
+            if !self.robots[i].frames.due(step) {
+                continue;
+            }
+            let boxes = self.robot_boxes_except(i);
+            let spec = &self.scenario.camera;
+            let r = &mut self.robots[i];
+            let img = render_camera(
+                &self.camera,
+                &r.truth,
+                &self.world,
+                &self.scenario.walls,
+                &boxes,
+                &mut self.textures,
+                false,
+                Some(CameraNoise {
+                    rng: &mut r.camera_rng,
+                    pixel_std: spec.pixel_noise_std,
+                    exposure_std: spec.exposure_jitter,
+                }),
+            );
+            let row = r.log.sensors.back().cloned();
+            let frame = CapturedFrame {
+                index: 0,
+                step,
+                time_s: step as f64 * CONTROL_DT_S,
+                odometry: r.odometry.pose(),
+                truth: r.truth,
+                sonar_m: row.as_ref().map_or([0.0; SONAR_COUNT], |s| s.sonar_m),
+                laser_mm: row
+                    .as_ref()
+                    .map_or([LASER_LOG_NO_RETURN; LASER_BEAMS], |s| s.laser_mm),
+                width: img.width,
+                height: img.height,
+                gray: img.gray,
+            };
+            r.frames.push(frame);
         }
     }
 

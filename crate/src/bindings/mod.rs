@@ -6,17 +6,40 @@
 //! function returns `Result<_, JsError>` so bad input reaches JavaScript as
 //! an exception with a message, never as a panic or a trap.
 
-pub mod surf;
 
 use crate::lab;
 use crate::render::{grid_step_m, scale_bar_m, RenderOptions};
 use crate::report::Timings;
 use crate::scenario::Scenario;
+use image::ImageEncoder;
 use wasm_bindgen::prelude::*;
 use wasm_bindgen::Clamped;
 
 fn js_err(e: impl std::fmt::Display) -> JsError {
     JsError::new(&e.to_string())
+}
+
+/// Copies straight RGBA pixels into a canvas context at (0, 0).
+fn put_rgba(
+    ctx: &web_sys::CanvasRenderingContext2d,
+    rgba: &[u8],
+    w: u32,
+    h: u32,
+) -> Result<(), JsError> {
+    let img = web_sys::ImageData::new_with_u8_clamped_array_and_sh(Clamped(rgba), w, h)
+        .map_err(|_| JsError::new("could not make ImageData"))?;
+    ctx.put_image_data(&img, 0.0, 0.0)
+        .map_err(|_| JsError::new("could not draw into the canvas"))
+}
+
+fn frame_meta(f: &crate::camera::capture::CapturedFrame) -> serde_json::Value {
+    serde_json::json!({
+        "index": f.index,
+        "step": f.step,
+        "time_s": f.time_s,
+        "odometry": [f.odometry.x, f.odometry.y, f.odometry.theta],
+        "truth": [f.truth.x, f.truth.y, f.truth.theta],
+    })
 }
 
 /// Installs a panic hook that prints Rust panics to the console (a panic
@@ -204,6 +227,113 @@ impl Lab {
         let t: Timings =
             serde_json::from_str(timings_json).map_err(|e| js_err(format!("timings: {e}")))?;
         Ok(self.inner.report(t).map_err(js_err)?.to_json())
+    }
+
+    /// The camera image size as JSON `{width, height, hfov_deg}`.
+    #[wasm_bindgen(js_name = cameraInfo)]
+    pub fn camera_info(&self) -> String {
+        let c = &self.inner.scenario().camera;
+        serde_json::json!({"width": c.width, "height": c.height, "hfov_deg": c.hfov_deg})
+            .to_string()
+    }
+
+    /// Draws what robot `robot`'s camera sees now (noise-free, in colour) into
+    /// a canvas context at the camera's resolution.
+    #[wasm_bindgen(js_name = drawCamera)]
+    pub fn draw_camera(
+        &mut self,
+        robot: u32,
+        ctx: &web_sys::CanvasRenderingContext2d,
+    ) -> Result<(), JsError> {
+        let img = self
+            .inner
+            .camera_view(robot as usize, true)
+            .map_err(js_err)?;
+        let rgba = img.rgba.ok_or_else(|| JsError::new("no colour image"))?;
+        put_rgba(ctx, &rgba, img.width, img.height)
+    }
+
+    /// The camera view of robot `robot` as grey bytes (width*height).
+    #[wasm_bindgen(js_name = cameraGray)]
+    pub fn camera_gray(&mut self, robot: u32) -> Result<Vec<u8>, JsError> {
+        Ok(self
+            .inner
+            .camera_view(robot as usize, false)
+            .map_err(js_err)?
+            .gray)
+    }
+
+    /// Robot `robot`'s captured frames as JSON: `[{index, step, time_s,
+    /// odometry: [x, y, theta], truth: [x, y, theta]}]` (no pixels).
+    #[wasm_bindgen(js_name = framesJson)]
+    pub fn frames_json(&self, robot: u32) -> Result<String, JsError> {
+        let frames = self.inner.frames(robot as usize).map_err(js_err)?;
+        let v: Vec<serde_json::Value> = frames.iter().map(frame_meta).collect();
+        Ok(serde_json::Value::Array(v).to_string())
+    }
+
+    /// How many frames robot `robot` has captured (and kept).
+    #[wasm_bindgen(js_name = frameCount)]
+    pub fn frame_count(&self, robot: u32) -> Result<u32, JsError> {
+        Ok(self.inner.frames(robot as usize).map_err(js_err)?.len() as u32)
+    }
+
+    /// Metadata of frame `index` of robot `robot`, as JSON.
+    #[wasm_bindgen(js_name = frameJson)]
+    pub fn frame_json(&self, robot: u32, index: u32) -> Result<String, JsError> {
+        Ok(frame_meta(
+            self.inner
+                .frame(robot as usize, index as usize)
+                .map_err(js_err)?,
+        )
+        .to_string())
+    }
+
+    /// Draws captured frame `index` of robot `robot` (grey) into a context.
+    #[wasm_bindgen(js_name = drawFrame)]
+    pub fn draw_frame(
+        &self,
+        robot: u32,
+        index: u32,
+        ctx: &web_sys::CanvasRenderingContext2d,
+    ) -> Result<(), JsError> {
+        let f = self
+            .inner
+            .frame(robot as usize, index as usize)
+            .map_err(js_err)?;
+        let rgba: Vec<u8> = f.gray.iter().flat_map(|&g| [g, g, g, 255]).collect();
+        put_rgba(ctx, &rgba, f.width, f.height)
+    }
+
+    /// Captured frame `index` of robot `robot` as grey bytes.
+    #[wasm_bindgen(js_name = frameGray)]
+    pub fn frame_gray(&self, robot: u32, index: u32) -> Result<Vec<u8>, JsError> {
+        Ok(self
+            .inner
+            .frame(robot as usize, index as usize)
+            .map_err(js_err)?
+            .gray
+            .clone())
+    }
+
+    /// Captured frame `index` of robot `robot` as a PNG file (8-bit grey).
+    #[wasm_bindgen(js_name = framePng)]
+    pub fn frame_png(&self, robot: u32, index: u32) -> Result<Vec<u8>, JsError> {
+        let f = self
+            .inner
+            .frame(robot as usize, index as usize)
+            .map_err(js_err)?;
+        let mut out = Vec::new();
+        image::codecs::png::PngEncoder::new(&mut out)
+            .write_image(&f.gray, f.width, f.height, image::ExtendedColorType::L8)
+            .map_err(js_err)?;
+        Ok(out)
+    }
+
+    /// Puts a PNG or JPEG picture on every wall whose texture is `image:NAME`.
+    #[wasm_bindgen(js_name = addImageTexture)]
+    pub fn add_image_texture(&mut self, name: &str, bytes: &[u8]) -> Result<(), JsError> {
+        self.inner.add_image_texture(name, bytes).map_err(js_err)
     }
 
     /// One robot's log as CSV (the thesis's layout).

@@ -1,0 +1,100 @@
+//! # Frame capture, as Fraps did in the thesis
+//!
+//! In the thesis, Fraps saved the camera view once a second (§6.1.2) and
+//! MATLAB kept the time, pose, sonar and laser of every step (§6.2.1); the
+//! two were joined by time. Here a frame is captured every
+//! `camera.period_s` simulated seconds (1 s by default, starting at t = 0)
+//! together with the odometry pose, sonar and laser of that instant, and the
+//! true pose beside it for scoring.
+//!
+//! Frames are stored raw (8-bit grey, `width × height` bytes) so that
+//! matching never pays for decoding. Memory is bounded by a budget shared by
+//! all robots ([`FRAME_BUDGET_BYTES`]). When a robot's share is full the
+//! store is **thinned**: every other frame is dropped and the capture period
+//! doubles, so the frames kept still span the whole run evenly (a 1-hour run
+//! at 320 × 240 keeps a frame every 4 s instead of every second). The
+//! number of frames dropped is reported.
+
+use crate::geom::Pose2;
+use crate::sensors::{LASER_BEAMS, SONAR_COUNT};
+
+/// Frames of all robots together use at most this much memory (96 MiB).
+pub const FRAME_BUDGET_BYTES: usize = 96 << 20;
+
+/// One captured frame and the robot's senses at that instant.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CapturedFrame {
+    /// Capture number for this robot (0, 1, 2, … in capture order; frames
+    /// dropped by thinning leave gaps).
+    pub index: usize,
+    pub step: usize,
+    pub time_s: f64,
+    /// What the robot believed (odometry frame).
+    pub odometry: Pose2,
+    /// Where it really was (world frame). For scoring only.
+    pub truth: Pose2,
+    pub sonar_m: [f32; SONAR_COUNT],
+    /// Laser ranges in mm; `u16::MAX` for no return.
+    pub laser_mm: [u16; LASER_BEAMS],
+    pub width: u32,
+    pub height: u32,
+    pub gray: Vec<u8>,
+}
+
+/// One robot's frames, within its share of the budget.
+#[derive(Clone, Debug)]
+pub struct FrameStore {
+    pub frames: Vec<CapturedFrame>,
+    /// Capture every this many control steps.
+    pub period_steps: usize,
+    pub max_frames: usize,
+    /// Frames dropped by thinning.
+    pub dropped: usize,
+    next_index: usize,
+}
+
+impl FrameStore {
+    /// A store for frames of `frame_bytes` each, with `robots` robots sharing
+    /// the budget, capturing every `period_steps` steps.
+    pub fn new(frame_bytes: usize, robots: usize, period_steps: usize) -> Self {
+        let share = FRAME_BUDGET_BYTES / robots.max(1);
+        FrameStore {
+            frames: Vec::new(),
+            period_steps: period_steps.max(1),
+            max_frames: (share / frame_bytes.max(1)).max(2),
+            dropped: 0,
+            next_index: 0,
+        }
+    }
+
+    /// Whether a frame is due at `step`.
+    pub fn due(&self, step: usize) -> bool {
+        step % self.period_steps == 0
+    }
+
+    /// The index the next frame will get.
+    pub fn next_index(&self) -> usize {
+        self.next_index
+    }
+
+    /// Stores a frame, thinning first if the share is full.
+    pub fn push(&mut self, mut frame: CapturedFrame) {
+        if self.frames.len() >= self.max_frames {
+            let before = self.frames.len();
+            let mut k = 0;
+            self.frames.retain(|_| {
+                k += 1;
+                k % 2 == 1
+            });
+            self.dropped += before - self.frames.len();
+            self.period_steps *= 2;
+        }
+        frame.index = self.next_index;
+        self.next_index += 1;
+        self.frames.push(frame);
+    }
+
+    pub fn bytes(&self) -> usize {
+        self.frames.iter().map(|f| f.gray.len()).sum()
+    }
+}

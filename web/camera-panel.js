@@ -1,0 +1,177 @@
+// Camera views and film strips, one block per robot.
+//
+// Each block shows what the robot's camera sees (live, in colour; before a
+// run, the view from its start pose) and, under it, a film strip of the
+// frames captured so far (one per simulated second, as Fraps saved them in
+// the thesis). Clicking a thumbnail shows that frame (the grey image the
+// vision pipeline uses) and marks on the map where it was taken; "live"
+// returns to the live view.
+
+import { robotColour } from './robots-panel.js';
+
+const LIVE_INTERVAL_MS = 120; // live views refresh at about 8 per second
+const THUMB_W = 64;
+const THUMB_H = 48;
+
+export class CameraPanel {
+  /**
+   * @param {HTMLElement} host
+   * @param {{lab: () => any, onMarker: (m: null | {robot: number, pose: number[], fovDeg: number}) => void,
+   *          onError: (e: unknown) => void}} hooks
+   */
+  constructor(host, hooks) {
+    this.host = host;
+    this.hooks = hooks;
+    this.blocks = [];
+    this.key = '';
+    this.lastLiveMs = 0;
+    this.scratch = document.createElement('canvas');
+    this.camera = { width: 320, height: 240, hfov_deg: 60 };
+  }
+
+  /** Rebuilds the blocks when the set of robots (or the camera) changes. */
+  sync(scenario) {
+    const lab = this.hooks.lab();
+    if (!lab) return;
+    this.camera = JSON.parse(lab.cameraInfo());
+    const key = JSON.stringify([scenario.robots.map((r) => r.name), this.camera]);
+    if (key === this.key) return;
+    this.key = key;
+    this.host.replaceChildren();
+    this.blocks = scenario.robots.map((r, i) => this.makeBlock(r.name, i));
+    this.scratch.width = this.camera.width;
+    this.scratch.height = this.camera.height;
+    this.select(null);
+    this.refresh(true);
+  }
+
+  makeBlock(name, i) {
+    const el = document.createElement('div');
+    el.className = 'cam-block';
+    el.style.setProperty('--robot', robotColour(i));
+    const head = document.createElement('div');
+    head.className = 'cam-head';
+    const title = document.createElement('span');
+    title.className = 'cam-title';
+    title.textContent = `${name} camera`;
+    const what = document.createElement('span');
+    what.className = 'cam-what';
+    const live = document.createElement('button');
+    live.type = 'button';
+    live.className = 'cam-live';
+    live.textContent = 'live';
+    live.hidden = true;
+    live.setAttribute('aria-label', `Back to ${name}'s live camera view`);
+    live.addEventListener('click', () => this.select(null));
+    head.append(title, what, live);
+    const body = document.createElement('div');
+    body.className = 'cam-body';
+    const view = document.createElement('canvas');
+    view.className = 'cam-view';
+    view.width = this.camera.width;
+    view.height = this.camera.height;
+    view.setAttribute('role', 'img');
+    view.setAttribute('aria-label', `What ${name}'s camera sees`);
+    const strip = document.createElement('div');
+    strip.className = 'cam-strip';
+    strip.setAttribute('role', 'list');
+    strip.setAttribute('aria-label', `${name}'s captured frames`);
+    const empty = document.createElement('p');
+    empty.className = 'cam-empty';
+    empty.textContent = 'Frames appear here once a second while the robots run.';
+    strip.append(empty);
+    body.append(view, strip);
+    el.append(head, body);
+    this.host.append(el);
+    return { el, what, live, view, ctx: view.getContext('2d'), strip, empty, shown: [], robot: i, selected: null };
+  }
+
+  /** Shows a captured frame in robot i's view (or live again with null). */
+  select(choice) {
+    const lab = this.hooks.lab();
+    for (const b of this.blocks) {
+      const mine = choice && choice.robot === b.robot;
+      b.selected = mine ? choice.index : null;
+      b.live.hidden = !mine;
+      for (const t of b.strip.querySelectorAll('.cam-thumb')) {
+        t.classList.toggle('selected', mine && Number(t.dataset.index) === choice.index);
+      }
+      if (mine && lab) {
+        const m = JSON.parse(lab.frameJson(b.robot, choice.index));
+        lab.drawFrame(b.robot, choice.index, b.ctx);
+        b.what.textContent = `frame ${m.index} · t = ${m.time_s.toFixed(1)} s (grey, as the vision pipeline sees it)`;
+        this.hooks.onMarker({ robot: b.robot, pose: m.truth, fovDeg: this.camera.hfov_deg });
+      } else {
+        b.what.textContent = 'live';
+      }
+    }
+    if (!choice) this.hooks.onMarker(null);
+    this.lastLiveMs = 0;
+  }
+
+  /** Called every animation frame; `changed` when the world moved or was edited. */
+  update(nowMs, changed) {
+    if (!this.blocks.length) return;
+    if (changed && nowMs - this.lastLiveMs >= LIVE_INTERVAL_MS) {
+      this.lastLiveMs = nowMs;
+      this.refresh(false);
+    }
+  }
+
+  refresh(force) {
+    const lab = this.hooks.lab();
+    if (!lab) return;
+    try {
+      for (const b of this.blocks) {
+        if (b.selected === null) lab.drawCamera(b.robot, b.ctx);
+        this.syncStrip(lab, b, force);
+      }
+    } catch (e) {
+      this.hooks.onError(e);
+    }
+  }
+
+  syncStrip(lab, b, force) {
+    const count = lab.frameCount(b.robot);
+    if (!force && count === b.shown.length) return;
+    const metas = JSON.parse(lab.framesJson(b.robot));
+    const have = new Set(metas.map((m) => m.index));
+    // Frames can vanish (a reset, or thinning at the memory cap).
+    if (b.shown.some((k) => !have.has(k))) {
+      for (const t of [...b.strip.querySelectorAll('.cam-thumb')]) {
+        if (!have.has(Number(t.dataset.index))) t.remove();
+      }
+      b.shown = b.shown.filter((k) => have.has(k));
+      if (b.selected !== null && !have.has(b.selected)) this.select(null);
+    }
+    const shown = new Set(b.shown);
+    const sctx = this.scratch.getContext('2d');
+    const atEnd = b.strip.scrollLeft + b.strip.clientWidth >= b.strip.scrollWidth - 4;
+    for (const m of metas) {
+      if (shown.has(m.index)) continue;
+      lab.drawFrame(b.robot, m.index, sctx);
+      const t = document.createElement('canvas');
+      t.className = 'cam-thumb';
+      t.width = THUMB_W;
+      t.height = THUMB_H;
+      t.dataset.index = String(m.index);
+      t.tabIndex = 0;
+      t.setAttribute('role', 'listitem');
+      t.setAttribute('aria-label', `frame ${m.index} at ${m.time_s.toFixed(0)} s`);
+      t.title = `frame ${m.index} · t = ${m.time_s.toFixed(1)} s — click to view it and see where it was taken`;
+      t.getContext('2d').drawImage(this.scratch, 0, 0, THUMB_W, THUMB_H);
+      const pick = () => this.select({ robot: b.robot, index: m.index });
+      t.addEventListener('click', pick);
+      t.addEventListener('keydown', (e) => {
+        if (e.key === 'Enter' || e.key === ' ') {
+          e.preventDefault();
+          pick();
+        }
+      });
+      b.strip.append(t);
+      b.shown.push(m.index);
+    }
+    b.empty.hidden = b.shown.length > 0;
+    if (atEnd) b.strip.scrollLeft = b.strip.scrollWidth;
+  }
+}
