@@ -75,3 +75,23 @@ fn badly_placed_robots_are_kept_for_editing_but_refuse_to_run() {
 fn simd_flag_matches_the_build() {
     assert_eq!(simd_enabled(), cfg!(target_feature = "simd128"));
 }
+
+#[wasm_bindgen_test]
+fn camera_frames_cross_the_boundary() {
+    let mut lab = Lab::new(THESIS).unwrap();
+    // Before a run: a live view from the start pose, no frames yet.
+    assert_eq!(lab.camera_gray(0).unwrap().len(), 320 * 240);
+    assert_eq!(lab.frame_count(0).unwrap(), 0);
+    lab.step(20).unwrap();
+    assert_eq!(lab.frame_count(1).unwrap(), 3, "t = 0, 1, 2 s");
+    let frames: serde_json::Value = serde_json::from_str(&lab.frames_json(1).unwrap()).unwrap();
+    assert_eq!(frames[2]["time_s"], 2.0);
+    assert_eq!(frames[0]["odometry"], serde_json::json!([0.0, 0.0, 0.0]));
+    let png = lab.frame_png(1, 2).unwrap();
+    let img = image::load_from_memory(&png).unwrap().to_luma8();
+    assert_eq!(img.as_raw(), &lab.frame_gray(1, 2).unwrap());
+    assert!(message(lab.frame_png(1, 99).unwrap_err()).contains("has no frame 99"));
+    assert!(message(lab.camera_gray(7).unwrap_err()).contains("no robot with index 7"));
+    assert!(message(lab.add_image_texture("x", b"junk").unwrap_err()).contains("not a PNG or JPEG"));
+    lab.add_image_texture("poster", &png).unwrap();
+}

@@ -109,3 +109,45 @@ test('bad command lines exit 2 with a message', () => {
     assert.match(r.stderr, pattern, args.join(' '));
   }
 });
+
+test('frames writes one PNG per captured frame and an index', () => {
+  const out = path.join(tmp, 'frames');
+  const r = run('frames', 'scenarios/thesis.json', '--out', out, '--duration', '5');
+  assert.equal(r.code, 0, r.stderr);
+  const index = JSON.parse(readFileSync(path.join(out, 'index.json'), 'utf8'));
+  assert.equal(index.scenario, 'thesis');
+  assert.deepEqual(index.camera, { width: 320, height: 240, hfov_deg: 60 });
+  // Two robots, a frame at t = 0, 1, ..., 5 s each.
+  assert.equal(index.frames.length, 12);
+  const thesis = JSON.parse(readFileSync(path.join(root, 'scenarios/thesis.json'), 'utf8'));
+  for (const [k, f] of index.frames.entries()) {
+    const robot = k < 6 ? 'robot1' : 'robot2';
+    assert.equal(f.robot, robot);
+    assert.equal(f.index, k % 6);
+    assert.equal(f.time, k % 6);
+    assert.equal(f.odometry.length, 3);
+    assert.equal(f.truth.length, 3);
+    if (f.index === 0) {
+      assert.deepEqual(f.odometry, [0, 0, 0]);
+      assert.deepEqual(f.truth, thesis.robots[k < 6 ? 0 : 1].start);
+    }
+    const png = readFileSync(path.join(out, f.file));
+    assert.deepEqual([...png.subarray(0, 8)], [137, 80, 78, 71, 13, 10, 26, 10], 'a PNG signature');
+    assert.equal(png.readUInt32BE(16), 320); // IHDR width
+    assert.equal(png.readUInt32BE(20), 240); // IHDR height
+    assert.equal(png[25], 0, 'colour type 0: greyscale');
+  }
+  assert.match(r.stderr, /wrote 12 frames/);
+});
+
+test('frames refuses bad input with exit 2', () => {
+  for (const [args, pattern] of [
+    [['frames', 'scenarios/thesis.json'], /--out DIR is required/],
+    [['frames', '--out', path.join(tmp, 'x')], /expected exactly one SCENARIO/],
+    [['frames', 'nope.json', '--out', path.join(tmp, 'x')], /cannot read scenario 'nope.json'/],
+  ]) {
+    const r = run(...args);
+    assert.equal(r.code, 2, r.stderr);
+    assert.match(r.stderr, pattern);
+  }
+});

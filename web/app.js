@@ -634,7 +634,9 @@ function refreshSelectionPanel(ed) {
   row.innerHTML = `<label for="wall-texture">Texture</label>
     <input type="text" id="wall-texture" list="texture-names" placeholder="(own texture)" aria-label="Texture name of the selected wall">
     <datalist id="texture-names"></datalist>
-    <button type="button" id="wall-delete" aria-label="Delete the selected wall">Delete wall</button>`;
+    <button type="button" id="wall-delete" aria-label="Delete the selected wall">Delete wall</button>
+    <label class="button" id="wall-picture-label" role="button" tabindex="0" aria-label="Put a PNG or JPEG picture on the selected wall">Picture…
+      <input type="file" id="wall-picture" accept="image/png,image/jpeg" hidden></label>`;
   body.append(coords, row);
   const input = row.querySelector('#wall-texture');
   input.value = w.texture ?? '';
@@ -659,9 +661,36 @@ function refreshSelectionPanel(ed) {
     }),
   );
   row.querySelector('#wall-delete').addEventListener('click', guard(deleteSelection));
+  const picture = row.querySelector('#wall-picture');
+  picture.disabled = !ed;
+  row.querySelector('#wall-picture-label').addEventListener('keydown', (e) => {
+    if (e.key === 'Enter' || e.key === ' ') {
+      e.preventDefault();
+      picture.click();
+    }
+  });
+  picture.addEventListener('change', async () => {
+    const file = picture.files && picture.files[0];
+    picture.value = '';
+    if (!file) return;
+    if (!editable()) return notEditable();
+    try {
+      const bytes = new Uint8Array(await file.arrayBuffer());
+      const name = file.name.replace(/\.[^.]*$/, '').replace(/[^\w-]+/g, '_').slice(0, 48) || 'picture';
+      app.lab.addImageTexture(name, bytes); // throws with a message for a bad file
+      const next = clone(app.scenario);
+      next.walls[sel.index].texture = `image:${name}`;
+      commit(next);
+      setStatus(`Wall ${sel.index + 1} now shows ${file.name} (texture “image:${name}”).`, 'ok');
+    } catch (e) {
+      setStatus(`Could not use ${file.name}: ${message(e)}. The wall is unchanged.`, 'error');
+    }
+  });
   const note = document.createElement('p');
   note.className = 'hint';
-  note.textContent = 'Walls with the same texture name look alike; "plain" is featureless.';
+  note.textContent =
+    'Walls with the same texture name look alike; "plain" is featureless. A picture lives in this browser session; ' +
+    'the scenario keeps its name, and a wall whose picture is not loaded shows a generated texture.';
   body.append(note);
 }
 

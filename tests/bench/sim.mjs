@@ -37,3 +37,32 @@ for (let k = 0; k < 200; k++) {
   times.push(performance.now() - t0);
 }
 console.log(`wasm (${build}) render 960x720 ${median(times).toFixed(2)} ms/frame`);
+
+// Camera: ms per grey frame (noise-free view from robot1 at t = 150 s,
+// textures already cached), at the default 320 x 240 and at 640 x 480.
+for (const [w, h] of [[320, 240], [640, 480]]) {
+  const scenario = JSON.parse(readFileSync(new URL('../../scenarios/thesis.json', import.meta.url), 'utf8'));
+  scenario.camera = { width: w, height: h };
+  const cam = new wasm.Lab(JSON.stringify(scenario));
+  cam.step(1500);
+  cam.cameraGray(0); // warm the texture cache
+  const t = [];
+  for (let k = 0; k < 50; k++) {
+    const t0 = performance.now();
+    cam.cameraGray(0);
+    t.push(performance.now() - t0);
+  }
+  console.log(`wasm (${build}) camera ${w}x${h} ${median(t).toFixed(2)} ms/frame`);
+  cam.free();
+}
+
+// A whole thesis run with capture (301 frames per robot) against one
+// without, per simulated step.
+{
+  const text = readFileSync(new URL('../../scenarios/thesis.json', import.meta.url), 'utf8');
+  const lab = new wasm.Lab(text);
+  const t0 = performance.now();
+  lab.runToEnd();
+  const ms = performance.now() - t0;
+  console.log(`wasm (${build}) thesis run, 300 s with cameras: ${ms.toFixed(0)} ms (${(ms / 3000).toFixed(3)} ms per step)`);
+}

@@ -136,16 +136,12 @@ pub fn wall_texture_key(walls: &[WallSpec], i: usize, back: bool) -> TextureKey 
     }
 }
 
-fn bilinear(tex: &[u8], w: u32, h: u32, x: f64, y: f64) -> f64 {
-    let x = (x - 0.5).clamp(0.0, (w - 1) as f64);
-    let y = (y - 0.5).clamp(0.0, (h - 1) as f64);
-    let (x0, y0) = (x as u32, y as u32);
-    let (x1, y1) = ((x0 + 1).min(w - 1), (y0 + 1).min(h - 1));
-    let (fx, fy) = (x - x0 as f64, y - y0 as f64);
-    let at = |xx: u32, yy: u32| tex[(yy * w + xx) as usize] as f64;
-    let top = at(x0, y0) * (1.0 - fx) + at(x1, y0) * fx;
-    let bot = at(x0, y1) * (1.0 - fx) + at(x1, y1) * fx;
-    top * (1.0 - fy) + bot * fy
+/// Rows whose pixel centres lie between the continuous rows `top` and
+/// `bottom`, clipped to the image: `first..end`.
+fn row_span(top: f64, bottom: f64, h: u32) -> (u32, u32) {
+    let first = (top - 0.5).ceil().max(0.0);
+    let end = ((bottom - 0.5).floor() + 1.0).clamp(0.0, h as f64);
+    (first.min(h as f64) as u32, end as u32)
 }
 
 /// Shade of the floor at a row below the horizon, darker with distance.
@@ -185,138 +181,147 @@ pub fn render(
     let origin = pose.position();
     let cy = h as f64 / 2.0;
     let ppm = TEXELS_PER_M as f64;
+    // Floor and ceiling depend only on the row: shade them once per frame.
+    let row_shade: Vec<f64> = (0..h)
+        .map(|r| {
+            let yc = r as f64 + 0.5;
+            if yc < cy {
+                ceiling_shade(cam, yc)
+            } else {
+                floor_shade(cam, yc)
+            }
+        })
+        .collect();
+    let row_rgb: Vec<[u8; 3]> = row_shade
+        .iter()
+        .enumerate()
+        .map(|(r, &v)| {
+            if (r as f64 + 0.5) < cy {
+                [v as u8, v as u8, (v + 8.0).min(255.0) as u8]
+            } else {
+                [
+                    (v + 10.0).min(255.0) as u8,
+                    v as u8,
+                    (v - 10.0).max(0.0) as u8,
+                ]
+            }
+        })
+        .collect();
     let mut column = vec![0f64; h as usize];
     let mut column_rgb = vec![[0u8; 3]; if colour { h as usize } else { 0 }];
     for c in 0..w {
         let local = cam.column_ray(c);
         let cos_a = local.x;
         let dir = DVec2::from_angle(pose.theta).rotate(local);
-        // The nearest wall, and the nearest robot if it is nearer still.
+        column.copy_from_slice(&row_shade);
+        if colour {
+            column_rgb.copy_from_slice(&row_rgb);
+        }
+        // The nearest wall: its span of rows, sampled from the texture.
         let hit = world.cast(origin, dir, MAX_VIEW_M);
+        if let Some((hit, wi)) = hit.and_then(|hit| hit.wall.map(|wi| (hit, wi))) {
+            let depth = hit.range_m * cos_a;
+            let seg = world.walls()[wi];
+            let p = origin + dir * hit.range_m;
+            let back = cross(seg.b - seg.a, origin - seg.a) < 0.0;
+            // Measured so that the texture reads left to right for the
+            // viewer: from `b` on the left side of a→b, from `a` on its
+            // right side.
+            let along = if back {
+                (p - seg.a).length()
+            } else {
+                (p - seg.b).length()
+            };
+            // Texels per pixel decides the mip level.
+            let footprint = ppm * depth / cam.f_px;
+            let level = if footprint < 1.6 {
+                0
+            } else if footprint < 3.2 {
+                1
+            } else {
+                2
+            };
+            let k = along.floor() as i64;
+            let lx = (along - k as f64) * ppm;
+            let chunk = bank.chunk(&wall_texture_key(walls, wi, back), k);
+            let (top, bottom) = (cam.row_of(cam.wall_height_m, depth), cam.row_of(0.0, depth));
+            let (r0, r1) = row_span(top, bottom, h);
+            // On the wall, texel row = (h_w - z) * ppm with z linear in the
+            // row: ty(r) = ty0 + r * dty.
+            let scale = (1u32 << level) as f64;
+            let dty = ppm * depth / (cam.f_px * scale);
+            let ty0 = ((cam.wall_height_m - cam.mount_height_m) * ppm
+                + (0.5 - cy) * ppm * depth / cam.f_px)
+                / scale;
+            let (tw, th) = (chunk.width[level], chunk.height[level]);
+            let tex = &chunk.gray[level];
+            let x = (lx / scale - 0.5).clamp(0.0, (tw - 1) as f64);
+            let x0 = x as usize;
+            let x1 = (x0 + 1).min(tw as usize - 1);
+            let fx = x - x0 as f64;
+            let tw = tw as usize;
+            for r in r0..r1 {
+                let y = (ty0 + r as f64 * dty - 0.5).clamp(0.0, (th - 1) as f64);
+                let y0 = y as usize;
+                let y1 = (y0 + 1).min(th as usize - 1);
+                let fy = y - y0 as f64;
+                let (a, b) = (tex[y0 * tw + x0] as f64, tex[y0 * tw + x1] as f64);
+                let (c2, d) = (tex[y1 * tw + x0] as f64, tex[y1 * tw + x1] as f64);
+                let top_v = a + (b - a) * fx;
+                let bot_v = c2 + (d - c2) * fx;
+                column[r as usize] = top_v + (bot_v - top_v) * fy;
+            }
+            if colour {
+                let (tw0, th0) = (chunk.width[0], chunk.height[0]);
+                let tx = (lx as u32).min(tw0 - 1);
+                for r in r0..r1 {
+                    let ty = ((ty0 + r as f64 * dty) * scale).max(0.0) as u32;
+                    let i = ((ty.min(th0 - 1) * tw0 + tx) * 4) as usize;
+                    column_rgb[r as usize] = [chunk.rgba[i], chunk.rgba[i + 1], chunk.rgba[i + 2]];
+                }
+            }
+        }
+        // Other robots in front of the wall hide it up to their height.
+        let wall_range = hit.map_or(f64::INFINITY, |h| h.range_m);
         let mut robot_hit: Option<(f64, [u8; 3], f64)> = None;
         for rb in robots {
             let n = rb.corners.len();
             for k in 0..n {
                 let (a, b) = (rb.corners[k], rb.corners[(k + 1) % n]);
-                let seg = crate::geom::Segment::new(a, b);
-                if let Some(t) = seg.ray_hit(origin, dir) {
-                    if robot_hit.is_none_or(|(tb, _, _)| t < tb) {
+                if let Some(t) = crate::geom::Segment::new(a, b).ray_hit(origin, dir) {
+                    if t < wall_range && robot_hit.is_none_or(|(tb, _, _)| t < tb) {
                         // Faces turned away from the light are darker.
                         let e = (b - a).normalize_or_zero();
-                        let shade = 0.65 + 0.35 * e.x.abs();
-                        robot_hit = Some((t, rb.rgb, shade));
+                        robot_hit = Some((t, rb.rgb, 0.65 + 0.35 * e.x.abs()));
                     }
                 }
             }
         }
-        // Wall span and texture column.
-        let mut wall_span = (f64::INFINITY, f64::NEG_INFINITY);
-        let mut tex: Option<(TextureKey, i64, f64, f64, usize)> = None; // key, chunk, local x, depth, level
-        if let Some(hit) = hit {
-            if let Some(wi) = hit.wall {
-                let depth = hit.range_m * cos_a;
-                let seg = world.walls()[wi];
-                let p = origin + dir * hit.range_m;
-                let back = cross(seg.b - seg.a, origin - seg.a) < 0.0;
-                // Measured so that the texture reads left to right for the
-                // viewer: from `b` on the left side of a→b, from `a` on its
-                // right side.
-                let along = if back {
-                    (p - seg.a).length()
-                } else {
-                    (p - seg.b).length()
-                };
-                let footprint = ppm * depth / cam.f_px; // texels per pixel
-                let level = if footprint < 1.6 {
-                    0
-                } else if footprint < 3.2 {
-                    1
-                } else {
-                    2
-                };
-                let k = along.floor() as i64;
-                tex = Some((
-                    wall_texture_key(walls, wi, back),
-                    k,
-                    (along - k as f64) * ppm,
-                    depth,
-                    level,
-                ));
-                wall_span = (cam.row_of(cam.wall_height_m, depth), cam.row_of(0.0, depth));
-            }
-        }
-        let robot_span = robot_hit
-            .filter(|(t, _, _)| hit.is_none_or(|hw| *t < hw.range_m))
-            .map(|(t, rgb, shade)| {
-                let depth = t * cos_a;
-                (
-                    cam.row_of(ROBOT_HEIGHT_M, depth),
-                    cam.row_of(0.0, depth),
-                    rgb,
-                    shade,
-                )
-            });
-        let wall = tex
-            .as_ref()
-            .map(|(key, k, lx, depth, level)| (bank.chunk(key, *k), *lx, *depth, *level));
-        for r in 0..h {
-            let yc = r as f64 + 0.5;
-            let mut value;
-            let mut rgb = [0u8; 3];
-            if let Some((_, _, col, shade)) = robot_span.filter(|s| yc >= s.0 && yc <= s.1) {
-                value =
-                    (0.299 * col[0] as f64 + 0.587 * col[1] as f64 + 0.114 * col[2] as f64) * shade;
-                rgb = [
-                    (col[0] as f64 * shade) as u8,
-                    (col[1] as f64 * shade) as u8,
-                    (col[2] as f64 * shade) as u8,
-                ];
-            } else if let Some((chunk, lx, depth, level)) =
-                wall.filter(|_| yc >= wall_span.0 && yc <= wall_span.1)
-            {
-                let z = cam.mount_height_m - (yc - cy) * depth / cam.f_px;
-                let ty = (cam.wall_height_m - z) * ppm;
-                let scale = (1u32 << level) as f64;
-                value = bilinear(
-                    &chunk.gray[level],
-                    chunk.width[level],
-                    chunk.height[level],
-                    lx / scale,
-                    ty / scale,
-                );
+        if let Some((t, col, shade)) = robot_hit {
+            let depth = t * cos_a;
+            let (r0, r1) = row_span(cam.row_of(ROBOT_HEIGHT_M, depth), cam.row_of(0.0, depth), h);
+            let v = (0.299 * col[0] as f64 + 0.587 * col[1] as f64 + 0.114 * col[2] as f64) * shade;
+            let rgb = col.map(|ch| (ch as f64 * shade) as u8);
+            for r in r0..r1 {
+                column[r as usize] = v;
                 if colour {
-                    let (tw, th) = (chunk.width[0], chunk.height[0]);
-                    let tx = (lx as u32).min(tw - 1);
-                    let tyy = (ty.max(0.0) as u32).min(th - 1);
-                    let i = ((tyy * tw + tx) * 4) as usize;
-                    rgb = [chunk.rgba[i], chunk.rgba[i + 1], chunk.rgba[i + 2]];
+                    column_rgb[r as usize] = rgb;
                 }
-            } else if yc < cy {
-                value = ceiling_shade(cam, yc);
-                let v = value as u8;
-                rgb = [v, v, (value + 8.0).min(255.0) as u8];
-            } else {
-                value = floor_shade(cam, yc);
-                let v = value as u8;
-                rgb = [
-                    (value + 10.0).min(255.0) as u8,
-                    v,
-                    (value - 10.0).max(0.0) as u8,
-                ];
-            }
-            value *= gain;
-            if let Some(n) = &mut noise {
-                if n.pixel_std > 0.0 {
-                    value += n.pixel_std * n.rng.approx_gaussian();
-                }
-            }
-            column[r as usize] = value;
-            if colour {
-                column_rgb[r as usize] = rgb;
             }
         }
-        for r in 0..h as usize {
-            gray[r * w as usize + c as usize] = column[r].round().clamp(0.0, 255.0) as u8;
+        // Exposure and sensor noise, then out.
+        match &mut noise {
+            Some(n) if n.pixel_std > 0.0 => {
+                for (r, v) in column.iter().enumerate() {
+                    let noisy = v * gain + n.pixel_std * n.rng.approx_gaussian();
+                    gray[r * w as usize + c as usize] = noisy.round().clamp(0.0, 255.0) as u8;
+                }
+            }
+            _ => {
+                for (r, v) in column.iter().enumerate() {
+                    gray[r * w as usize + c as usize] = (v * gain).round().clamp(0.0, 255.0) as u8;
+                }
+            }
         }
         if let Some(out) = rgba.as_mut() {
             for (r, px) in column_rgb.iter().enumerate() {
