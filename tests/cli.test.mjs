@@ -3,7 +3,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawnSync } from 'node:child_process';
-import { mkdtempSync, writeFileSync, readFileSync } from 'node:fs';
+import { mkdtempSync, mkdirSync, writeFileSync, readFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -150,4 +150,81 @@ test('frames refuses bad input with exit 2', () => {
     assert.equal(r.code, 2, r.stderr);
     assert.match(r.stderr, pattern);
   }
+});
+
+test('map writes a ROS map_server PGM + YAML and a PNG', () => {
+  const out = path.join(tmp, 'map', 'thesis.yaml');
+  mkdirSync(path.dirname(out), { recursive: true });
+  const r = run('map', 'scenarios/thesis.json', '--robot', 'robot2', '--out', out, '--duration', '20');
+  assert.equal(r.code, 0, r.stderr);
+  const yaml = readFileSync(out, 'utf8');
+  assert.match(yaml, /^image: "?thesis\.pgm"?$/m);
+  assert.match(yaml, /^resolution: 0\.05$/m);
+  assert.match(yaml, /^origin: \[-?[\d.]+, -?[\d.]+, 0(\.0)?\]$/m);
+  assert.match(yaml, /^negate: 0$/m);
+  assert.match(yaml, /^occupied_thresh: 0\.65$/m);
+  assert.match(yaml, /^free_thresh: 0\.196$/m);
+  // Binary PGM: "P5", width, height, 255 (comment lines allowed between),
+  // one whitespace, then w*h bytes of 254 / 0 / 205 only.
+  const pgm = readFileSync(path.join(path.dirname(out), 'thesis.pgm'));
+  const header = pgm.subarray(0, 200).toString('latin1').match(/^P5(?:\s+|#[^\n]*\n)+(\d+)\s+(\d+)\s+255\s/);
+  assert.ok(header, 'a P5 header');
+  const [w, h] = [Number(header[1]), Number(header[2])];
+  const data = pgm.subarray(header[0].length);
+  assert.equal(data.length, w * h);
+  const counts = { 0: 0, 205: 0, 254: 0 };
+  for (const v of data) {
+    assert.ok(v in counts, `unexpected cell value ${v}`);
+    counts[v] += 1;
+  }
+  assert.ok(counts[0] > 50 && counts[254] > 500 && counts[205] > 0, JSON.stringify(counts));
+  const png = readFileSync(path.join(path.dirname(out), 'thesis.png'));
+  assert.deepEqual([...png.subarray(1, 4)], [80, 78, 71]);
+  // Bad input.
+  for (const [args, pattern] of [
+    [['map', 'scenarios/thesis.json', '--robot', 'nobody', '--out', out, '--duration', '1'], /no robot named 'nobody'/],
+    [['map', 'scenarios/thesis.json', '--out', out], /--robot NAME is required/],
+    [['map', 'scenarios/thesis.json', '--robot', 'robot1', '--out', out, '--mapper', 'magic'], /--mapper/],
+  ]) {
+    const b = run(...args);
+    assert.equal(b.code, 2, b.stderr);
+    assert.match(b.stderr, pattern);
+  }
+});
+
+test('features and match keep the interface JSON', () => {
+  const f = run('features', 'tests/data/coffee.png', '--json');
+  assert.equal(f.code, 0, f.stderr);
+  const feats = JSON.parse(f.stdout);
+  assert.equal(feats.width, 640);
+  assert.equal(feats.height, 480);
+  assert.ok(feats.keypoints.length > 500, `${feats.keypoints.length} keypoints`);
+  for (const k of feats.keypoints.slice(0, 50)) {
+    for (const key of ['x', 'y', 'scale', 'orientation', 'laplacian', 'descriptor']) assert.ok(key in k, key);
+    assert.ok([1, -1].includes(k.laplacian));
+    assert.equal(k.descriptor.length, 64);
+  }
+  const m = run('match', 'tests/data/coffee.png', 'tests/data/coffee_rot12_s085.png', '--json');
+  assert.equal(m.code, 0, m.stderr);
+  const res = JSON.parse(m.stdout);
+  assert.ok(res.matches > 100 && res.inliers > 100 && res.inliers <= res.matches);
+  assert.equal(res.homography.length, 3);
+  assert.equal(res.quad.length, 4);
+  // The known warp: rotation 12° and scale 0.85 about the image centre.
+  const H = res.homography;
+  const project = ([x, y]) => {
+    const w = H[2][0] * x + H[2][1] * y + H[2][2];
+    return [(H[0][0] * x + H[0][1] * y + H[0][2]) / w, (H[1][0] * x + H[1][1] * y + H[1][2]) / w];
+  };
+  const c = Math.cos((12 * Math.PI) / 180) * 0.85;
+  const s = Math.sin((12 * Math.PI) / 180) * 0.85;
+  for (const p of [[100, 100], [540, 380], [319.5, 239.5]]) {
+    const [dx, dy] = [p[0] - 319.5, p[1] - 239.5];
+    const expected = [319.5 + c * dx - s * dy, 239.5 + s * dx + c * dy];
+    const got = project(p);
+    assert.ok(Math.hypot(got[0] - expected[0], got[1] - expected[1]) < 1.5, `${p} -> ${got} vs ${expected}`);
+  }
+  const bad = run('match', 'tests/data/coffee.png', 'tests/data/README.md', '--json');
+  assert.equal(bad.code, 2);
+  assert.match(bad.stderr, /not a PNG or JPEG/);
 });

@@ -10,10 +10,12 @@ use slamlab::scenario::{FollowSide, Scenario};
 use slamlab::sensors::{RangeScene, Sonar};
 use slamlab::sim::Simulation;
 
-/// A simulation without camera capture: these tests are about motion.
+/// A simulation without camera capture or mapping: these tests are about
+/// motion, which neither changes.
 fn sim_of(s: &Scenario) -> Simulation {
     let mut sim = Simulation::new(s).unwrap();
     sim.set_capture(false);
+    sim.set_mapping(false);
     sim
 }
 use wasm_bindgen_test::wasm_bindgen_test;
@@ -400,4 +402,23 @@ fn a_robot_that_never_moves_keeps_a_bounded_log() {
     assert_eq!(r.log.sensors_dropped, 13_001 - slamlab::sim::LOG_SENSOR_CAP);
     assert_eq!(r.log.sensors.back().unwrap().step, 13_000);
     assert_eq!(r.truth, r.spec.start_pose());
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn camera_capture_and_mapping_do_not_change_the_run() {
+    // The switches the tests above use must not change what they test.
+    let mut s = Scenario::from_json(PRESETS[0].1).unwrap();
+    s.duration_s = 30.0;
+    let mut full = Simulation::new(&s).unwrap();
+    full.run_to_end();
+    let mut bare = sim_of(&s);
+    bare.run_to_end();
+    for (a, b) in full.robots.iter().zip(&bare.robots) {
+        assert_eq!(a.log.truth, b.log.truth);
+        assert_eq!(a.log.odometry, b.log.odometry);
+        assert_eq!(a.log.sensors, b.log.sensors);
+        assert_eq!(a.frames.frames.len(), 31);
+        // Only the frame taken at t = 0, when the simulation was built.
+        assert_eq!(b.frames.frames.len(), 1);
+    }
 }

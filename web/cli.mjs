@@ -7,34 +7,15 @@
 // Exit status: 0 when the run completed, 2 on bad input (message on stderr),
 // 1 on an internal error (a bug: please report it).
 // Further commands (features, match, bench-surf, ...) come from web/cli/*.mjs.
-import { readFile } from 'node:fs/promises';
 import { performance } from 'node:perf_hooks';
 import { loadWasm } from './cli/wasm.mjs';
-import { UsageError, parseArgs } from './cli/args.mjs';
+import { UsageError, parseArgs, wasmCall, openScenario } from './cli/args.mjs';
 
 export { UsageError, parseArgs };
 
 const USAGE = `usage:
   node web/cli.mjs run SCENARIO.json [--seed N] [--duration S] [--json]
       run the scenario headless and print a report (JSON with --json)`;
-
-async function readText(path, what) {
-  try {
-    return await readFile(path, 'utf8');
-  } catch (e) {
-    throw new UsageError(`cannot read ${what} '${path}': ${e.code ?? e.message}`);
-  }
-}
-
-/** Calls into wasm; an Error thrown there is a problem with the input. */
-function wasmCall(f) {
-  try {
-    return f();
-  } catch (e) {
-    if (e instanceof WebAssembly.RuntimeError) throw e; // a trap is a bug
-    throw new UsageError(e.message ?? String(e));
-  }
-}
 
 async function run(argv, wasm) {
   const { positional, options } = parseArgs(argv, {
@@ -45,26 +26,7 @@ async function run(argv, wasm) {
     throw new UsageError('--method: map merging is not available in this build yet');
   }
   const t0 = performance.now();
-  const text = await readText(positional[0], 'scenario');
-  const lab = wasmCall(() => new wasm.Lab(text));
-  if (options.seed !== undefined) {
-    const seed = Number(options.seed);
-    if (!/^\d+$/.test(options.seed) || !Number.isSafeInteger(seed)) {
-      throw new UsageError(`--seed: '${options.seed}' is not a whole number from 0 to 2^53`);
-    }
-    wasmCall(() => lab.setSeed(seed));
-  }
-  if (options.duration !== undefined) {
-    const d = Number(options.duration);
-    if (options.duration.trim() === '' || !Number.isFinite(d)) {
-      throw new UsageError(`--duration: '${options.duration}' is not a number of seconds`);
-    }
-    wasmCall(() => lab.setDuration(d));
-  }
-  // Refuse badly placed robots before running (the message names the field).
-  const problems = JSON.parse(lab.problemsJson());
-  if (problems.length > 0) throw new UsageError(problems[0].text);
-
+  const lab = await openScenario(positional[0], options, wasm);
   const state0 = JSON.parse(lab.stateJson());
   const total = state0.total_steps;
   const tSim = performance.now();
@@ -102,7 +64,7 @@ const usages = [USAGE];
 
 // Commands contributed by other capabilities (each module exports `commands`
 // and optionally `usage`).
-for (const mod of ['./cli/camera.mjs', './cli/surf.mjs']) {
+for (const mod of ['./cli/camera.mjs', './cli/surf.mjs', './cli/slam.mjs']) {
   try {
     const m = await import(mod);
     Object.assign(commands, m.commands);

@@ -1,15 +1,23 @@
+//! Prints what each robot is doing over a time window: the follower's mode,
+//! the true pose and the command. Useful to see how an encounter or a corner
+//! plays out.
+//!
+//! `cargo run --release -p slamlab --example trace -- scenarios/thesis.json 60 100`
+
 use slamlab::lab::Lab;
-fn main() {
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
-    let text = std::fs::read_to_string(&args[1]).unwrap();
-    let from: f64 = args[2].parse().unwrap();
-    let to: f64 = args[3].parse().unwrap();
-    let mut lab = Lab::new(&text).unwrap();
-    while lab.state().time_s < to {
-        lab.step(5).unwrap();
+    let usage = "usage: trace SCENARIO.json FROM_S TO_S";
+    let text = std::fs::read_to_string(args.get(1).ok_or(usage)?)?;
+    let from: f64 = args.get(2).ok_or(usage)?.parse()?;
+    let to: f64 = args.get(3).ok_or(usage)?.parse()?;
+    let mut lab = Lab::new(&text)?;
+    while lab.state().time_s < to && !lab.state().finished {
+        lab.step(5)?;
         let st = lab.state();
         if st.time_s >= from {
-            let s: Vec<String> = st
+            let robots: Vec<String> = st
                 .robots
                 .iter()
                 .map(|r| {
@@ -24,7 +32,8 @@ fn main() {
                     )
                 })
                 .collect();
-            println!("{:6.1} {}", st.time_s, s.join(" | "));
+            println!("{:6.1} {}", st.time_s, robots.join(" | "));
         }
     }
+    Ok(())
 }

@@ -236,7 +236,11 @@ impl WallFollower {
             }
             best
         };
-        let nearest = pick(true).or_else(|| pick(false));
+        // Right after an encounter only the remembered wall will do: if it
+        // is out of sight, the Seek branch below heads back to it (falling
+        // back on any nearer point here is how robots got captured by a
+        // pillar next to the place where they met).
+        let nearest = pick(true);
         if let Some((r, q)) = nearest {
             // Remember the wall we follow, as long as no encounter is on.
             if self.waiting_since_s.is_none() && t_s >= self.reacquire_until_s {

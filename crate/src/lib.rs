@@ -21,6 +21,7 @@
 //! | [`camera`] | the pinhole camera, wall textures, frame capture |
 //! | [`follower`] | the thesis's wall-following controller |
 //! | [`sim`] | the fixed-step simulation and its per-robot logs |
+//! | [`slam`] | per-robot occupancy grids, scan matching, map scoring and export |
 //! | [`render`] | tiny-skia drawing of the world, robots and sensors |
 //! | [`report`] | the JSON report of a run (`web/cli.mjs run --json`) |
 //! | [`surf`] | SURF features, matching and MSAC (Bay et al. 2008) |
@@ -42,5 +43,6 @@ pub mod rng;
 pub mod scenario;
 pub mod sensors;
 pub mod sim;
+pub mod slam;
 pub mod surf;
 pub mod world;

@@ -40,6 +40,10 @@ pub struct RobotReport {
     pub follow: String,
     pub truth: Vec<[f64; 4]>,
     pub odometry: Vec<[f64; 4]>,
+    /// SLAM pose per step, same frame and times as `odometry`.
+    pub estimate: Vec<[f64; 4]>,
+    /// ATE and map figures of the SLAM and odometry-only mappers.
+    pub slam: crate::slam::lab::SlamFigures,
     pub bumps: u32,
     /// Camera frames captured.
     pub frames: usize,
@@ -95,6 +99,8 @@ impl Report {
                     },
                     truth: rows(&log.times_s, &log.truth),
                     odometry: rows(&log.times_s, &log.odometry),
+                    estimate: rows(&log.times_s, r.mapping.estimates()),
+                    slam: crate::slam::lab::figures(sim, r),
                     bumps: r.bumps,
                     frames: r.frames.next_index(),
                     frames_dropped: r.frames.dropped,

@@ -584,7 +584,10 @@ impl Scenario {
             let whole = |v: &Value, path: &str, lo: u32, hi: u32| -> Result<u32, ScenarioError> {
                 let x = number_in(v, path, lo as f64, hi as f64)?;
                 if x.fract() != 0.0 {
-                    return Err(ScenarioError::new(path, format!("{x} is not a whole number of pixels")));
+                    return Err(ScenarioError::new(
+                        path,
+                        format!("{x} is not a whole number of pixels"),
+                    ));
                 }
                 Ok(x as u32)
             };

@@ -96,6 +96,8 @@ pub struct RobotSim {
     pub last_scan: LaserScan,
     pub last_command: Command,
     pub log: RobotLog,
+    /// The robot's two mappers (odometry-only and SLAM), fed each step.
+    pub mapping: crate::slam::RobotMapping,
     /// Frames captured by the camera.
     pub frames: FrameStore,
     camera_rng: Rng,
@@ -155,6 +157,9 @@ pub struct Simulation {
     /// Whether frames are captured (off only for experiments that need no
     /// images, e.g. controller tests; it changes nothing else in the run).
     capture: bool,
+    /// Whether the robots' mappers run (off only for experiments that need
+    /// no maps; mapping reads the senses and changes nothing else).
+    mapping: bool,
 }
 
 impl Simulation {
@@ -218,6 +223,7 @@ impl Simulation {
                     },
                     last_command: Command::default(),
                     log: RobotLog::default(),
+                    mapping: crate::slam::RobotMapping::default(),
                     frames: FrameStore::new(frame_bytes, n_robots, period_steps),
                     camera_rng: Rng::stream(seed, i, Stream::Camera),
                 }
@@ -231,6 +237,7 @@ impl Simulation {
             camera,
             textures,
             capture: true,
+            mapping: true,
         };
         sim.sense();
         for r in &mut sim.robots {
@@ -366,6 +373,12 @@ impl Simulation {
         for r in &mut self.robots {
             r.log_row(step, t);
         }
+        // 5b. mapping: odometry pose and scan into both mappers (never the truth)
+        if self.mapping {
+            for r in &mut self.robots {
+                r.mapping.observe(&r.odometry.pose(), &r.last_scan);
+            }
+        }
         // 6. camera frames, once per capture period
         self.capture_due_frames();
     }
@@ -404,6 +417,11 @@ impl Simulation {
     /// robots use, so the run is otherwise the same.
     pub fn set_capture(&mut self, on: bool) {
         self.capture = on;
+    }
+
+    /// Turns the robots' mappers off or on (see [`Simulation::set_capture`]).
+    pub fn set_mapping(&mut self, on: bool) {
+        self.mapping = on;
     }
 
     fn capture_due_frames(&mut self) {

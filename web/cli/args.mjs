@@ -1,5 +1,7 @@
-// Shared by every command module: argument parsing and the input-error type.
+// Shared by every command module: argument parsing, the input-error type,
+// and opening a scenario file into a Lab with the common --seed/--duration.
 // (Command modules import from here, not from ../cli.mjs, which imports them.)
+import { readFile } from 'node:fs/promises';
 
 /** An input error: exit status 2 with this message. */
 export class UsageError extends Error {}
@@ -28,4 +30,45 @@ export function parseArgs(argv, spec) {
     }
   }
   return { positional, options };
+}
+
+/** Calls into wasm; an Error thrown there is a problem with the input. */
+export function wasmCall(f) {
+  try {
+    return f();
+  } catch (e) {
+    if (e instanceof WebAssembly.RuntimeError) throw e; // a trap is a bug
+    throw new UsageError(e.message ?? String(e));
+  }
+}
+
+/**
+ * Reads a scenario file into a new `wasm.Lab`, applies `options.seed` and
+ * `options.duration` (strings from the command line) and refuses badly
+ * placed robots, each with a message naming the problem.
+ */
+export async function openScenario(file, options, wasm) {
+  let text;
+  try {
+    text = await readFile(file, 'utf8');
+  } catch (e) {
+    throw new UsageError(`cannot read scenario '${file}': ${e.code ?? e.message}`);
+  }
+  const lab = wasmCall(() => new wasm.Lab(text));
+  if (options.seed !== undefined) {
+    if (!/^\d+$/.test(options.seed) || !Number.isSafeInteger(Number(options.seed))) {
+      throw new UsageError(`--seed: '${options.seed}' is not a whole number from 0 to 2^53`);
+    }
+    wasmCall(() => lab.setSeed(Number(options.seed)));
+  }
+  if (options.duration !== undefined) {
+    const d = Number(options.duration);
+    if (options.duration.trim() === '' || !Number.isFinite(d)) {
+      throw new UsageError(`--duration: '${options.duration}' is not a number of seconds`);
+    }
+    wasmCall(() => lab.setDuration(d));
+  }
+  const problems = JSON.parse(lab.problemsJson());
+  if (problems.length > 0) throw new UsageError(problems[0].text);
+  return lab;
 }

@@ -6,6 +6,8 @@
 //! function returns `Result<_, JsError>` so bad input reaches JavaScript as
 //! an exception with a message, never as a panic or a trap.
 
+mod slam;
+pub mod surf;
 
 use crate::lab;
 use crate::render::{grid_step_m, scale_bar_m, RenderOptions};

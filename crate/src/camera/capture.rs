@@ -69,7 +69,7 @@ impl FrameStore {
 
     /// Whether a frame is due at `step`.
     pub fn due(&self, step: usize) -> bool {
-        step % self.period_steps == 0
+        step.is_multiple_of(self.period_steps)
     }
 
     /// The index the next frame will get.

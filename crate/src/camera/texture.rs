@@ -475,7 +475,9 @@ impl TextureBank {
             let mut pb = PathBuilder::new();
             let n = 12;
             let amp: Vec<f64> = (0..3).map(|_| rng.range(0.0, 0.3)).collect();
-            let ph: Vec<f64> = (0..3).map(|_| rng.range(0.0, 6.283)).collect();
+            let ph: Vec<f64> = (0..3)
+                .map(|_| rng.range(0.0, std::f64::consts::TAU))
+                .collect();
             for i in 0..=n {
                 let a = i as f64 / n as f64 * std::f64::consts::TAU;
                 let rr = r as f64

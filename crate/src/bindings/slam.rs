@@ -1,0 +1,121 @@
+//! # JavaScript boundary of the SLAM maps
+//!
+//! A second `#[wasm_bindgen] impl Lab` block: a robot's map (`"slam"` or
+//! `"odometry"`) as pixels, metadata, ROS map_server files, and the figures
+//! and error series the page plots. Robots are addressed by index (the
+//! order of the scenario's `robots`); `robotIndex(name)` looks one up.
+
+use super::Lab;
+use crate::slam::MapperKind;
+use wasm_bindgen::prelude::*;
+use wasm_bindgen::Clamped;
+
+fn err(e: impl std::fmt::Display) -> JsError {
+    JsError::new(&e.to_string())
+}
+
+fn kind(mapper: &str) -> Result<MapperKind, JsError> {
+    MapperKind::parse(mapper).map_err(err)
+}
+
+#[wasm_bindgen]
+impl Lab {
+    /// Index of the robot called `name`; throws if there is none.
+    #[wasm_bindgen(js_name = robotIndex)]
+    pub fn robot_index(&self, name: &str) -> Result<u32, JsError> {
+        Ok(self.inner.robot_index(name).map_err(err)? as u32)
+    }
+
+    /// The map as a binary PGM (ROS map_server: free 254, occupied 0,
+    /// unknown 205, row 0 at the top).
+    #[wasm_bindgen(js_name = mapPgm)]
+    pub fn map_pgm(&self, robot: u32, mapper: &str) -> Result<Vec<u8>, JsError> {
+        self.inner
+            .map_pgm(robot as usize, kind(mapper)?)
+            .map_err(err)
+    }
+
+    /// The same pixels as a PNG.
+    #[wasm_bindgen(js_name = mapPng)]
+    pub fn map_png(&self, robot: u32, mapper: &str) -> Result<Vec<u8>, JsError> {
+        self.inner
+            .map_png(robot as usize, kind(mapper)?)
+            .map_err(err)
+    }
+
+    /// The map_server YAML naming `image` (the PGM's file name).
+    #[wasm_bindgen(js_name = mapYaml)]
+    pub fn map_yaml(&self, robot: u32, mapper: &str, image: &str) -> Result<String, JsError> {
+        self.inner
+            .map_yaml(robot as usize, kind(mapper)?, image)
+            .map_err(err)
+    }
+
+    /// Size, resolution and origin of a map (JSON).
+    #[wasm_bindgen(js_name = mapInfoJson)]
+    pub fn map_info_json(&self, robot: u32, mapper: &str) -> Result<String, JsError> {
+        let info = self
+            .inner
+            .map_info(robot as usize, kind(mapper)?)
+            .map_err(err)?;
+        serde_json::to_string(&info).map_err(err)
+    }
+
+    /// ATE and map figures of one robot (JSON, as in the report).
+    #[wasm_bindgen(js_name = slamFiguresJson)]
+    pub fn slam_figures_json(&self, robot: u32) -> Result<String, JsError> {
+        let f = self.inner.slam_figures(robot as usize).map_err(err)?;
+        serde_json::to_string(&f).map_err(err)
+    }
+
+    /// Position error over time, `{"rows": [[t, slam_m, odometry_m], ...]}`,
+    /// at most about `max_rows` rows.
+    #[wasm_bindgen(js_name = slamErrorsJson)]
+    pub fn slam_errors_json(&self, robot: u32, max_rows: u32) -> Result<String, JsError> {
+        let s = self
+            .inner
+            .slam_errors(robot as usize, max_rows as usize)
+            .map_err(err)?;
+        serde_json::to_string(&s).map_err(err)
+    }
+
+    /// Draws a robot's map with its estimated (red) and true (green) paths
+    /// into a 2-D canvas context of `width × height`.
+    #[wasm_bindgen(js_name = drawMap)]
+    pub fn draw_map(
+        &self,
+        ctx: &web_sys::CanvasRenderingContext2d,
+        robot: u32,
+        mapper: &str,
+        width: u32,
+        height: u32,
+    ) -> Result<(), JsError> {
+        let px = self
+            .inner
+            .map_rgba(robot as usize, kind(mapper)?, width, height)
+            .map_err(err)?;
+        let img = web_sys::ImageData::new_with_u8_clamped_array_and_sh(Clamped(&px), width, height)
+            .map_err(|_| JsError::new("could not make ImageData"))?;
+        ctx.put_image_data(&img, 0.0, 0.0)
+            .map_err(|_| JsError::new("could not draw into the canvas"))
+    }
+
+    /// Re-matches robot `robot`'s latest scan against its SLAM map from the
+    /// current prior, without changing anything (for timing the matcher).
+    /// Returns the matched pose `[x, y, theta]`.
+    #[wasm_bindgen(js_name = benchMatchScan)]
+    pub fn bench_match_scan(&self, robot: u32) -> Result<Vec<f64>, JsError> {
+        let sim = self
+            .inner
+            .simulation()
+            .ok_or_else(|| JsError::new("nothing has run yet: run the scenario first"))?;
+        let r = sim
+            .robots
+            .get(robot as usize)
+            .ok_or_else(|| JsError::new(&format!("no robot with index {robot}")))?;
+        let m = &r.mapping;
+        let out =
+            crate::slam::mapper::match_scan(&m.slam_map, &r.last_scan, &m.estimate(), &m.config);
+        Ok(vec![out.pose.x, out.pose.y, out.pose.theta])
+    }
+}

@@ -1,0 +1,395 @@
+//! # The occupancy grid and its laser beam model
+//!
+//! Each robot maps in its own odometry frame (origin at its start pose) on a
+//! grid of square cells, `resolution_m` wide (0.05 m by default). A cell
+//! holds the *log-odds* `l = ln(p / (1 − p))` that it is occupied, the
+//! classic representation of Moravec and Elfes (1985) as taught in Thrun,
+//! Burgard and Fox, *Probabilistic Robotics*, §9.2 ("occupancy grid mapping
+//! with known poses", Table 9.1): Bayes' rule for a binary cell becomes an
+//! addition, `l ← l + l_sensor`, with 0 meaning "unknown" (p = ½).
+//!
+//! ## The beam model (inverse sensor model)
+//! A laser beam from the robot's centre to its end point says:
+//!
+//! * every cell the beam passes through is free (`l += l_free`, negative),
+//!   except the cells its last cell-length touches, which are left alone: with range noise, beams that end just behind a wall would
+//!   otherwise clear the wall's own cell, and walls would drift half a cell
+//!   away from wherever the robot saw them from;
+//!   A cell already at the upper clamp (a wall seen many times) is not
+//!   lowered by passing beams either: at a grazing angle a beam crosses the
+//!   cells of the wall it ends on, and such erosion, strongest far along the
+//!   wall, would tilt every wall the robot follows;
+//! * the end cell holds the surface that returned it (`l += l_occ`);
+//! * a *max-range* beam (nothing within range) clears up to the range and
+//!   marks nothing: "no wall within 4 m" is not a wall at 4 m;
+//! * a *reflective* return came off another robot, which moves: the beam
+//!   still clears the space before it, but its end is never marked as wall.
+//!
+//! Cells along a beam are visited with the traversal of Amanatides and Woo
+//! (1987), the same walk [`crate::world`] uses for ray casting, so every cell
+//! the segment touches is visited exactly once. Log-odds are clamped to
+//! `[l_min, l_max]`, so a cell that was wrong (a robot that stood there) can
+//! be cleared again after a few scans, and stored quantised in steps of
+//! [`LOG_ODDS_UNIT`] as one byte per cell: integer sums are exact, so the
+//! map is the same on every machine.
+//!
+//! ## Growth and origin bookkeeping
+//! Cells are addressed by *global* indices `(⌊x / r⌋, ⌊y / r⌋)` in the odometry
+//! frame. The grid stores a dense window of them and remembers the global
+//! index of its cell (0, 0), so its lower-left corner lies exactly at
+//! [`OccupancyGrid::origin_m`] = `origin_cell · r` and nothing drifts when
+//! it grows: before each scan it grows (in steps of [`GROW_STEP_CELLS`]) to
+//! cover the scan's reach, in whichever direction the robot explores.
+//!
+//! ## Bounded memory
+//! A grid never holds more than `max_cells` cells (4 Mi by default: one byte
+//! each, about 100 m × 100 m at 0.05 m). A growth that would exceed it does
+//! not happen: the grid keeps its size, updates that fall outside it are
+//! dropped (and counted in [`OccupancyGrid::dropped_updates`]), and the
+//! matcher keeps working on what is mapped.
+
+use crate::geom::Pose2;
+use crate::sensors::laser::beam_bearing;
+use crate::sensors::LaserScan;
+use glam::DVec2;
+
+/// Log-odds are stored as `i8` multiples of this.
+pub const LOG_ODDS_UNIT: f32 = 0.05;
+/// The grid grows in whole blocks of this many cells (amortises copies).
+pub const GROW_STEP_CELLS: i64 = 64;
+
+/// Settings of a grid and its beam model.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GridConfig {
+    pub resolution_m: f64,
+    /// Log-odds added to a cell where a beam ends on a surface (units of
+    /// [`LOG_ODDS_UNIT`]): 17 → 0.85, p ≈ 0.70 after one hit.
+    pub hit: i8,
+    /// Log-odds added to a cell a beam passes through: −8 → −0.4.
+    pub miss: i8,
+    /// Clamp range: −40 → −2.0 (p ≈ 0.12), 70 → 3.5 (p ≈ 0.97).
+    pub min: i8,
+    pub max: i8,
+    /// A beam that hits a surface clears nothing its last `hit_margin_m`
+    /// touches (see the module doc).
+    pub hit_margin_m: f64,
+    /// Most cells this grid may hold.
+    pub max_cells: usize,
+}
+
+impl Default for GridConfig {
+    fn default() -> Self {
+        GridConfig {
+            resolution_m: 0.05,
+            hit: 17,
+            miss: -8,
+            min: -40,
+            max: 70,
+            hit_margin_m: 0.1,
+            max_cells: 1 << 22,
+        }
+    }
+}
+
+/// What a cell is believed to be, with the ROS map_server thresholds
+/// (occupied above p = 0.65, free below p = 0.196).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CellState {
+    Unknown,
+    Free,
+    Occupied,
+}
+
+/// A log-odds occupancy grid in one robot's odometry frame.
+#[derive(Clone, Debug)]
+pub struct OccupancyGrid {
+    pub config: GridConfig,
+    cells: Vec<i8>,
+    width: usize,
+    height: usize,
+    /// Global index of local cell (0, 0).
+    origin_cell: [i64; 2],
+    dropped_updates: u64,
+    scans: u64,
+}
+
+/// Log-odds (in units) above which a cell is occupied: p > 0.65 ⇔ l > 0.619.
+const OCCUPIED_UNITS: i8 = 13;
+/// Below which it is free: p < 0.196 ⇔ l < −1.41.
+const FREE_UNITS: i8 = -28;
+
+impl OccupancyGrid {
+    /// An empty grid (no cells yet; it grows with the first scan).
+    pub fn new(config: GridConfig) -> OccupancyGrid {
+        OccupancyGrid {
+            config,
+            cells: Vec::new(),
+            width: 0,
+            height: 0,
+            origin_cell: [0, 0],
+            dropped_updates: 0,
+            scans: 0,
+        }
+    }
+
+    pub fn resolution_m(&self) -> f64 {
+        self.config.resolution_m
+    }
+    pub fn width(&self) -> usize {
+        self.width
+    }
+    pub fn height(&self) -> usize {
+        self.height
+    }
+    /// Global index of local cell (0, 0).
+    pub fn origin_cell(&self) -> [i64; 2] {
+        self.origin_cell
+    }
+    /// Where the lower-left corner of cell (0, 0) lies in the robot's
+    /// odometry frame (m).
+    pub fn origin_m(&self) -> DVec2 {
+        DVec2::new(self.origin_cell[0] as f64, self.origin_cell[1] as f64)
+            * self.config.resolution_m
+    }
+    /// Cell updates dropped because they fell outside a grid at its cap.
+    pub fn dropped_updates(&self) -> u64 {
+        self.dropped_updates
+    }
+    /// Scans integrated so far.
+    pub fn scans(&self) -> u64 {
+        self.scans
+    }
+    /// Bytes held by the cells.
+    pub fn memory_bytes(&self) -> usize {
+        self.cells.capacity()
+    }
+
+    /// Global cell index of a point of the odometry frame.
+    pub fn global_cell(&self, p: DVec2) -> [i64; 2] {
+        let r = self.config.resolution_m;
+        [(p.x / r).floor() as i64, (p.y / r).floor() as i64]
+    }
+
+    /// Local `(column, row)` of a global cell, if the grid holds it.
+    pub fn local(&self, g: [i64; 2]) -> Option<(usize, usize)> {
+        let x = g[0] - self.origin_cell[0];
+        let y = g[1] - self.origin_cell[1];
+        if x >= 0 && y >= 0 && (x as usize) < self.width && (y as usize) < self.height {
+            Some((x as usize, y as usize))
+        } else {
+            None
+        }
+    }
+
+    /// Centre of local cell `(ix, iy)` in the odometry frame.
+    pub fn cell_centre(&self, ix: usize, iy: usize) -> DVec2 {
+        self.origin_m() + (DVec2::new(ix as f64, iy as f64) + 0.5) * self.config.resolution_m
+    }
+
+    /// Log-odds of local cell `(ix, iy)` in stored units (0 = unknown).
+    /// # Panics
+    /// If the cell is outside the grid.
+    pub fn units(&self, ix: usize, iy: usize) -> i8 {
+        self.cells[iy * self.width + ix]
+    }
+
+    /// Log-odds of a global cell (0 outside the grid).
+    pub fn log_odds_global(&self, g: [i64; 2]) -> f32 {
+        self.local(g)
+            .map_or(0.0, |(x, y)| self.units(x, y) as f32 * LOG_ODDS_UNIT)
+    }
+
+    /// Probability of occupancy of local cell `(ix, iy)`.
+    pub fn probability(&self, ix: usize, iy: usize) -> f32 {
+        let l = self.units(ix, iy) as f32 * LOG_ODDS_UNIT;
+        1.0 - 1.0 / (1.0 + l.exp())
+    }
+
+    pub fn state(&self, ix: usize, iy: usize) -> CellState {
+        state_of(self.units(ix, iy))
+    }
+
+    /// All cells row by row (row 0 at the bottom, y up), stored units.
+    pub fn raw_units(&self) -> &[i8] {
+        &self.cells
+    }
+
+    /// Number of occupied cells.
+    pub fn occupied_count(&self) -> usize {
+        self.cells.iter().filter(|&&c| c > OCCUPIED_UNITS).count()
+    }
+
+    /// Grows the grid to cover the box `lo..hi` (odometry frame) plus
+    /// a margin. Returns false, changing nothing, if that would exceed
+    /// `max_cells`.
+    pub fn ensure_contains(&mut self, lo: DVec2, hi: DVec2) -> bool {
+        let (a, b) = (self.global_cell(lo), self.global_cell(hi));
+        let (x0, y0) = (self.origin_cell[0], self.origin_cell[1]);
+        let (x1, y1) = (x0 + self.width as i64, y0 + self.height as i64);
+        if self.width > 0 && a[0] >= x0 && a[1] >= y0 && b[0] < x1 && b[1] < y1 {
+            return true;
+        }
+        let snap_down = |v: i64| v.div_euclid(GROW_STEP_CELLS) * GROW_STEP_CELLS;
+        let snap_up = |v: i64| (v + GROW_STEP_CELLS).div_euclid(GROW_STEP_CELLS) * GROW_STEP_CELLS;
+        let (nx0, ny0, nx1, ny1) = if self.width == 0 {
+            (
+                snap_down(a[0]),
+                snap_down(a[1]),
+                snap_up(b[0]),
+                snap_up(b[1]),
+            )
+        } else {
+            (
+                x0.min(snap_down(a[0])),
+                y0.min(snap_down(a[1])),
+                x1.max(snap_up(b[0])),
+                y1.max(snap_up(b[1])),
+            )
+        };
+        let (nw, nh) = ((nx1 - nx0) as usize, (ny1 - ny0) as usize);
+        if nw.saturating_mul(nh) > self.config.max_cells {
+            return false;
+        }
+        let mut cells = vec![0i8; nw * nh];
+        let (dx, dy) = ((x0 - nx0) as usize, (y0 - ny0) as usize);
+        for row in 0..self.height {
+            let src = &self.cells[row * self.width..(row + 1) * self.width];
+            let start = (row + dy) * nw + dx;
+            cells[start..start + self.width].copy_from_slice(src);
+        }
+        self.cells = cells;
+        self.width = nw;
+        self.height = nh;
+        self.origin_cell = [nx0, ny0];
+        true
+    }
+
+    fn add(&mut self, g: [i64; 2], delta: i8) {
+        match self.local(g) {
+            Some((x, y)) => {
+                let c = &mut self.cells[y * self.width + x];
+                if delta < 0 && *c >= self.config.max {
+                    // A saturated wall is not cleared by a passing beam.
+                    return;
+                }
+                *c = (*c as i16 + delta as i16)
+                    .clamp(self.config.min as i16, self.config.max as i16)
+                    as i8;
+            }
+            None => self.dropped_updates += 1,
+        }
+    }
+
+    /// Integrates one beam from `from` to `to` (odometry frame). With `hit`,
+    /// the end cell is marked and every cell the beam crosses is cleared
+    /// except those its last `hit_margin_m` of length touches; without, every
+    /// cell up to and including the end cell is cleared and nothing marked.
+    pub fn integrate_beam(&mut self, from: DVec2, to: DVec2, hit: bool) {
+        let end = self.global_cell(to);
+        let (miss, occ) = (self.config.miss, self.config.hit);
+        let r = self.config.resolution_m;
+        if hit {
+            let len = (to - from).length();
+            let margin = self.config.hit_margin_m;
+            if len > margin {
+                let stop = from + (to - from) * ((len - margin) / len);
+                let last = self.global_cell(stop);
+                traverse(from / r, stop / r, |c| {
+                    if c != end && c != last {
+                        self.add(c, miss);
+                    }
+                });
+            }
+            self.add(end, occ);
+        } else {
+            traverse(from / r, to / r, |c| self.add(c, miss));
+        }
+    }
+
+    /// Integrates a whole scan taken at `pose` (odometry frame), growing the
+    /// grid to cover the scan's reach first.
+    pub fn integrate_scan(&mut self, pose: &Pose2, scan: &LaserScan) {
+        let reach = scan.range_max_m + 2.0 * self.config.resolution_m;
+        let c = pose.position();
+        self.ensure_contains(c - reach, c + reach);
+        for i in 0..scan.ranges_m.len() {
+            let a = pose.theta + beam_bearing(i);
+            let end = c + DVec2::new(a.cos(), a.sin()) * scan.ranges_m[i];
+            let hit = !scan.max_range[i] && !scan.reflective[i];
+            self.integrate_beam(c, end, hit);
+        }
+        self.scans += 1;
+    }
+}
+
+/// The state a stored log-odds value stands for.
+pub fn state_of(units: i8) -> CellState {
+    if units > OCCUPIED_UNITS {
+        CellState::Occupied
+    } else if units < FREE_UNITS {
+        CellState::Free
+    } else {
+        // Never seen (0), or seen but not yet decided either way.
+        CellState::Unknown
+    }
+}
+
+/// Amanatides–Woo traversal of the cells (unit-sized, in cell coordinates)
+/// the segment `a → b` passes through, from `a`'s cell to `b`'s cell
+/// inclusive, each once.
+pub fn traverse(a: DVec2, b: DVec2, mut visit: impl FnMut([i64; 2])) {
+    let mut cell = [a.x.floor() as i64, a.y.floor() as i64];
+    let end = [b.x.floor() as i64, b.y.floor() as i64];
+    let d = b - a;
+    let step = [
+        if d.x > 0.0 { 1 } else { -1 },
+        if d.y > 0.0 { 1 } else { -1 },
+    ];
+    let t_delta = [
+        if d.x != 0.0 {
+            1.0 / d.x.abs()
+        } else {
+            f64::INFINITY
+        },
+        if d.y != 0.0 {
+            1.0 / d.y.abs()
+        } else {
+            f64::INFINITY
+        },
+    ];
+    let boundary = |p: f64, c: i64, s: i64| {
+        if s > 0 {
+            (c + 1) as f64 - p
+        } else {
+            p - c as f64
+        }
+    };
+    let mut t_max = [
+        if d.x != 0.0 {
+            boundary(a.x, cell[0], step[0]) * t_delta[0]
+        } else {
+            f64::INFINITY
+        },
+        if d.y != 0.0 {
+            boundary(a.y, cell[1], step[1]) * t_delta[1]
+        } else {
+            f64::INFINITY
+        },
+    ];
+    // At most |Δx| + |Δy| cell steps; the bound also guards rounding.
+    let n = (end[0] - cell[0]).abs() + (end[1] - cell[1]).abs();
+    visit(cell);
+    for _ in 0..n {
+        if t_max[0] < t_max[1] {
+            cell[0] += step[0];
+            t_max[0] += t_delta[0];
+        } else {
+            cell[1] += step[1];
+            t_max[1] += t_delta[1];
+        }
+        visit(cell);
+        if cell == end {
+            break;
+        }
+    }
+}

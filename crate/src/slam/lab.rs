@@ -1,0 +1,263 @@
+//! # What the page and the CLI ask of a robot's maps
+//!
+//! A separate `impl Lab` block (the session object lives in
+//! [`crate::lab`]) built on its public accessors: a robot's map as ROS
+//! files or as a picture, its metadata, and the figures that score it.
+//! Scoring reads the truth, as display and scoring may; the mappers never do.
+
+use super::export::{to_pgm, to_png, to_yaml};
+use super::grid::{CellState, OccupancyGrid};
+use super::mapper::{MapperKind, RobotMapping};
+use super::scoring::{ate_m, map_accuracy, position_errors_m};
+use crate::lab::Lab;
+use crate::sim::{RobotSim, Simulation};
+use serde::Serialize;
+
+/// The figures of one robot's two mappers (the report's `robots[].slam`).
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct SlamFigures {
+    /// ATE of the SLAM poses (m).
+    pub ate_m: f64,
+    /// ATE of the raw odometry (m).
+    pub odometry_ate_m: f64,
+    /// Position error at the last step (m).
+    pub final_error_m: f64,
+    pub odometry_final_error_m: f64,
+    /// Share of the SLAM map's occupied cells within 0.15 m of a true wall.
+    pub occupied_precision: f64,
+    pub odometry_occupied_precision: f64,
+    /// Share of true wall length the SLAM map shows.
+    pub wall_coverage: f64,
+    pub odometry_wall_coverage: f64,
+    pub occupied_cells: usize,
+    /// Steps matched fully, across a corridor only, or left to odometry.
+    pub matched_steps: usize,
+    pub degenerate_steps: usize,
+    pub odometry_only_steps: usize,
+    /// Cells of the SLAM grid and their bytes.
+    pub map_width: usize,
+    pub map_height: usize,
+    pub map_bytes: usize,
+}
+
+fn r6(x: f64) -> f64 {
+    (x * 1e6).round() / 1e6
+}
+
+/// Scores one robot of a simulation.
+pub fn figures(sim: &Simulation, robot: &RobotSim) -> SlamFigures {
+    let start = robot.spec.start_pose();
+    let m: &RobotMapping = &robot.mapping;
+    let truth = &robot.log.truth;
+    let est = m.estimates();
+    let slam = map_accuracy(&m.slam_map, &start, &sim.world);
+    let odo = map_accuracy(&m.odometry_map, &start, &sim.world);
+    let last_err = |poses: &[crate::geom::Pose2]| {
+        let n = poses.len().min(truth.len());
+        if n == 0 {
+            0.0
+        } else {
+            (start.compose(&poses[n - 1]).position() - truth[n - 1].position()).length()
+        }
+    };
+    SlamFigures {
+        ate_m: r6(ate_m(&start, est, truth)),
+        odometry_ate_m: r6(ate_m(&start, &robot.log.odometry, truth)),
+        final_error_m: r6(last_err(est)),
+        odometry_final_error_m: r6(last_err(&robot.log.odometry)),
+        occupied_precision: r6(slam.occupied_precision),
+        odometry_occupied_precision: r6(odo.occupied_precision),
+        wall_coverage: r6(slam.wall_coverage),
+        odometry_wall_coverage: r6(odo.wall_coverage),
+        occupied_cells: slam.occupied_cells,
+        matched_steps: m.counts.matched,
+        degenerate_steps: m.counts.degenerate,
+        odometry_only_steps: m.counts.odometry_only,
+        map_width: m.slam_map.width(),
+        map_height: m.slam_map.height(),
+        map_bytes: m.slam_map.memory_bytes(),
+    }
+}
+
+/// Map metadata for the page.
+#[derive(Serialize)]
+pub struct MapInfo {
+    pub width: usize,
+    pub height: usize,
+    pub resolution_m: f64,
+    /// Lower-left corner of cell (0, 0) in the robot's odometry frame.
+    pub origin_m: [f64; 2],
+    pub occupied_cells: usize,
+    pub scans: u64,
+    pub dropped_updates: u64,
+}
+
+/// Position error over time for the page's plot: every `stride`-th step,
+/// `[t, slam_error_m, odometry_error_m]`.
+#[derive(Serialize)]
+pub struct ErrorSeries {
+    pub rows: Vec<[f64; 3]>,
+}
+
+impl Lab {
+    fn robot_sim(&self, robot: usize) -> Result<(&Simulation, &RobotSim), String> {
+        let sim = self
+            .simulation()
+            .ok_or("nothing has run yet: run the scenario first")?;
+        let r = sim
+            .robots
+            .get(robot)
+            .ok_or_else(|| format!("no robot with index {robot}"))?;
+        Ok((sim, r))
+    }
+
+    /// One robot's map (`which` = slam or odometry).
+    pub fn robot_map(&self, robot: usize, which: MapperKind) -> Result<&OccupancyGrid, String> {
+        Ok(self.robot_sim(robot)?.1.mapping.map(which))
+    }
+
+    /// Index of the robot called `name`.
+    pub fn robot_index(&self, name: &str) -> Result<usize, String> {
+        self.scenario()
+            .robots
+            .iter()
+            .position(|r| r.name == name)
+            .ok_or_else(|| format!("robot: no robot named '{name}'"))
+    }
+
+    pub fn map_pgm(&self, robot: usize, which: MapperKind) -> Result<Vec<u8>, String> {
+        Ok(to_pgm(self.robot_map(robot, which)?))
+    }
+
+    pub fn map_png(&self, robot: usize, which: MapperKind) -> Result<Vec<u8>, String> {
+        to_png(self.robot_map(robot, which)?)
+    }
+
+    pub fn map_yaml(&self, robot: usize, which: MapperKind, image: &str) -> Result<String, String> {
+        Ok(to_yaml(self.robot_map(robot, which)?, image))
+    }
+
+    pub fn map_info(&self, robot: usize, which: MapperKind) -> Result<MapInfo, String> {
+        let g = self.robot_map(robot, which)?;
+        let o = g.origin_m();
+        Ok(MapInfo {
+            width: g.width(),
+            height: g.height(),
+            resolution_m: g.resolution_m(),
+            origin_m: [o.x, o.y],
+            occupied_cells: g.occupied_count(),
+            scans: g.scans(),
+            dropped_updates: g.dropped_updates(),
+        })
+    }
+
+    pub fn slam_figures(&self, robot: usize) -> Result<SlamFigures, String> {
+        let (sim, r) = self.robot_sim(robot)?;
+        Ok(figures(sim, r))
+    }
+
+    /// Position errors over time, at most about `max_rows` rows.
+    pub fn slam_errors(&self, robot: usize, max_rows: usize) -> Result<ErrorSeries, String> {
+        let (_, r) = self.robot_sim(robot)?;
+        let start = r.spec.start_pose();
+        let e = position_errors_m(&start, r.mapping.estimates(), &r.log.truth);
+        let o = position_errors_m(&start, &r.log.odometry, &r.log.truth);
+        let n = e.len().min(o.len()).min(r.log.times_s.len());
+        let stride = n.div_ceil(max_rows.max(1)).max(1);
+        let rows = (0..n)
+            .step_by(stride)
+            .map(|k| [r.log.times_s[k], r6(e[k]), r6(o[k])])
+            .collect();
+        Ok(ErrorSeries { rows })
+    }
+
+    /// Draws one robot's map as RGBA pixels (`width × height`, straight
+    /// alpha, opaque), fitted to the image, with the SLAM (or odometry)
+    /// path and the true path (drawn in the odometry frame) on top.
+    pub fn map_rgba(
+        &self,
+        robot: usize,
+        which: MapperKind,
+        width: u32,
+        height: u32,
+    ) -> Result<Vec<u8>, String> {
+        use tiny_skia::{Color, Paint, PathBuilder, Pixmap, Stroke, Transform};
+        let (_, r) = self.robot_sim(robot)?;
+        let g = r.mapping.map(which);
+        let mut pm = Pixmap::new(width, height)
+            .ok_or_else(|| format!("cannot make a {width}x{height} image"))?;
+        pm.fill(Color::from_rgba8(205, 205, 205, 255));
+        if g.width() == 0 {
+            return Ok(pm.take());
+        }
+        // Fit the grid to the image, y up.
+        let scale = (width as f64 / g.width() as f64).min(height as f64 / g.height() as f64);
+        let ox = (width as f64 - scale * g.width() as f64) / 2.0;
+        let oy = (height as f64 - scale * g.height() as f64) / 2.0;
+        let data = pm.data_mut();
+        for py in 0..height as usize {
+            let gy = ((height as f64 - 0.5 - py as f64 - oy) / scale).floor();
+            if gy < 0.0 || gy >= g.height() as f64 {
+                continue;
+            }
+            for px in 0..width as usize {
+                let gx = ((px as f64 + 0.5 - ox) / scale).floor();
+                if gx < 0.0 || gx >= g.width() as f64 {
+                    continue;
+                }
+                let v = match g.state(gx as usize, gy as usize) {
+                    CellState::Free => 250,
+                    CellState::Occupied => 30,
+                    CellState::Unknown => 205,
+                };
+                let i = (py * width as usize + px) * 4;
+                data[i..i + 3].fill(v);
+            }
+        }
+        let origin = g.origin_m();
+        let res = g.resolution_m();
+        let to_px = |p: glam::DVec2| {
+            let u = (p - origin) / res;
+            (
+                (ox + u.x * scale) as f32,
+                (height as f64 - oy - u.y * scale) as f32,
+            )
+        };
+        let inv_start = r.spec.start_pose().inverse();
+        let truth: Vec<_> = r.log.truth.iter().map(|t| inv_start.compose(t)).collect();
+        let est: &[crate::geom::Pose2] = match which {
+            MapperKind::Slam => r.mapping.estimates(),
+            MapperKind::Odometry => &r.log.odometry,
+        };
+        for (poses, rgb, w) in [
+            (&truth[..], (40u8, 160u8, 60u8), 1.5f32),
+            (est, (200, 40, 40), 1.5),
+        ] {
+            let mut pb = PathBuilder::new();
+            let stride = (poses.len() / 2000).max(1);
+            for (k, p) in poses.iter().step_by(stride).enumerate() {
+                let (x, y) = to_px(p.position());
+                if k == 0 {
+                    pb.move_to(x, y);
+                } else {
+                    pb.line_to(x, y);
+                }
+            }
+            if let Some(last) = poses.last() {
+                let (x, y) = to_px(last.position());
+                pb.line_to(x, y);
+            }
+            if let Some(path) = pb.finish() {
+                let mut paint = Paint::default();
+                paint.set_color_rgba8(rgb.0, rgb.1, rgb.2, 255);
+                paint.anti_alias = true;
+                let stroke = Stroke {
+                    width: w,
+                    ..Stroke::default()
+                };
+                pm.stroke_path(&path, &paint, &stroke, Transform::identity(), None);
+            }
+        }
+        Ok(pm.take())
+    }
+}

@@ -1,0 +1,33 @@
+//! # SLAM: each robot maps in its own frame, and scan matching beats drift
+//!
+//! The thesis (Chapter 4) defines SLAM as recovering the path `X_T` and the
+//! map `M` from odometry `U_T` and observations `Z_T`, then maps at raw
+//! odometry poses; its Chapter 7 names the resulting noise as the first
+//! problem left open. This module does both, side by side, per robot:
+//!
+//! | stage | file | follows |
+//! |---|---|---|
+//! | log-odds occupancy grid, beam model, growth | [`grid`] | Thrun et al., *Probabilistic Robotics* §9.2 |
+//! | smoothed map for matching | [`likelihood`] | Olson 2009 §III-B; Hector SLAM §IV-A |
+//! | multi-resolution correlative search | [`correlative`] | Olson, ICRA 2009 |
+//! | Gauss–Newton refinement | [`gauss_newton`] | Kohlbrecher et al., SSRR 2011 |
+//! | corridor degeneracy guard | [`degeneracy`] | Zhang, Kaess, Singh, ICRA 2016 |
+//! | the two mappers, online | [`mapper`] | thesis §4.3 (online SLAM) |
+//! | scoring against ground truth | [`scoring`] | Sturm et al., IROS 2012 (ATE) |
+//! | drawing and ROS map export | [`export`] | ROS `map_server` format |
+//!
+//! The simulation feeds every robot's [`RobotMapping`] once per step with
+//! the odometry pose and the laser scan (never the truth).
+
+pub mod correlative;
+pub mod degeneracy;
+pub mod export;
+pub mod gauss_newton;
+pub mod grid;
+pub mod lab;
+pub mod likelihood;
+pub mod mapper;
+pub mod scoring;
+
+pub use grid::{CellState, GridConfig, OccupancyGrid};
+pub use mapper::{MapperKind, MatchStatus, RobotMapping, SlamConfig};

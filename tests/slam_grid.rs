@@ -1,0 +1,168 @@
+//! The occupancy grid: the beam model on hand-computed cases, origin
+//! bookkeeping as the grid grows, and the memory cap.
+
+use glam::DVec2;
+use slamlab::geom::Pose2;
+use slamlab::slam::export::{to_pgm, to_yaml};
+use slamlab::slam::grid::{traverse, CellState, GridConfig, OccupancyGrid, LOG_ODDS_UNIT};
+use wasm_bindgen_test::wasm_bindgen_test;
+
+fn grid() -> OccupancyGrid {
+    let mut g = OccupancyGrid::new(GridConfig::default());
+    assert!(g.ensure_contains(DVec2::new(-1.0, -1.0), DVec2::new(1.0, 1.0)));
+    g
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn traversal_visits_each_crossed_cell_once_in_order() {
+    let mut v = Vec::new();
+    traverse(DVec2::new(0.5, 0.5), DVec2::new(3.5, 1.2), |c| v.push(c));
+    // Slope 0.7/3 from (0.5, 0.5): crosses x = 1, x = 2, then y = 1 at x ≈ 2.64, then x = 3.
+    assert_eq!(v, vec![[0, 0], [1, 0], [2, 0], [2, 1], [3, 1]]);
+    v.clear();
+    traverse(DVec2::new(0.5, 0.5), DVec2::new(-1.5, 0.5), |c| v.push(c));
+    assert_eq!(v, vec![[0, 0], [-1, 0], [-2, 0]]);
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn a_hit_clears_before_the_margin_and_marks_the_end_cell() {
+    let mut g = grid();
+    let cfg = g.config.clone();
+    // From the centre of cell (0, 0) along +x for 0.5 m: the end (0.525) is in cell 10;
+    // the last 0.1 m (0.425..0.525) touches cells 8, 9, 10, so cells 0..=7 are cleared.
+    g.integrate_beam(DVec2::new(0.025, 0.025), DVec2::new(0.525, 0.025), true);
+    for x in 0..=7 {
+        assert_eq!(
+            g.log_odds_global([x, 0]),
+            cfg.miss as f32 * LOG_ODDS_UNIT,
+            "cell {x}"
+        );
+    }
+    assert_eq!(g.log_odds_global([8, 0]), 0.0);
+    assert_eq!(g.log_odds_global([9, 0]), 0.0);
+    assert_eq!(g.log_odds_global([10, 0]), cfg.hit as f32 * LOG_ODDS_UNIT);
+    assert_eq!(g.log_odds_global([11, 0]), 0.0);
+    assert_eq!(g.log_odds_global([0, 1]), 0.0, "the beam stays in its row");
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn a_max_range_or_reflective_beam_clears_without_marking() {
+    let mut g = grid();
+    g.integrate_beam(DVec2::new(0.025, 0.025), DVec2::new(0.025, 0.525), false);
+    for y in 0..=10 {
+        assert!(g.log_odds_global([0, y]) < 0.0, "cell (0, {y}) cleared");
+    }
+    assert_eq!(g.log_odds_global([0, 11]), 0.0);
+    assert_eq!(g.occupied_count(), 0);
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn log_odds_are_clamped_and_saturated_walls_survive_passing_beams() {
+    let mut g = grid();
+    let (lo, hi) = (
+        g.config.min as f32 * LOG_ODDS_UNIT,
+        g.config.max as f32 * LOG_ODDS_UNIT,
+    );
+    for _ in 0..50 {
+        g.integrate_beam(DVec2::new(0.025, 0.025), DVec2::new(0.525, 0.025), true);
+    }
+    assert_eq!(g.log_odds_global([10, 0]), hi);
+    assert_eq!(g.log_odds_global([3, 0]), lo);
+    assert_eq!(
+        g.state(g.local([10, 0]).unwrap().0, g.local([10, 0]).unwrap().1),
+        CellState::Occupied
+    );
+    // A beam passing through the saturated wall cell does not lower it.
+    g.integrate_beam(DVec2::new(0.025, 0.025), DVec2::new(0.925, 0.025), true);
+    assert_eq!(g.log_odds_global([10, 0]), hi);
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn the_origin_stays_right_as_the_grid_grows_in_every_direction() {
+    let mut g = OccupancyGrid::new(GridConfig::default());
+    let r = g.resolution_m();
+    // Mark a cell, then grow the grid west, south, east and north in turn:
+    // the mark stays at the same place of the odometry frame.
+    let p = DVec2::new(0.33, -0.12);
+    g.ensure_contains(p, p);
+    g.integrate_beam(p - DVec2::new(0.2, 0.0), p, true);
+    let expected = g.global_cell(p);
+    for (lo, hi) in [
+        (DVec2::new(-30.0, -0.1), DVec2::new(0.0, 0.0)),
+        (DVec2::new(0.0, -25.0), DVec2::new(0.1, 0.0)),
+        (DVec2::new(0.0, 0.0), DVec2::new(41.0, 0.1)),
+        (DVec2::new(0.0, 0.0), DVec2::new(0.1, 17.0)),
+    ] {
+        assert!(g.ensure_contains(lo, hi));
+        let (ix, iy) = g.local(expected).expect("mark still inside");
+        assert_eq!(g.state(ix, iy), CellState::Occupied);
+        // The cell's centre, through the origin, is where the mark was made.
+        let c = g.cell_centre(ix, iy);
+        assert!(
+            (c - p).abs().max_element() <= r / 2.0 + 1e-12,
+            "{c:?} vs {p:?}"
+        );
+        assert_eq!(g.occupied_count(), 1);
+        // The origin is the lower-left corner of cell (0, 0), and covers the box.
+        let o = g.origin_m();
+        assert!(o.x <= lo.x && o.y <= lo.y);
+        assert!(o.x + g.width() as f64 * r > hi.x && o.y + g.height() as f64 * r > hi.y);
+    }
+    assert!(g.origin_m().x <= -30.0 && g.origin_m().y <= -25.0);
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn growth_beyond_the_cap_is_refused_and_updates_outside_are_counted() {
+    let mut g = OccupancyGrid::new(GridConfig {
+        max_cells: 200 * 200,
+        ..GridConfig::default()
+    });
+    assert!(g.ensure_contains(DVec2::ZERO, DVec2::new(5.0, 5.0)));
+    let (w, h) = (g.width(), g.height());
+    assert!(!g.ensure_contains(DVec2::ZERO, DVec2::new(50.0, 5.0)));
+    assert_eq!((g.width(), g.height()), (w, h));
+    let before = g.dropped_updates();
+    g.integrate_beam(DVec2::new(1.0, 1.0), DVec2::new(30.0, 1.0), true);
+    assert!(g.dropped_updates() > before);
+    assert!(g.memory_bytes() <= 200 * 200);
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn ros_export_has_the_map_server_layout() {
+    let mut g = OccupancyGrid::new(GridConfig::default());
+    let pose = Pose2::IDENTITY;
+    g.ensure_contains(DVec2::new(-0.5, -0.5), DVec2::new(0.5, 0.5));
+    for _ in 0..5 {
+        g.integrate_beam(pose.position() + 0.01, DVec2::new(0.301, 0.01), true);
+    }
+    let pgm = to_pgm(&g);
+    let header = format!(
+        "P5\n# slamlab occupancy grid, 0.05 m/cell\n{} {}\n255\n",
+        g.width(),
+        g.height()
+    );
+    assert!(pgm.starts_with(header.as_bytes()));
+    let px = &pgm[header.len()..];
+    assert_eq!(px.len(), g.width() * g.height());
+    // The wall cell (6, 0): row 0 of the image is the top of the map.
+    let (ix, iy) = g.local([6, 0]).unwrap();
+    assert_eq!(px[(g.height() - 1 - iy) * g.width() + ix], 0);
+    let (fx, fy) = g.local([2, 0]).unwrap();
+    assert_eq!(px[(g.height() - 1 - fy) * g.width() + fx], 254);
+    assert_eq!(px[0], 205);
+    let yaml = to_yaml(&g, "map.pgm");
+    let o = g.origin_m();
+    assert!(
+        yaml.contains(&format!("origin: [{}, {}, 0.0]", o.x, o.y)),
+        "{yaml}"
+    );
+    for line in [
+        "image: \"map.pgm\"",
+        "resolution: 0.05",
+        "negate: 0",
+        "occupied_thresh: 0.65",
+        "free_thresh: 0.196",
+    ] {
+        assert!(yaml.contains(line), "{line} in {yaml}");
+    }
+}
