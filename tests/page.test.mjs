@@ -182,6 +182,23 @@ test('the lab page: edit, run, step, read sensors, reset, autosave, corrupt save
   const modes = await page.$$eval('.robot-card .readout .mode', (els) => els.map((e) => e.textContent));
   assert.ok(modes.every((m) => m && m !== 'not started' && m !== '–'), `modes: ${modes}`);
 
+  // Cameras: a film strip per robot with a frame per simulated second
+  // (t = 0, 1, ..., so floor(t) + 1 of them); clicking one shows it.
+  await page.waitForFunction(
+    (n) => [...document.querySelectorAll('.cam-strip')].every((st) => st.querySelectorAll('.cam-thumb').length === n),
+    Math.floor(stepped.time_s) + 1,
+  );
+  await page.locator('.cam-block').first().locator('.cam-thumb').nth(2).click();
+  assert.match(await page.locator('.cam-block').first().locator('.cam-what').innerText(), /frame 2 · t = 2\.0 s/);
+  await page.locator('.cam-block').first().getByRole('button', { name: /live camera view/ }).click();
+
+  // Maps: each robot's map with SLAM and odometry figures.
+  await page.waitForFunction(() => document.querySelectorAll('.map-block:not([hidden]) .map-figures b').length === 2);
+  const figures = await page.$$eval('.map-figures', (els) => els.map((e) => e.textContent));
+  for (const f of figures) assert.match(f, /SLAM \d+\.\d\d m · odometry \d+\.\d\d m/);
+  await page.getByLabel('odometry only (thesis)').check();
+  await page.waitForTimeout(100);
+
   await page.screenshot({ path: path.join(ARTIFACTS, 'page.png') });
   await page.setViewportSize({ width: 1600, height: 900 });
   await page.waitForTimeout(150);

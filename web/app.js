@@ -33,6 +33,7 @@ import {
 } from './geometry.js';
 import { RobotsPanel, robotColour, setRobotColours } from './robots-panel.js';
 import { CameraPanel } from './camera-panel.js';
+import { MapsPanel } from './maps-panel.js';
 
 const STORAGE_KEY = 'slamlab.scenario.v1';
 const LAYERS_KEY = 'slamlab.layers.v1';
@@ -592,9 +593,17 @@ const cameraPanel = new CameraPanel($('cameras'), {
   onError: (e) => setStatus(message(e), 'error'),
 });
 
+// Each robot's map, SLAM or odometry-only (web/maps-panel.js).
+const mapsPanel = new MapsPanel($('maps'), {
+  lab: () => app.lab,
+  onError: (e) => setStatus(message(e), 'error'),
+  download: (name, data, type) => download(name, data, type),
+});
+
 function refreshPanels() {
   if (!app.scenario) return;
   cameraPanel.sync(app.scenario);
+  mapsPanel.sync(app.scenario);
   const ed = editable();
   robotsPanel.sonarRange = app.scenario.sensors?.sonar_range_m ?? 2;
   robotsPanel.sync(app.scenario, {
@@ -1435,6 +1444,7 @@ function frame(now) {
     const changed = app.dirty;
     if (app.dirty) draw();
     cameraPanel.update(now, changed || app.running);
+    mapsPanel.update(now, changed || app.running);
     if (app.running) updateReadouts(false);
   } catch (e) {
     app.running = false;

@@ -1,0 +1,190 @@
+// Each robot's own map, in its own odometry frame, as it grows.
+//
+// Two mappers run side by side for every robot (crate/src/slam): the
+// thesis's mapping at raw odometry poses, and SLAM, which corrects each pose
+// by matching the scan against the map. The switch shows either; the small
+// plot shows both robots' position error over time for both mappers (against
+// the ground truth, which the mappers never see).
+
+import { robotColour } from './robots-panel.js';
+
+const REFRESH_MS = 500;
+const MAP_W = 300;
+const MAP_H = 210;
+
+export class MapsPanel {
+  /**
+   * @param {HTMLElement} host
+   * @param {{lab: () => any, scenario: () => any, onError: (e: unknown) => void,
+   *          download: (name: string, data: BlobPart, type: string) => void}} hooks
+   */
+  constructor(host, hooks) {
+    this.host = host;
+    this.hooks = hooks;
+    this.mapper = 'slam';
+    this.key = '';
+    this.lastMs = 0;
+    this.blocks = [];
+  }
+
+  sync(scenario) {
+    const key = JSON.stringify(scenario.robots.map((r) => r.name));
+    if (key === this.key) return;
+    this.key = key;
+    this.host.replaceChildren();
+    const bar = document.createElement('div');
+    bar.className = 'map-switch';
+    bar.setAttribute('role', 'radiogroup');
+    bar.setAttribute('aria-label', 'Which map to show');
+    for (const [value, text] of [['slam', 'SLAM (scan matching)'], ['odometry', 'odometry only (thesis)']]) {
+      const label = document.createElement('label');
+      const input = document.createElement('input');
+      input.type = 'radio';
+      input.name = 'mapper';
+      input.value = value;
+      input.checked = value === this.mapper;
+      input.addEventListener('change', () => {
+        this.mapper = value;
+        this.refresh(true);
+      });
+      label.append(input, ` ${text}`);
+      bar.append(label);
+    }
+    const note = document.createElement('p');
+    note.className = 'hint';
+    note.textContent =
+      'Each robot maps in its own frame (its start is the origin). Dark: wall, light: free, grey: unknown; ' +
+      'red: where the robot thinks it went, green: where it went.';
+    this.empty = document.createElement('p');
+    this.empty.className = 'hint';
+    this.empty.textContent = 'The maps grow here while the robots run.';
+    this.host.append(bar, note, this.empty);
+    this.blocks = scenario.robots.map((r, i) => this.makeBlock(r.name, i));
+    this.refresh(true);
+  }
+
+  makeBlock(name, i) {
+    const el = document.createElement('div');
+    el.className = 'map-block';
+    el.style.setProperty('--robot', robotColour(i));
+    el.hidden = true;
+    const title = document.createElement('div');
+    title.className = 'map-title';
+    title.textContent = `${name}'s map`;
+    const canvas = document.createElement('canvas');
+    canvas.className = 'map-view';
+    canvas.width = MAP_W;
+    canvas.height = MAP_H;
+    canvas.setAttribute('role', 'img');
+    canvas.setAttribute('aria-label', `${name}'s occupancy grid`);
+    const figures = document.createElement('div');
+    figures.className = 'map-figures';
+    const plot = document.createElement('canvas');
+    plot.className = 'map-plot';
+    plot.width = MAP_W;
+    plot.height = 70;
+    plot.setAttribute('role', 'img');
+    plot.setAttribute('aria-label', `${name}'s position error over time`);
+    const links = document.createElement('div');
+    links.className = 'map-links';
+    const pgm = document.createElement('button');
+    pgm.type = 'button';
+    pgm.textContent = 'Download map (PGM + YAML)';
+    pgm.addEventListener('click', () => this.downloadPgm(i, name));
+    const png = document.createElement('button');
+    png.type = 'button';
+    png.textContent = 'PNG';
+    png.setAttribute('aria-label', `Download ${name}'s map as PNG`);
+    png.addEventListener('click', () => this.downloadPng(i, name));
+    links.append(pgm, png);
+    el.append(title, canvas, figures, plot, links);
+    this.host.append(el);
+    return { el, ctx: canvas.getContext('2d'), figures, plot, robot: i, name };
+  }
+
+  update(nowMs, changed) {
+    if (changed && nowMs - this.lastMs >= REFRESH_MS) {
+      this.lastMs = nowMs;
+      this.refresh(false);
+    }
+  }
+
+  refresh() {
+    const lab = this.hooks.lab();
+    if (!lab || !this.blocks.length) return;
+    const started = lab.timeS() > 0;
+    this.empty.hidden = started;
+    try {
+      for (const b of this.blocks) {
+        b.el.hidden = !started;
+        if (!started) continue;
+        lab.drawMap(b.ctx, b.robot, this.mapper, MAP_W, MAP_H);
+        const f = JSON.parse(lab.slamFiguresJson(b.robot));
+        const pct = (x) => `${(100 * x).toFixed(0)} %`;
+        b.figures.innerHTML =
+          `<span>position error (ATE): <b>SLAM ${f.ate_m.toFixed(2)} m</b> · odometry ${f.odometry_ate_m.toFixed(2)} m</span>` +
+          `<span>cells on a real wall: SLAM ${pct(f.occupied_precision)} · odometry ${pct(f.odometry_occupied_precision)}</span>`;
+        this.plot(b, JSON.parse(lab.slamErrorsJson(b.robot, 150)).rows);
+      }
+    } catch (e) {
+      this.hooks.onError(e);
+    }
+  }
+
+  /** Position error over time: SLAM solid, odometry dashed. */
+  plot(b, rows) {
+    const c = b.plot.getContext('2d');
+    const { width: w, height: h } = b.plot;
+    c.clearRect(0, 0, w, h);
+    c.fillStyle = '#fff';
+    c.fillRect(0, 0, w, h);
+    if (rows.length < 2) return;
+    const tMax = rows[rows.length - 1][0] || 1;
+    const eMax = Math.max(0.1, ...rows.map((r) => Math.max(r[1], r[2])));
+    const x = (t) => 30 + ((w - 36) * t) / tMax;
+    const y = (e) => h - 12 - ((h - 20) * e) / eMax;
+    c.strokeStyle = '#ccc';
+    c.beginPath();
+    c.moveTo(30, y(0));
+    c.lineTo(w - 6, y(0));
+    c.stroke();
+    c.fillStyle = '#555';
+    c.font = '10px sans-serif';
+    c.fillText(`${eMax.toFixed(1)} m`, 0, 10);
+    c.fillText('0', 18, y(0) + 3);
+    c.fillText(`${tMax.toFixed(0)} s`, w - 30, h - 1);
+    for (const [k, dash] of [[2, [4, 3]], [1, []]]) {
+      c.setLineDash(dash);
+      c.strokeStyle = k === 1 ? '#c0392b' : '#7f6a5a';
+      c.beginPath();
+      rows.forEach((r, i) => (i ? c.lineTo(x(r[0]), y(r[k])) : c.moveTo(x(r[0]), y(r[k]))));
+      c.stroke();
+    }
+    c.setLineDash([]);
+    c.fillStyle = '#c0392b';
+    c.fillText('SLAM', 40, 10);
+    c.fillStyle = '#7f6a5a';
+    c.fillText('- - odometry', 74, 10);
+  }
+
+  downloadPgm(i, name) {
+    const lab = this.hooks.lab();
+    try {
+      const base = `${name.replace(/[^\w.-]+/g, '_')}_${this.mapper}`;
+      this.hooks.download(`${base}.pgm`, lab.mapPgm(i, this.mapper), 'image/x-portable-graymap');
+      this.hooks.download(`${base}.yaml`, lab.mapYaml(i, this.mapper, `${base}.pgm`), 'text/yaml');
+    } catch (e) {
+      this.hooks.onError(e);
+    }
+  }
+
+  downloadPng(i, name) {
+    const lab = this.hooks.lab();
+    try {
+      const base = `${name.replace(/[^\w.-]+/g, '_')}_${this.mapper}`;
+      this.hooks.download(`${base}.png`, lab.mapPng(i, this.mapper), 'image/png');
+    } catch (e) {
+      this.hooks.onError(e);
+    }
+  }
+}
