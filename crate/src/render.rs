@@ -140,29 +140,20 @@ impl RenderOptions {
     }
 }
 
-/// FNV-1a: a stable hash of a texture name for its hint colour.
-fn name_hash(s: &str) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for b in s.bytes() {
-        h ^= b as u64;
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    h
-}
-
 /// The hint colour for a wall's texture (a muted hue from the name; plain
 /// walls are grey).
 pub fn texture_hint(name: Option<&str>, wall_index: usize, seed: u64) -> [u8; 3] {
     let key = match name {
         Some("plain") => return [150, 150, 150],
-        Some(n) => name_hash(n),
-        None => name_hash(&format!("wall#{wall_index}/{seed}")),
+        Some(n) => crate::camera::texture::name_hash(n),
+        None => crate::camera::texture::name_hash(&format!("wall#{wall_index}/{seed}")),
     };
     let hue = (key % 360) as f64;
     hsl_to_rgb(hue, 0.45, 0.45)
 }
 
-fn hsl_to_rgb(h: f64, s: f64, l: f64) -> [u8; 3] {
+/// HSL (hue in degrees, saturation and lightness in 0..1) to 8-bit RGB.
+pub fn hsl_to_rgb(h: f64, s: f64, l: f64) -> [u8; 3] {
     let c = (1.0 - (2.0 * l - 1.0).abs()) * s;
     let hp = h / 60.0;
     let x = c * (1.0 - (hp % 2.0 - 1.0).abs());

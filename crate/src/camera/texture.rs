@@ -180,23 +180,7 @@ fn colour(rng: &mut Rng, base_hue: f64, spread: f64) -> [u8; 3] {
     let h = (base_hue + rng.range(-spread, spread)).rem_euclid(360.0);
     let s = rng.range(0.25, 0.85);
     let l = rng.range(0.12, 0.88);
-    let c = (1.0 - (2.0 * l - 1.0f64).abs()) * s;
-    let hp = h / 60.0;
-    let x = c * (1.0 - (hp % 2.0 - 1.0).abs());
-    let (r, g, b) = match hp as u32 {
-        0 => (c, x, 0.0),
-        1 => (x, c, 0.0),
-        2 => (0.0, c, x),
-        3 => (0.0, x, c),
-        4 => (x, 0.0, c),
-        _ => (c, 0.0, x),
-    };
-    let m = l - c / 2.0;
-    [
-        ((r + m) * 255.0) as u8,
-        ((g + m) * 255.0) as u8,
-        ((b + m) * 255.0) as u8,
-    ]
+    crate::render::hsl_to_rgb(h, s, l)
 }
 
 impl Clone for TextureBank {
