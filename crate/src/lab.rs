@@ -10,8 +10,8 @@
 
 use crate::camera::capture::CapturedFrame;
 use crate::camera::texture::{ImageTexture, TextureBank};
-use crate::camera::{render as render_camera, CameraImage, PinholeCamera, RobotBox};
-use crate::render::{render_world, RenderOptions, ROBOT_COLOURS};
+use crate::camera::{render as render_camera, robot_boxes, CameraImage, PinholeCamera};
+use crate::render::{render_world, RenderOptions};
 use crate::report::{Report, Timings};
 use crate::scenario::{Scenario, ScenarioError, MAX_DURATION_S};
 use crate::sensors::laser::beam_bearing;
@@ -324,17 +324,13 @@ impl Lab {
         let world = self.preview_world.get_or_insert_with(|| {
             World::new(self.scenario.walls.iter().map(|w| w.segment()).collect())
         });
-        let robots: Vec<RobotBox> = self
+        let starts: Vec<crate::geom::Pose2> = self
             .scenario
             .robots
             .iter()
-            .enumerate()
-            .filter(|(j, _)| *j != i)
-            .map(|(j, r)| RobotBox {
-                corners: crate::kinematics::P2dx::body(&r.start_pose()).corners,
-                rgb: ROBOT_COLOURS[j % ROBOT_COLOURS.len()],
-            })
+            .map(|r| r.start_pose())
             .collect();
+        let robots = robot_boxes(&starts, i);
         let mut bank = self.textures.take().unwrap_or_else(|| {
             TextureBank::new(self.scenario.seed, self.scenario.camera.wall_height_m)
         });

@@ -194,15 +194,18 @@ fn stroke(width: f32) -> Stroke {
     }
 }
 
-/// Draws a long polyline (a trajectory), dropping points closer than 1.5 px
-/// to the last one kept: the picture is the same, the path far shorter.
-fn trajectory(
+/// Draws a polyline of world points. Points closer than `min_step_px` to
+/// the last one kept are dropped (a long trajectory looks the same with a
+/// far shorter path); 0 keeps every point.
+fn polyline(
     pm: &mut Pixmap,
     o: &RenderOptions,
     pts: impl Iterator<Item = DVec2>,
+    min_step_px: f32,
     p: &Paint,
     s: &Stroke,
 ) {
+    let min2 = min_step_px * min_step_px;
     let mut pb = PathBuilder::new();
     let mut last: Option<(f32, f32)> = None;
     let mut pending: Option<(f32, f32)> = None;
@@ -213,43 +216,16 @@ fn trajectory(
                 pb.move_to(x, y);
                 last = Some((x, y));
             }
-            Some((lx, ly)) => {
-                if (x - lx).powi(2) + (y - ly).powi(2) >= 2.25 {
-                    pb.line_to(x, y);
-                    last = Some((x, y));
-                    pending = None;
-                } else {
-                    pending = Some((x, y));
-                }
+            Some((lx, ly)) if (x - lx).powi(2) + (y - ly).powi(2) >= min2 => {
+                pb.line_to(x, y);
+                last = Some((x, y));
+                pending = None;
             }
+            Some(_) => pending = Some((x, y)),
         }
     }
     if let Some((x, y)) = pending {
         pb.line_to(x, y);
-    }
-    if let Some(path) = pb.finish() {
-        pm.stroke_path(&path, p, s, Transform::identity(), None);
-    }
-}
-
-/// Draws a polyline of world points.
-fn polyline(
-    pm: &mut Pixmap,
-    o: &RenderOptions,
-    pts: impl Iterator<Item = DVec2>,
-    p: &Paint,
-    s: &Stroke,
-) {
-    let mut pb = PathBuilder::new();
-    let mut first = true;
-    for w in pts {
-        let (x, y) = o.to_px(w);
-        if first {
-            pb.move_to(x, y);
-            first = false;
-        } else {
-            pb.line_to(x, y);
-        }
     }
     if let Some(path) = pb.finish() {
         pm.stroke_path(&path, p, s, Transform::identity(), None);
@@ -395,19 +371,21 @@ pub fn render_world(
                 s.line_cap = LineCap::Butt;
                 s.dash = StrokeDash::new(vec![6.0, 4.0], 0.0);
                 let dark = [c[0] / 2, c[1] / 2, c[2] / 2];
-                trajectory(
+                polyline(
                     pm,
                     o,
                     r.log.odometry.iter().map(|p| start.compose(p).position()),
+                    1.5,
                     &paint(dark, 0.8),
                     &s,
                 );
             }
             if o.layers.truth_path && r.log.truth.len() > 1 {
-                trajectory(
+                polyline(
                     pm,
                     o,
                     r.log.truth.iter().map(|p| p.position()),
+                    1.5,
                     &paint(c, 0.75),
                     &Stroke {
                         width: 2.0,
@@ -429,13 +407,28 @@ pub fn render_world(
                 pm,
                 o,
                 seg.into_iter(),
+                0.0,
                 &paint([255, 200, 0], 0.9),
                 &stroke(wall_px + 8.0),
             );
         }
-        polyline(pm, o, seg.into_iter(), &outline, &stroke(wall_px + 2.0));
+        polyline(
+            pm,
+            o,
+            seg.into_iter(),
+            0.0,
+            &outline,
+            &stroke(wall_px + 2.0),
+        );
         let hint = texture_hint(wall.texture.as_deref(), i, scenario.seed);
-        polyline(pm, o, seg.into_iter(), &paint(hint, 1.0), &stroke(wall_px));
+        polyline(
+            pm,
+            o,
+            seg.into_iter(),
+            0.0,
+            &paint(hint, 1.0),
+            &stroke(wall_px),
+        );
     }
 
     if let Some(p) = o.preview_wall {
@@ -445,6 +438,7 @@ pub fn render_world(
             pm,
             o,
             [DVec2::new(p[0], p[1]), DVec2::new(p[2], p[3])].into_iter(),
+            0.0,
             &paint([30, 90, 200], 0.9),
             &s,
         );

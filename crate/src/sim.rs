@@ -24,7 +24,9 @@
 
 use crate::camera::capture::{CapturedFrame, FrameStore};
 use crate::camera::texture::TextureBank;
-use crate::camera::{render as render_camera, CameraImage, CameraNoise, PinholeCamera, RobotBox};
+use crate::camera::{
+    render as render_camera, robot_boxes, CameraImage, CameraNoise, PinholeCamera, RobotBox,
+};
 use crate::follower::{Command, FollowerMode, WallFollower};
 use crate::geom::{ConvexPolygon, Pose2, Segment};
 use crate::kinematics::{integrate_wheels, wheel_speeds, P2dx, WheelState, CONTROL_DT_S};
@@ -385,15 +387,8 @@ impl Simulation {
 
     /// The other robots as boxes for robot `skip`'s camera.
     fn robot_boxes_except(&self, skip: usize) -> Vec<RobotBox> {
-        self.robots
-            .iter()
-            .enumerate()
-            .filter(|(j, _)| *j != skip)
-            .map(|(j, r)| RobotBox {
-                corners: r.body().corners,
-                rgb: crate::render::ROBOT_COLOURS[j % crate::render::ROBOT_COLOURS.len()],
-            })
-            .collect()
+        let poses: Vec<Pose2> = self.robots.iter().map(|r| r.truth).collect();
+        robot_boxes(&poses, skip)
     }
 
     /// What robot `i`'s camera sees now, noise-free (for display), in

@@ -125,6 +125,20 @@ pub struct RobotBox {
     pub rgb: [u8; 3],
 }
 
+/// The robots a camera on robot `skip` can see: every other robot's body at
+/// its pose, in its display colour.
+pub fn robot_boxes(poses: &[Pose2], skip: usize) -> Vec<RobotBox> {
+    poses
+        .iter()
+        .enumerate()
+        .filter(|(j, _)| *j != skip)
+        .map(|(j, pose)| RobotBox {
+            corners: crate::kinematics::P2dx::body(pose).corners,
+            rgb: crate::render::ROBOT_COLOURS[j % crate::render::ROBOT_COLOURS.len()],
+        })
+        .collect()
+}
+
 /// The texture a wall face shows.
 pub fn wall_texture_key(walls: &[WallSpec], i: usize, back: bool) -> TextureKey {
     TextureKey {

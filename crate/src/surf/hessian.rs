@@ -175,17 +175,22 @@ fn valid_range(len: usize, half: usize, step: usize) -> Option<(usize, usize)> {
 }
 
 impl ResponseLayer {
-    /// Computes det(H) for the filter of side `size`, sampled every `step`
-    /// pixels, wherever the filter fits in the image.
-    pub fn compute(ii: &IntegralImage, size: usize, step: usize) -> Self {
-        let mut layer = ResponseLayer {
+    /// A layer with no responses yet, to be filled by `recompute`.
+    fn empty(size: usize, step: usize) -> Self {
+        ResponseLayer {
             size,
             step,
             cols: 0,
             rows: 0,
             det: Vec::new(),
             valid: None,
-        };
+        }
+    }
+
+    /// Computes det(H) for the filter of side `size`, sampled every `step`
+    /// pixels, wherever the filter fits in the image.
+    pub fn compute(ii: &IntegralImage, size: usize, step: usize) -> Self {
+        let mut layer = ResponseLayer::empty(size, step);
         let planes = (step > 1).then(|| PhasePlanes::new(ii, step));
         layer.recompute(ii, planes.as_ref(), size, step);
         layer
@@ -285,14 +290,7 @@ impl FastHessian {
             for i in 0..self.intervals {
                 let size = filter_size(o, i);
                 if layers.len() <= i {
-                    layers.push(ResponseLayer {
-                        size,
-                        step,
-                        cols: 0,
-                        rows: 0,
-                        det: Vec::new(),
-                        valid: None,
-                    });
+                    layers.push(ResponseLayer::empty(size, step));
                 }
                 layers[i].recompute(ii, planes.as_ref(), size, step);
             }
