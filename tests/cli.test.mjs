@@ -53,7 +53,12 @@ test('the same seed gives the same run; another seed another', () => {
   const a = run('run', 'scenarios/office.json', '--json', '--duration', '15', '--seed', '3');
   const b = run('run', 'scenarios/office.json', '--json', '--duration', '15', '--seed', '3');
   const c = run('run', 'scenarios/office.json', '--json', '--duration', '15', '--seed', '4');
-  const strip = (s) => { const j = JSON.parse(s); delete j.timings_ms; return j; };
+  const strip = (s) => {
+    const j = JSON.parse(s);
+    delete j.timings_ms;
+    if (j.merge) delete j.merge.timings_ms;
+    return j;
+  };
   assert.deepEqual(strip(a.stdout), strip(b.stdout));
   assert.equal(JSON.parse(a.stdout).seed, 3);
   assert.notDeepEqual(strip(a.stdout).robots[0].odometry, strip(c.stdout).robots[0].odometry);
@@ -101,6 +106,8 @@ test('bad command lines exit 2 with a message', () => {
     [['run', 'scenarios/thesis.json', '--duration', '0'], /duration_s: 0 is outside/],
     [['run', 'scenarios/thesis.json', '--duration'], /--duration needs a value/],
     [['run', 'scenarios/thesis.json', '--frobnicate'], /unknown option --frobnicate/],
+    [['run', 'scenarios/thesis.json', '--method', 'magic'], /--method: 'magic' is not one of auto, thesis, map-only/],
+    [['merge', 'scenarios/thesis.json'], /--out FILE.yaml is required/],
     [['fly'], /unknown command 'fly'/],
     [[], /usage:/],
   ]) {
@@ -227,4 +234,101 @@ test('features and match keep the interface JSON', () => {
   const bad = run('match', 'tests/data/coffee.png', 'tests/data/README.md', '--json');
   assert.equal(bad.code, 2);
   assert.match(bad.stderr, /not a PNG or JPEG/);
+});
+
+test('run merges with the automatic method: the report carries the table, the verdict and the transform', () => {
+  const r = run('run', 'scenarios/thesis.json', '--json');
+  assert.equal(r.code, 0, r.stderr);
+  const report = JSON.parse(r.stdout);
+  assert.equal(report.method, 'auto');
+  assert.equal(report.match_tables.length, 1);
+  const t = report.match_tables[0];
+  assert.equal(t.a, 'robot1');
+  assert.equal(t.b, 'robot2');
+  assert.equal(t.inliers.length, t.rows.length);
+  for (const row of t.inliers) assert.equal(row.length, t.cols.length);
+  assert.ok(t.rows.every((i) => Number.isInteger(i) && i >= 0 && i < report.robots[0].frames));
+  assert.ok(t.inliers.flat().some((n) => n >= 10), 'some frame pairs share a place');
+  const m = report.merge;
+  assert.equal(m.status, 'merged', m.reason);
+  assert.ok(m.confidence > 0 && m.confidence <= 1, `${m.confidence}`);
+  assert.deepEqual(m.transforms.map((x) => x.robot), ['robot1', 'robot2']);
+  assert.deepEqual(m.transforms[0].pose, [0, 0, 0]);
+  // The truth: robot2's start pose seen from robot1's start pose.
+  const thesis = JSON.parse(readFileSync(path.join(root, 'scenarios/thesis.json'), 'utf8'));
+  const [x1, y1, t1] = thesis.robots[0].start;
+  const [x2, y2, t2] = thesis.robots[1].start;
+  const dx = x2 - x1;
+  const dy = y2 - y1;
+  const truth = [Math.cos(t1) * dx + Math.sin(t1) * dy, -Math.sin(t1) * dx + Math.cos(t1) * dy, t2 - t1];
+  const [x, y, th] = m.transforms[1].pose;
+  const dth = Math.atan2(Math.sin(th - truth[2]), Math.cos(th - truth[2]));
+  assert.ok(Math.hypot(x - truth[0], y - truth[1]) < 0.1, `robot2's frame at ${x}, ${y}; truth ${truth}`);
+  assert.ok(Math.abs(dth) < (1 * Math.PI) / 180, `heading off by ${dth} rad`);
+  const e = m.errors.find((q) => q.robot === 'robot2');
+  assert.ok(Math.abs(e.error_m - Math.hypot(x - truth[0], y - truth[1])) < 1e-3, 'the report scores the same error');
+  for (const k of ['simulate', 'camera', 'slam', 'features', 'matching', 'merge', 'total']) {
+    assert.ok(typeof report.timings_ms[k] === 'number' && report.timings_ms[k] >= 0, k);
+  }
+  assert.ok(report.timings_ms.features > 0 && report.timings_ms.matching > 0);
+});
+
+test('robots that never share a place: no_merge with the reason, only the first robot joined', () => {
+  const room = (ox) => [
+    { from: [ox, 0], to: [ox + 6, 0] }, { from: [ox + 6, 0], to: [ox + 6, 4] },
+    { from: [ox + 6, 4], to: [ox, 4] }, { from: [ox, 4], to: [ox, 0] },
+    { from: [ox + 2, 2], to: [ox + 4, 2] },
+  ];
+  const file = scenarioFile('apart.json', {
+    name: 'apart', seed: 11, duration_s: 90,
+    walls: [...room(0), ...room(20)],
+    robots: [
+      { name: 'a', start: [1, 1, 0], follow: 'left' },
+      { name: 'b', start: [21, 1, 0.5], follow: 'right' },
+    ],
+  });
+  for (const method of ['auto', 'map-only']) {
+    const r = run('run', file, '--json', '--method', method);
+    assert.equal(r.code, 0, r.stderr);
+    const m = JSON.parse(r.stdout).merge;
+    assert.equal(m.status, 'no_merge', `${method}: ${m.reason}`);
+    assert.ok(m.reason.length > 10, m.reason);
+    assert.deepEqual(m.transforms.map((x) => x.robot), ['a'], method);
+  }
+});
+
+test('the thesis method and the map-only baseline report their own verdicts', () => {
+  for (const method of ['thesis', 'map-only']) {
+    const r = run('run', 'scenarios/thesis.json', '--json', '--method', method, '--duration', '200');
+    assert.equal(r.code, 0, r.stderr);
+    const report = JSON.parse(r.stdout);
+    assert.equal(report.method, method);
+    assert.ok(['merged', 'no_merge'].includes(report.merge.status));
+    assert.ok(report.merge.reason.length > 0);
+    if (method === 'thesis') {
+      const t = report.match_tables[0];
+      // The thesis compares every selected frame with every other.
+      assert.equal(t.inliers.flat().length, t.rows.length * t.cols.length);
+      assert.ok(t.rows.length >= 2 && t.cols.length >= 2, `${t.rows.length} x ${t.cols.length} selected frames`);
+    }
+  }
+});
+
+test('merge writes the merged map as ROS map_server PGM + YAML and a PNG', () => {
+  const out = path.join(tmp, 'merged', 'thesis.yaml');
+  mkdirSync(path.dirname(out), { recursive: true });
+  const r = run('merge', 'scenarios/thesis.json', '--out', out);
+  assert.equal(r.code, 0, r.stderr);
+  assert.match(r.stdout, /merge \(auto\): merged/);
+  const yaml = readFileSync(out, 'utf8');
+  assert.match(yaml, /^image: "?thesis\.pgm"?$/m);
+  assert.match(yaml, /^resolution: 0\.05/m);
+  const pgm = readFileSync(out.replace(/yaml$/, 'pgm'));
+  const header = pgm.subarray(0, 20).toString('latin1');
+  const [magic, w, h, max] = header.split(/\s+/);
+  assert.equal(magic, 'P5');
+  assert.equal(max, '255');
+  assert.ok(Number(w) > 100 && Number(h) > 100, `${w} x ${h}`);
+  const png = readFileSync(out.replace(/yaml$/, 'png'));
+  assert.deepEqual([...png.subarray(1, 4)], [0x50, 0x4e, 0x47]);
 });

@@ -244,3 +244,64 @@ test('the lab page: edit, run, step, read sensors, reset, autosave, corrupt save
   assert.deepEqual(problems, [], 'no console errors or page errors');
   await context.close();
 });
+
+test('merging in the page: the table fills, a pair shows its matches, the verdict and transform appear', { timeout: 180000 }, async () => {
+  const context = await browser.newContext({ viewport: { width: 1280, height: 720 } });
+  const page = await context.newPage();
+  const problems = [];
+  page.on('console', (m) => {
+    if (m.type() === 'error') problems.push(`console error: ${m.text()} (${m.location().url})`);
+  });
+  page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
+  await page.goto(baseUrl);
+  await waitReady(page);
+  await page.selectOption('#preset', 'thesis');
+  await page.waitForFunction(() => window.slamlab.scenario().name === 'thesis');
+  const mergeButton = page.getByRole('button', { name: 'Merge maps' });
+  assert.equal(await mergeButton.isDisabled(), true, 'nothing to merge before a run');
+
+  // A shorter run at full speed: both robots see the long south corridor.
+  await page.fill('#duration', '150');
+  await page.locator('#duration').dispatchEvent('change');
+  await page.locator('#speed').fill('50');
+  await page.getByRole('button', { name: 'Run', exact: true }).click();
+  await page.waitForFunction(() => window.slamlab.state().finished, null, { timeout: 120000 });
+
+  // Merge with the automatic method: the table fills in over several frames.
+  await page.selectOption('#merge-method', 'auto');
+  await mergeButton.click();
+  await page.waitForFunction(() => document.querySelector('#merge-stage').textContent.startsWith('matching'), null, {
+    timeout: 60000,
+  });
+  await page.waitForFunction(() => document.querySelector('#merge-verdict')?.textContent.length > 0, null, {
+    timeout: 60000,
+  });
+  const verdict = await page.locator('#merge-verdict').innerText();
+  assert.match(verdict, /^(Merged \(confidence \d\.\d\d\): |No merge, because )\S/);
+  const view = await page.evaluate(() => JSON.parse(window.slamlab.lab.mergeViewJson()));
+  assert.ok(view.progress.finished);
+  assert.ok(view.tables[0].cells.length > 20, `${view.tables[0].cells.length} pairs checked`);
+  assert.match(await page.locator('#merge-table-hint').innerText(), /pairs checked/);
+  if (view.report.status === 'merged') {
+    const rows = await page.locator('#merge-transforms tr').count();
+    assert.equal(rows, 3, 'a header and one row per robot');
+    assert.match(await page.locator('#merge-transforms').innerText(), /robot2\s+-?\d+\.\d\d\s+-?\d+\.\d\d/);
+    const e = view.report.errors.find((x) => x.robot === 'robot2');
+    assert.ok(e.error_m < 0.3 && Math.abs(e.error_deg) < 3, `robot2's transform is off by ${e.error_m} m, ${e.error_deg} deg`);
+  }
+
+  // The best cell opens the pair view with match lines.
+  await page.locator('#merge-table').press('Enter');
+  await page.waitForSelector('#pair-overlay:not([hidden]) canvas');
+  assert.match(await page.locator('#pair-overlay').innerText(), /ratio-test matches, \d+ inliers/);
+  await page.screenshot({ path: path.join(ARTIFACTS, 'page-merge.png') });
+  await page.getByRole('button', { name: 'Close the pair view' }).click();
+  assert.equal(await page.locator('#pair-overlay').isHidden(), true);
+
+  // Reset drops the merge and the panel follows.
+  await page.getByRole('button', { name: 'Reset', exact: true }).click();
+  await page.waitForFunction(() => document.querySelector('.merge-result').hidden);
+  assert.equal(await page.evaluate(() => window.slamlab.lab.hasMerge()), false);
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});

@@ -34,6 +34,7 @@ import {
 import { RobotsPanel, robotColour, setRobotColours } from './robots-panel.js';
 import { CameraPanel } from './camera-panel.js';
 import { MapsPanel } from './maps-panel.js';
+import { MergePanel } from './merge-panel.js';
 
 const STORAGE_KEY = 'slamlab.scenario.v1';
 const LAYERS_KEY = 'slamlab.layers.v1';
@@ -598,6 +599,16 @@ const mapsPanel = new MapsPanel($('maps'), {
   lab: () => app.lab,
   onError: (e) => setStatus(message(e), 'error'),
   download: (name, data, type) => download(name, data, type),
+});
+
+// Merging the maps, with the matched-pair table (web/merge-panel.js).
+const mergePanel = new MergePanel($('merge'), $('pair-overlay'), {
+  lab: () => app.lab,
+  canMerge: () => Boolean(app.lab && app.state && app.state.steps > 0 && !app.running && app.scenario.robots.length >= 2),
+  onError: (e) => setStatus(message(e), 'error'),
+  setStatus: (text, kind) => setStatus(text, kind),
+  download: (name, data, type) => download(name, data, type),
+  report: () => app.lab.reportJson('{}'),
 });
 
 function refreshPanels() {
@@ -1445,6 +1456,7 @@ function frame(now) {
     if (app.dirty) draw();
     cameraPanel.update(now, changed || app.running);
     mapsPanel.update(now, changed || app.running);
+    mergePanel.update(now);
     if (app.running) updateReadouts(false);
   } catch (e) {
     app.running = false;

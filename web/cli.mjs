@@ -1,7 +1,7 @@
 #!/usr/bin/env node
 // The lab's command line: the same wasm build as the page, run headless in node.
 //
-//   node web/cli.mjs run SCENARIO.json [--seed N] [--duration S] [--json]
+//   node web/cli.mjs run SCENARIO.json [--seed N] [--duration S] [--method auto|thesis|map-only] [--json]
 //
 // Progress goes to stderr; with --json the report is the only thing on stdout.
 // Exit status: 0 when the run completed, 2 on bad input (message on stderr),
@@ -10,21 +10,21 @@
 import { performance } from 'node:perf_hooks';
 import { loadWasm } from './cli/wasm.mjs';
 import { UsageError, parseArgs, wasmCall, openScenario } from './cli/args.mjs';
+import { methodOf, mergeLab, describeMerge } from './cli/merge.mjs';
 
 export { UsageError, parseArgs };
 
 const USAGE = `usage:
-  node web/cli.mjs run SCENARIO.json [--seed N] [--duration S] [--json]
-      run the scenario headless and print a report (JSON with --json)`;
+  node web/cli.mjs run SCENARIO.json [--seed N] [--duration S] [--method auto|thesis|map-only] [--json]
+      run the scenario headless, merge the robots' maps (default method: auto)
+      and print a report (JSON with --json)`;
 
 async function run(argv, wasm) {
   const { positional, options } = parseArgs(argv, {
     seed: 'value', duration: 'value', json: 'flag', method: 'value',
   });
   if (positional.length !== 1) throw new UsageError('run: expected exactly one SCENARIO.json');
-  if (options.method !== undefined) {
-    throw new UsageError('--method: map merging is not available in this build yet');
-  }
+  const method = methodOf(options);
   const t0 = performance.now();
   const lab = await openScenario(positional[0], options, wasm);
   const state0 = JSON.parse(lab.stateJson());
@@ -43,6 +43,7 @@ async function run(argv, wasm) {
     }
   }
   const simulateMs = performance.now() - tSim;
+  mergeLab(lab, method);
   const totalMs = performance.now() - t0;
   const report = wasmCall(() => lab.reportJson(JSON.stringify({ simulate: simulateMs, total: totalMs })));
   if (options.json) {
@@ -55,6 +56,10 @@ async function run(argv, wasm) {
       console.log(`  ${robot.name} (follows ${robot.follow} wall): path ${robot.path_length_m.toFixed(1)} m, ` +
         `bumps ${robot.bumps}, odometry off by ${e.position_m.toFixed(2)} m and ${e.heading_deg.toFixed(1)} deg at the end`);
     }
+    console.log(describeMerge(r.merge));
+    const t = r.timings_ms;
+    console.log(`timings (ms): simulate ${t.simulate.toFixed(0)} (camera ${t.camera.toFixed(0)}, slam ${t.slam.toFixed(0)}), ` +
+      `features ${t.features.toFixed(0)}, matching ${t.matching.toFixed(0)}, merge ${t.merge.toFixed(0)}, total ${t.total.toFixed(0)}`);
   }
   return 0;
 }
@@ -64,7 +69,7 @@ const usages = [USAGE];
 
 // Commands contributed by other capabilities (each module exports `commands`
 // and optionally `usage`).
-for (const mod of ['./cli/camera.mjs', './cli/surf.mjs', './cli/slam.mjs']) {
+for (const mod of ['./cli/camera.mjs', './cli/surf.mjs', './cli/slam.mjs', './cli/merge.mjs']) {
   try {
     const m = await import(mod);
     Object.assign(commands, m.commands);

@@ -24,13 +24,18 @@ use tiny_skia::Pixmap;
 /// A lab session: a scenario, and its simulation once started.
 pub struct Lab {
     scenario: Scenario,
-    sim: Option<Simulation>,
+    pub(crate) sim: Option<Simulation>,
     view: RenderOptions,
     pixmap: Option<Pixmap>,
     /// Texture cache and loaded pictures while no simulation holds them.
     textures: Option<TextureBank>,
     /// The world of the scenario being edited (for camera previews).
     preview_world: Option<World>,
+    /// The map merge of the current run, once asked for (see
+    /// [`crate::merge::lab`]); dropped when the run changes.
+    pub(crate) merge: Option<crate::merge::job::MergeJob>,
+    /// The host's millisecond clock, for stage timings.
+    pub(crate) clock: Option<fn() -> f64>,
 }
 
 /// Live figures for the page's readouts.
@@ -79,7 +84,15 @@ impl Lab {
             pixmap: None,
             textures: None,
             preview_world: None,
+            merge: None,
+            clock: None,
         })
+    }
+
+    /// Gives the session a millisecond clock: runs then time their camera
+    /// and mapping stages, and merges their stages.
+    pub fn set_clock(&mut self, clock: fn() -> f64) {
+        self.clock = Some(clock);
     }
 
     pub fn scenario(&self) -> &Scenario {
@@ -112,6 +125,7 @@ impl Lab {
 
     /// Drops the simulation, keeping its texture bank for the next run.
     fn stop(&mut self) {
+        self.merge = None;
         if let Some(sim) = self.sim.take() {
             self.textures = Some(sim.textures);
         }
@@ -154,7 +168,12 @@ impl Lab {
             None => {
                 let bank = self.take_textures();
                 match Simulation::with_textures(&self.scenario, bank) {
-                    Ok(s) => s,
+                    Ok(mut s) => {
+                        if let Some(clock) = self.clock {
+                            s.set_clock(clock);
+                        }
+                        s
+                    }
                     Err(e) => {
                         self.textures = Some(TextureBank::new(
                             self.scenario.seed,
@@ -173,6 +192,11 @@ impl Lab {
     pub fn step(&mut self, n: usize) -> Result<usize, ScenarioError> {
         let sim = self.start()?;
         let before = sim.steps();
+        if n > 0 && !sim.finished() {
+            // The robots move on: a merge of the old maps no longer holds.
+            self.merge = None;
+        }
+        let sim = self.start()?;
         for _ in 0..n {
             if sim.finished() {
                 break;
@@ -184,6 +208,9 @@ impl Lab {
 
     /// Runs to the end of the scenario's duration.
     pub fn run_to_end(&mut self) -> Result<(), ScenarioError> {
+        if !self.start()?.finished() {
+            self.merge = None;
+        }
         self.start()?.run_to_end();
         Ok(())
     }
@@ -285,7 +312,25 @@ impl Lab {
             .sim
             .as_ref()
             .ok_or("nothing has run yet: run the scenario first")?;
-        Ok(Report::from_sim(sim, timings))
+        let mut timings = timings;
+        if timings.camera == 0.0 && timings.slam == 0.0 {
+            timings.camera = sim.stage_times.camera_ms;
+            timings.slam = sim.stage_times.slam_ms;
+        }
+        if let Some(t) = self.merge.as_ref().map(|j| j.times_ms) {
+            if timings.features == 0.0 && timings.matching == 0.0 && timings.merge == 0.0 {
+                timings.features = t.features;
+                timings.matching = t.matching;
+                timings.merge = t.merge;
+            }
+        }
+        let mut report = Report::from_sim(sim, timings);
+        if let Some(job) = &self.merge {
+            report.method = Some(job.config.method.name().to_string());
+            report.match_tables = job.tables();
+            report.merge = self.merge_report();
+        }
+        Ok(report)
     }
 
     /// Puts a picture (PNG or JPEG bytes) on walls whose texture is

@@ -36,6 +36,8 @@ pub mod follower;
 pub mod geom;
 pub mod kinematics;
 pub mod lab;
+pub mod maze;
+pub mod merge;
 pub mod odometry;
 pub mod render;
 pub mod report;

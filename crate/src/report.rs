@@ -59,7 +59,18 @@ pub struct RobotReport {
 #[derive(Clone, Debug, Serialize, Default, serde::Deserialize)]
 #[serde(default)]
 pub struct Timings {
+    /// The whole simulation (`camera` and `slam` are parts of it).
     pub simulate: f64,
+    /// Rendering and capturing camera frames, inside `simulate`.
+    pub camera: f64,
+    /// Both mappers, inside `simulate`.
+    pub slam: f64,
+    /// SURF on the frames that take part in the merge.
+    pub features: f64,
+    /// Proposals and frame-pair verification (the matched-pair table).
+    pub matching: f64,
+    /// Decision and map fusion.
+    pub merge: f64,
     pub total: f64,
 }
 
@@ -69,7 +80,13 @@ pub struct Report {
     pub seed: u64,
     pub duration_s: f64,
     pub steps: usize,
+    /// The merge method (`auto`, `thesis`, `map-only`); null before any merge.
+    pub method: Option<String>,
     pub robots: Vec<RobotReport>,
+    /// One matched-pair table per pair of robots (empty before a merge).
+    pub match_tables: Vec<crate::merge::job::MatchTable>,
+    /// The merge verdict, transforms and their errors; null before a merge.
+    pub merge: Option<crate::merge::lab::MergeReport>,
     pub timings_ms: Timings,
 }
 
@@ -118,7 +135,10 @@ impl Report {
             seed: sim.scenario.seed,
             duration_s: sim.time_s(),
             steps: sim.steps(),
+            method: None,
             robots,
+            match_tables: Vec::new(),
+            merge: None,
             timings_ms: timings,
         }
     }

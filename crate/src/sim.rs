@@ -162,6 +162,20 @@ pub struct Simulation {
     /// Whether the robots' mappers run (off only for experiments that need
     /// no maps; mapping reads the senses and changes nothing else).
     mapping: bool,
+    /// A millisecond clock, if the host provides one (the core has no clock
+    /// of its own: wasm32-unknown-unknown has none); see [`StageTimes`].
+    clock: Option<fn() -> f64>,
+    /// Time spent in the camera and in the mappers so far.
+    pub stage_times: StageTimes,
+}
+
+/// Milliseconds spent in the expensive stages of [`Simulation::step`],
+/// measured with the clock given to [`Simulation::set_clock`] (zero
+/// without one). Reading a clock changes nothing in the run.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StageTimes {
+    pub camera_ms: f64,
+    pub slam_ms: f64,
 }
 
 impl Simulation {
@@ -240,6 +254,8 @@ impl Simulation {
             textures,
             capture: true,
             mapping: true,
+            clock: None,
+            stage_times: StageTimes::default(),
         };
         sim.sense();
         for r in &mut sim.robots {
@@ -376,13 +392,25 @@ impl Simulation {
             r.log_row(step, t);
         }
         // 5b. mapping: odometry pose and scan into both mappers (never the truth)
+        let t0 = self.clock.map_or(0.0, |now| now());
         if self.mapping {
             for r in &mut self.robots {
                 r.mapping.observe(&r.odometry.pose(), &r.last_scan);
             }
         }
         // 6. camera frames, once per capture period
+        let t1 = self.clock.map_or(0.0, |now| now());
         self.capture_due_frames();
+        if let Some(now) = self.clock {
+            self.stage_times.slam_ms += t1 - t0;
+            self.stage_times.camera_ms += now() - t1;
+        }
+    }
+
+    /// Gives the simulation a millisecond clock to time its stages with
+    /// ([`Simulation::stage_times`]).
+    pub fn set_clock(&mut self, clock: fn() -> f64) {
+        self.clock = Some(clock);
     }
 
     /// The other robots as boxes for robot `skip`'s camera.

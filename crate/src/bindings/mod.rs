@@ -6,6 +6,7 @@
 //! function returns `Result<_, JsError>` so bad input reaches JavaScript as
 //! an exception with a message, never as a panic or a trap.
 
+mod merge;
 mod slam;
 pub mod surf;
 
@@ -42,6 +43,21 @@ fn frame_meta(f: &crate::camera::capture::CapturedFrame) -> serde_json::Value {
         "odometry": [f.odometry.x, f.odometry.y, f.odometry.theta],
         "truth": [f.truth.x, f.truth.y, f.truth.theta],
     })
+}
+
+/// `performance.now()` where the host has it (browsers, node), else
+/// `Date.now()`: the clock the lab times its stages with.
+fn now_ms() -> f64 {
+    let global = js_sys::global();
+    js_sys::Reflect::get(&global, &JsValue::from_str("performance"))
+        .ok()
+        .filter(|p| p.is_object())
+        .and_then(|p| {
+            let now = js_sys::Reflect::get(&p, &JsValue::from_str("now")).ok()?;
+            let now: js_sys::Function = now.dyn_into().ok()?;
+            now.call0(&p).ok()?.as_f64()
+        })
+        .unwrap_or_else(js_sys::Date::now)
 }
 
 /// Installs a panic hook that prints Rust panics to the console (a panic
@@ -91,9 +107,9 @@ impl Lab {
     /// `problems()`), but such a scenario will not run.
     #[wasm_bindgen(constructor)]
     pub fn new(scenario_json: &str) -> Result<Lab, JsError> {
-        Ok(Lab {
-            inner: lab::Lab::new(scenario_json).map_err(js_err)?,
-        })
+        let mut inner = lab::Lab::new(scenario_json).map_err(js_err)?;
+        inner.set_clock(now_ms);
+        Ok(Lab { inner })
     }
 
     /// Replaces the scenario and stops the run. On error nothing changes.

@@ -1,0 +1,113 @@
+//! # JavaScript boundary of map merging
+//!
+//! A third `#[wasm_bindgen] impl Lab` block. The page starts a merge, then
+//! calls `mergeAdvance` from its animation loop with a small budget so the
+//! matched-pair table fills in while the page stays responsive; each call
+//! returns the progress as JSON, and `mergeViewJson` the tables and, at the
+//! end, the verdict. Robot pairs and frame pairs are addressed by the
+//! positions `mergeViewJson` lists.
+
+use super::Lab;
+use crate::merge::MergeMethod;
+use wasm_bindgen::prelude::*;
+use wasm_bindgen::Clamped;
+
+fn err(e: impl std::fmt::Display) -> JsError {
+    JsError::new(&e.to_string())
+}
+
+fn json<T: serde::Serialize>(v: &T) -> Result<String, JsError> {
+    serde_json::to_string(v).map_err(err)
+}
+
+#[wasm_bindgen]
+impl Lab {
+    /// Starts merging the run's maps with `method` (`auto`, `thesis` or
+    /// `map-only`); returns the progress JSON. Throws before any run.
+    #[wasm_bindgen(js_name = mergeStart)]
+    pub fn merge_start(&mut self, method: &str) -> Result<String, JsError> {
+        let method = MergeMethod::parse(method).map_err(err)?;
+        json(&self.inner.merge_start(method).map_err(err)?)
+    }
+
+    /// Whether a merge of the current run exists (started, running or
+    /// done); stepping, resetting or editing drops it.
+    #[wasm_bindgen(js_name = hasMerge)]
+    pub fn has_merge(&self) -> bool {
+        self.inner.merge.is_some()
+    }
+
+    /// Does up to `units` units of work (frames described, frame pairs
+    /// checked) in the current stage; returns the progress JSON
+    /// `{stage, done, total, finished}`.
+    #[wasm_bindgen(js_name = mergeAdvance)]
+    pub fn merge_advance(&mut self, units: u32) -> Result<String, JsError> {
+        json(&self.inner.merge_advance(units as usize).map_err(err)?)
+    }
+
+    /// Runs the merge to its end; returns the progress JSON.
+    #[wasm_bindgen(js_name = mergeFinish)]
+    pub fn merge_finish(&mut self) -> Result<String, JsError> {
+        json(&self.inner.merge_finish().map_err(err)?)
+    }
+
+    /// Progress, the selected frames, the tables so far and (when done) the
+    /// verdict with its errors, as JSON.
+    #[wasm_bindgen(js_name = mergeViewJson)]
+    pub fn merge_view_json(&self) -> Result<String, JsError> {
+        json(&self.inner.merge_view().map_err(err)?)
+    }
+
+    /// One checked frame pair's matches, homography, quad and candidate
+    /// transform (JSON); `pair`, `row` and `col` as in `mergeViewJson`.
+    #[wasm_bindgen(js_name = mergePairJson)]
+    pub fn merge_pair_json(&self, pair: u32, row: u32, col: u32) -> Result<String, JsError> {
+        json(
+            &self
+                .inner
+                .merge_pair_view(pair as usize, row as usize, col as usize)
+                .map_err(err)?,
+        )
+    }
+
+    /// Draws the merged map, fitted, with the robots' paths, into a canvas
+    /// context of `width × height`.
+    #[wasm_bindgen(js_name = drawMerged)]
+    pub fn draw_merged(
+        &self,
+        ctx: &web_sys::CanvasRenderingContext2d,
+        width: u32,
+        height: u32,
+    ) -> Result<(), JsError> {
+        let rgba = self.inner.merged_rgba(width, height).map_err(err)?;
+        let img =
+            web_sys::ImageData::new_with_u8_clamped_array_and_sh(Clamped(&rgba), width, height)
+                .map_err(|_| JsError::new("could not make ImageData"))?;
+        ctx.put_image_data(&img, 0.0, 0.0)
+            .map_err(|_| JsError::new("could not draw into the canvas"))
+    }
+
+    /// The merged map as straight RGBA pixels (for node and tests).
+    #[wasm_bindgen(js_name = mergedRgba)]
+    pub fn merged_rgba(&self, width: u32, height: u32) -> Result<Vec<u8>, JsError> {
+        self.inner.merged_rgba(width, height).map_err(err)
+    }
+
+    /// The merged map as ROS map_server files: binary PGM ...
+    #[wasm_bindgen(js_name = mergedPgm)]
+    pub fn merged_pgm(&self) -> Result<Vec<u8>, JsError> {
+        self.inner.merged_pgm().map_err(err)
+    }
+
+    /// ... the YAML naming `image` ...
+    #[wasm_bindgen(js_name = mergedYaml)]
+    pub fn merged_yaml(&self, image: &str) -> Result<String, JsError> {
+        self.inner.merged_yaml(image).map_err(err)
+    }
+
+    /// ... and a PNG of the same pixels.
+    #[wasm_bindgen(js_name = mergedPng)]
+    pub fn merged_png(&self) -> Result<Vec<u8>, JsError> {
+        self.inner.merged_png().map_err(err)
+    }
+}

@@ -1,0 +1,98 @@
+//! # Fusing the maps into one grid
+//!
+//! Once every robot's map frame has a pose in the merged frame (robot 0's),
+//! the grids are combined cell by cell. Log-odds make it one line of
+//! probability: two independent observations of a cell combine by
+//! *adding* their log-odds (Thrun, Burgard and Fox, *Probabilistic
+//! Robotics*, §9.2, eq. 9.7, the same rule each robot's mapper applies per
+//! beam), clamped to the grid's range like any other update. A cell one map
+//! calls free and the other a wall ends up in between, as it should.
+//!
+//! Resampling is done *backwards*: for each cell of the merged grid, its
+//! centre is carried into each map's frame (the inverse of that map's pose)
+//! and the map's cell there is read. Pushing cells forwards instead would
+//! leave holes wherever a rotated cell lattice misses a target cell;
+//! pulling visits every merged cell exactly once. Nearest-cell reading keeps
+//! every value a whole number of log-odds units, so the result is the same
+//! on every machine.
+
+use crate::geom::Pose2;
+use crate::slam::grid::{GridConfig, OccupancyGrid};
+use glam::DVec2;
+
+/// Corners of a grid's extent, in its own frame.
+fn corners(grid: &OccupancyGrid) -> [DVec2; 4] {
+    let lo = grid.origin_m();
+    let s = DVec2::new(grid.width() as f64, grid.height() as f64) * grid.resolution_m();
+    [
+        lo,
+        lo + DVec2::new(s.x, 0.0),
+        lo + s,
+        lo + DVec2::new(0.0, s.y),
+    ]
+}
+
+/// Writes log-odds `units` into the (empty) cell holding `p` of `grid`.
+///
+/// [`OccupancyGrid`] exposes no cell setter, only its beam model, so this
+/// uses the model's own path: a zero-length beam that "hits" adds
+/// `config.hit` to its end cell (clamped, like every update), with the
+/// config's `hit` set to the value wanted for the duration of the call.
+fn write_cell(grid: &mut OccupancyGrid, p: DVec2, units: i8) {
+    if units == 0 {
+        return;
+    }
+    let hit = grid.config.hit;
+    grid.config.hit = units;
+    grid.integrate_beam(p, p, true);
+    grid.config.hit = hit;
+}
+
+/// The merged grid: each map's frame at its pose in the merged frame,
+/// log-odds added and clamped to `config`'s range (see the module doc).
+/// Maps that are empty or have a non-finite pose are skipped; with nothing
+/// to fuse the result is an empty grid.
+pub fn fuse(maps: &[(&OccupancyGrid, Pose2)], config: GridConfig) -> OccupancyGrid {
+    let mut merged = OccupancyGrid::new(config.clone());
+    let usable: Vec<(&OccupancyGrid, Pose2)> = maps
+        .iter()
+        .filter(|(g, pose)| g.width() > 0 && g.height() > 0 && pose.is_finite())
+        .map(|(g, pose)| (*g, *pose))
+        .collect();
+    if usable.is_empty() || config.resolution_m.is_nan() || config.resolution_m <= 0.0 {
+        return merged;
+    }
+    let mut lo = DVec2::splat(f64::INFINITY);
+    let mut hi = DVec2::splat(f64::NEG_INFINITY);
+    for (g, pose) in &usable {
+        for c in corners(g) {
+            let q = pose.transform_point(c);
+            lo = lo.min(q);
+            hi = hi.max(q);
+        }
+    }
+    if !merged.ensure_contains(lo, hi) {
+        // Too large for the cell budget: fuse what fits around the first map.
+        let (g, pose) = usable[0];
+        let [a, b, c, d] = corners(g).map(|c| pose.transform_point(c));
+        let (l, h) = (a.min(b).min(c).min(d), a.max(b).max(c).max(d));
+        if !merged.ensure_contains(l, h) {
+            return merged;
+        }
+    }
+    let inverses: Vec<Pose2> = usable.iter().map(|(_, p)| p.inverse()).collect();
+    let (min, max) = (config.min as i32, config.max as i32);
+    for iy in 0..merged.height() {
+        for ix in 0..merged.width() {
+            let centre = merged.cell_centre(ix, iy);
+            let mut sum = 0i32;
+            for ((g, _), inv) in usable.iter().zip(&inverses) {
+                if let Some((x, y)) = g.local(g.global_cell(inv.transform_point(centre))) {
+                    sum += g.units(x, y) as i32;
+                }
+            }
+            write_cell(&mut merged, centre, sum.clamp(min, max) as i8);
+        }
+    }
+    merged
+}

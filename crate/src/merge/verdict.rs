@@ -1,0 +1,583 @@
+//! # The verdict: merge, or say why not
+//!
+//! A wrong merge is worse than none: it shows the user a confident map of
+//! a building that does not exist. So the two maps are merged only when
+//! two independent kinds of evidence agree, and otherwise the answer is
+//! "no merge" with the reason in a sentence.
+//!
+//! 1. **Vision: independent places agree.** The candidates (one per
+//!    verified frame pair, [`super::verify`]) go through the pairwise
+//!    consistency test ([`super::consistency`], after PCM, Mangelson et al.
+//!    2018). The largest agreeing set must span at least `min_places`
+//!    independent places: one place could be a texture that repeats
+//!    elsewhere, two places fooled by the *same* wrong transform is a
+//!    coincidence the maps' rigidity makes unlikely.
+//! 2. **The maps: they agree once overlaid.** The agreeing candidates'
+//!    transform is refined by laying B's grid onto A's ([`super::align`]),
+//!    and the overlaid maps are compared cell by cell ([`map_agreement`]).
+//!    Carpin's *acceptance index* (Birk and Carpin 2006: agreements over
+//!    agreements plus disagreements) is a ratio, and a ratio cannot tell a
+//!    small overlap from a large one: laying one corridor onto another gives
+//!    0.98 whether or not it is the same corridor. The verdict therefore
+//!    also demands **absolute evidence**: at least `min_agree_cells` wall
+//!    cells of each map on the other's walls. And it counts what a wrong
+//!    overlay produces and a right one does not: *contradictions*, walls of
+//!    one map lying in the other's well-observed free space (a robot drove
+//!    or saw through there). More than `max_contradiction` of the wall
+//!    cells in the overlap contradicting means "maps contradict".
+//!
+//! Walls of a SLAM map are within a cell or two of where they should be,
+//! not exactly on it, so agreement accepts an occupied cell within one cell,
+//! and a contradiction needs the whole neighbourhood (two cells around) to
+//! be free: a wall that is merely a little off does not count against the
+//! merge.
+
+use super::align::{refine_alignment, AlignConfig, Alignment};
+use super::consistency::{
+    consistent_hypotheses, independent_places, ConsistencyConfig, ConsistentSet,
+};
+use super::{Candidate, MergeStatus};
+use crate::geom::{wrap_angle, Pose2};
+use crate::slam::degeneracy::symmetric_eigen2;
+use crate::slam::grid::{CellState, OccupancyGrid};
+use glam::DVec2;
+use std::collections::HashSet;
+
+/// How two overlaid maps agree, counted in both directions (B's cells on
+/// A, and A's cells on B).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Agreement {
+    /// Known cells (free or occupied) of one map that land on known cells
+    /// of the other.
+    pub overlap_cells: usize,
+    /// Wall cells of one map with a wall of the other within one cell.
+    pub occupied_agree: usize,
+    /// Wall cells of one map whose whole neighbourhood (two cells around)
+    /// is free in the other.
+    pub occupied_contradict: usize,
+    /// The longest piece of wall (8-connected contradicting cells of one
+    /// map) standing in the other's free space: a wall where the other robot
+    /// saw through is decisive however small a share of the overlap it is.
+    pub largest_contradiction: usize,
+    /// Free cells of one map on free cells of the other.
+    pub free_agree: usize,
+    /// The smaller of the two directions' `occupied_agree`: both maps must
+    /// bring walls to the overlap.
+    pub min_direction_agree: usize,
+    /// How well the agreeing walls pin the overlay in its weakest direction:
+    /// the smaller eigenvalue of `Σ n nᵀ` over the agreeing wall cells'
+    /// unit normals (in cells' worth of wall facing that way). Walls that
+    /// are all parallel (one corridor laid on another) give about 0: they
+    /// agree wherever the overlay slides along them.
+    pub weak_constraint: f64,
+    /// `occupied_agree / (occupied_agree + occupied_contradict)`, 1 with no
+    /// wall cells in the overlap.
+    pub ratio: f64,
+}
+
+impl Agreement {
+    /// Share of the wall cells in the overlap that contradict (0..1).
+    pub fn contradiction(&self) -> f64 {
+        1.0 - self.ratio
+    }
+}
+
+/// The unit normal of the wall through global cell `g` of `grid`, from the
+/// principal axes of the occupied cells within two cells; `None` where
+/// they do not form a line (a corner, a lone cell).
+fn wall_normal(grid: &OccupancyGrid, g: [i64; 2]) -> Option<DVec2> {
+    let mut pts = [DVec2::ZERO; 25];
+    let mut n = 0;
+    for dy in -2..=2i64 {
+        for dx in -2..=2i64 {
+            if let Some((x, y)) = grid.local([g[0] + dx, g[1] + dy]) {
+                if grid.state(x, y) == CellState::Occupied {
+                    pts[n] = DVec2::new(dx as f64, dy as f64);
+                    n += 1;
+                }
+            }
+        }
+    }
+    if n < 3 {
+        return None;
+    }
+    let pts = &pts[..n];
+    let mean = pts.iter().copied().sum::<DVec2>() / n as f64;
+    let (mut a, mut b, mut c) = (0.0, 0.0, 0.0);
+    for p in pts {
+        let d = *p - mean;
+        a += d.x * d.x;
+        b += d.x * d.y;
+        c += d.y * d.y;
+    }
+    let (along, across, normal) = symmetric_eigen2(a / n as f64, b / n as f64, c / n as f64);
+    (along >= 0.5 && across <= 0.3 * along).then_some(normal)
+}
+
+/// One direction: `from`'s cells carried by `pose` onto `onto`. Also
+/// returns `Σ n nᵀ` of the agreeing cells' normals (in `onto`'s frame) as
+/// `[xx, xy, yy]`.
+fn one_way(onto: &OccupancyGrid, from: &OccupancyGrid, pose: &Pose2) -> (Agreement, [f64; 3]) {
+    let mut out = Agreement::default();
+    let mut info = [0.0; 3];
+    if onto.width() == 0 || from.width() == 0 {
+        return (out, info);
+    }
+    let mut contradicting: Vec<(i64, i64)> = Vec::new();
+    let state_at = |g: [i64; 2]| onto.local(g).map(|(x, y)| onto.state(x, y));
+    let occupied_near = |g: [i64; 2], r: i64| {
+        (-r..=r).any(|dy| {
+            (-r..=r).any(|dx| state_at([g[0] + dx, g[1] + dy]) == Some(CellState::Occupied))
+        })
+    };
+    let all_free = |g: [i64; 2], r: i64| {
+        (-r..=r)
+            .all(|dy| (-r..=r).all(|dx| state_at([g[0] + dx, g[1] + dy]) == Some(CellState::Free)))
+    };
+    for iy in 0..from.height() {
+        for ix in 0..from.width() {
+            let s = from.state(ix, iy);
+            if s == CellState::Unknown {
+                continue;
+            }
+            let g = onto.global_cell(pose.transform_point(from.cell_centre(ix, iy)));
+            let Some(t) = state_at(g) else { continue };
+            if t == CellState::Unknown && s == CellState::Free {
+                continue;
+            }
+            match s {
+                CellState::Occupied => {
+                    if occupied_near(g, 1) {
+                        out.occupied_agree += 1;
+                        out.overlap_cells += 1;
+                        if let Some(n) = wall_normal(onto, g) {
+                            info[0] += n.x * n.x;
+                            info[1] += n.x * n.y;
+                            info[2] += n.y * n.y;
+                        }
+                    } else if all_free(g, 2) {
+                        out.occupied_contradict += 1;
+                        contradicting.push((ix as i64, iy as i64));
+                        out.overlap_cells += 1;
+                    } else if t != CellState::Unknown {
+                        out.overlap_cells += 1;
+                    }
+                }
+                CellState::Free => {
+                    out.overlap_cells += 1;
+                    if t == CellState::Free {
+                        out.free_agree += 1;
+                    }
+                }
+                CellState::Unknown => {}
+            }
+        }
+    }
+    out.largest_contradiction = largest_component(&contradicting);
+    (out, info)
+}
+
+/// Size of the largest 8-connected group of cells.
+fn largest_component(cells: &[(i64, i64)]) -> usize {
+    let mut left: HashSet<(i64, i64)> = cells.iter().copied().collect();
+    let mut largest = 0;
+    let mut stack = Vec::new();
+    while let Some(&start) = left.iter().next() {
+        left.remove(&start);
+        stack.push(start);
+        let mut size = 0;
+        while let Some((x, y)) = stack.pop() {
+            size += 1;
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    if left.remove(&(x + dx, y + dy)) {
+                        stack.push((x + dx, y + dy));
+                    }
+                }
+            }
+        }
+        largest = largest.max(size);
+    }
+    largest
+}
+
+/// How maps A and B agree when B's frame sits at `pose` in A's (both
+/// directions summed; see the module doc).
+pub fn map_agreement(a: &OccupancyGrid, b: &OccupancyGrid, pose: &Pose2) -> Agreement {
+    if !pose.is_finite() {
+        return Agreement {
+            ratio: 0.0,
+            ..Agreement::default()
+        };
+    }
+    let (ab, info_a) = one_way(a, b, pose);
+    let (ba, info_b) = one_way(b, a, &pose.inverse());
+    // B's normals turn with B's frame into A's: R M Rᵀ.
+    let (s, c) = pose.theta.sin_cos();
+    let [bxx, bxy, byy] = info_b;
+    let rxx = c * c * bxx - 2.0 * s * c * bxy + s * s * byy;
+    let rxy = s * c * (bxx - byy) + (c * c - s * s) * bxy;
+    let ryy = s * s * bxx + 2.0 * s * c * bxy + c * c * byy;
+    let (_, weak, _) = symmetric_eigen2(info_a[0] + rxx, info_a[1] + rxy, info_a[2] + ryy);
+    let agree = ab.occupied_agree + ba.occupied_agree;
+    let contradict = ab.occupied_contradict + ba.occupied_contradict;
+    Agreement {
+        overlap_cells: ab.overlap_cells + ba.overlap_cells,
+        occupied_agree: agree,
+        occupied_contradict: contradict,
+        free_agree: ab.free_agree + ba.free_agree,
+        min_direction_agree: ab.occupied_agree.min(ba.occupied_agree),
+        largest_contradiction: ab.largest_contradiction.max(ba.largest_contradiction),
+        weak_constraint: weak.max(0.0),
+        ratio: if agree + contradict == 0 {
+            1.0
+        } else {
+            agree as f64 / (agree + contradict) as f64
+        },
+    }
+}
+
+/// Thresholds of the verdict.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VerdictConfig {
+    pub consistency: ConsistencyConfig,
+    pub align: AlignConfig,
+    /// Independent places the agreeing candidates must span. Default 2.
+    pub min_places: usize,
+    /// Wall cells of *each* map that must lie on the other's walls. Default 60
+    /// (3 m of wall at 0.05 m cells).
+    pub min_agree_cells: usize,
+    /// Largest share of contradicting wall cells in the overlap. Default 0.02:
+    /// right merges measure 0 to 0.5 %, wrong ones 3.6 % and up (see the module doc).
+    pub max_contradiction: f64,
+    /// The grid alignment may move the vision estimate at most this far at
+    /// the common places (m)... Default 0.35.
+    pub max_refine_shift_m: f64,
+    /// ...and turn it at most this much (rad). Default 3°.
+    pub max_refine_turn_rad: f64,
+    /// Refuse when this many connected wall cells of one map stand in the
+    /// other's free space. Default 16 (0.8 m of wall).
+    pub max_contradiction_run: usize,
+    /// Least `weak_constraint` of the agreement (cells of wall crossing the
+    /// weakest direction). Default 20.
+    pub min_weak_constraint: f64,
+    /// Rival hypotheses (agreeing sets) checked against the maps. Default 6.
+    pub max_hypotheses: usize,
+}
+
+impl Default for VerdictConfig {
+    fn default() -> Self {
+        VerdictConfig {
+            consistency: ConsistencyConfig::default(),
+            align: AlignConfig::default(),
+            min_places: 2,
+            min_agree_cells: 60,
+            max_contradiction: 0.02,
+            max_refine_shift_m: 0.35,
+            max_refine_turn_rad: 3f64.to_radians(),
+            min_weak_constraint: 20.0,
+            max_contradiction_run: 16,
+            max_hypotheses: 6,
+        }
+    }
+}
+
+/// The verdict on one pair of robots.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PairDecision {
+    pub status: MergeStatus,
+    /// A sentence with numbers, for the user.
+    pub reason: String,
+    /// Pose of B's map frame in A's: set when merged, and also when refused
+    /// for what the maps showed (so the page can show the rejected overlay).
+    pub pose: Option<Pose2>,
+    /// 0..1, for choosing among robot pairs (0 unless merged).
+    pub confidence: f64,
+    /// The agreeing candidates (indices into the input).
+    pub support: Vec<usize>,
+    /// Independent places among `support`.
+    pub places: usize,
+    pub agreement: Option<Agreement>,
+}
+
+/// What the search for candidates saw, for the "no candidate" reasons.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SearchSummary {
+    /// Frame pairs proposed by place recognition and verified.
+    pub proposed_pairs: usize,
+    /// Most rigid inliers any verified pair had (also below the minimum).
+    pub best_rigid_inliers: usize,
+    /// The minimum a candidate needs.
+    pub min_inliers: usize,
+}
+
+fn refuse(reason: String) -> PairDecision {
+    PairDecision {
+        status: MergeStatus::NoMerge,
+        reason,
+        pose: None,
+        confidence: 0.0,
+        support: Vec::new(),
+        places: 0,
+        agreement: None,
+    }
+}
+
+/// The transform the agreeing candidates share: their inlier-weighted mean
+/// angle, and the translation that best reproduces each candidate at its
+/// own place.
+fn mean_pose(cands: &[Candidate], members: &[usize]) -> Option<Pose2> {
+    let w_total: f64 = members.iter().map(|&i| cands[i].inliers as f64).sum();
+    if members.is_empty() || w_total <= 0.0 {
+        return None;
+    }
+    let ref_theta = cands[members[0]].pose.theta;
+    let dtheta: f64 = members
+        .iter()
+        .map(|&i| cands[i].inliers as f64 * wrap_angle(cands[i].pose.theta - ref_theta))
+        .sum::<f64>()
+        / w_total;
+    let theta = wrap_angle(ref_theta + dtheta);
+    let rot = DVec2::from_angle(theta);
+    let t = members
+        .iter()
+        .map(|&i| {
+            let c = &cands[i];
+            (c.pose.transform_point(c.place_b) - rot.rotate(c.place_b)) * c.inliers as f64
+        })
+        .sum::<DVec2>()
+        / w_total;
+    let pose = Pose2::new(t.x, t.y, theta);
+    pose.is_finite().then_some(pose)
+}
+
+/// Largest distance (m) and angle (rad) between `pose` and the members at
+/// their own places.
+fn spread(cands: &[Candidate], members: &[usize], pose: &Pose2) -> (f64, f64) {
+    members.iter().fold((0.0, 0.0), |(dm, da), &i| {
+        let c = &cands[i];
+        let d = (c.pose.transform_point(c.place_b) - pose.transform_point(c.place_b)).length();
+        let a = wrap_angle(c.pose.theta - pose.theta).abs();
+        (f64::max(dm, d), f64::max(da, a))
+    })
+}
+
+/// Decides whether to merge maps A and B from the candidates (see the
+/// module doc). With no candidates the reason is generic; use
+/// [`decide_pair_after_search`] to quote what the search saw.
+pub fn decide_pair(
+    cands: &[Candidate],
+    a: &OccupancyGrid,
+    b: &OccupancyGrid,
+    cfg: &VerdictConfig,
+) -> PairDecision {
+    decide_pair_after_search(cands, &SearchSummary::default(), a, b, cfg)
+}
+
+/// [`decide_pair`], with the search's figures for the reasons.
+pub fn decide_pair_after_search(
+    cands: &[Candidate],
+    summary: &SearchSummary,
+    a: &OccupancyGrid,
+    b: &OccupancyGrid,
+    cfg: &VerdictConfig,
+) -> PairDecision {
+    if cands.is_empty() {
+        let n = summary.proposed_pairs;
+        return refuse(if n == 0 {
+            "no common place seen: no frame pair was verified".to_string()
+        } else if summary.best_rigid_inliers >= 3 {
+            format!(
+                "too few inliers: the best of {n} proposed frame pairs has {} agreeing points ({} needed)",
+                summary.best_rigid_inliers,
+                summary.min_inliers.max(summary.best_rigid_inliers + 1)
+            )
+        } else {
+            format!("no common place seen: 0 of {n} proposed frame pairs verified")
+        });
+    }
+    let hypotheses = consistent_hypotheses(cands, &cfg.consistency, cfg.max_hypotheses.max(1));
+    let min_places = cfg.min_places.max(1);
+    let largest = hypotheses.first().cloned().unwrap_or_default();
+    if largest.places < min_places {
+        let all_places = independent_places(
+            cands,
+            &(0..cands.len()).collect::<Vec<_>>(),
+            &cfg.consistency,
+        );
+        let mut d = refuse(if all_places < min_places {
+            format!(
+                "too little evidence: {} verified frame pair{} at only {} place{}; {} independent places must agree",
+                cands.len(),
+                if cands.len() == 1 { "" } else { "s" },
+                all_places,
+                if all_places == 1 { "" } else { "s" },
+                min_places
+            )
+        } else {
+            format!(
+                "candidates disagree: the largest consistent set has {} of {} candidates, from {} of {} places",
+                largest.members.len(),
+                cands.len(),
+                largest.places,
+                all_places
+            )
+        });
+        d.support = largest.members;
+        d.places = largest.places;
+        return d;
+    }
+    // Every rival transform with enough places is checked against the maps.
+    let judged: Vec<PairDecision> = hypotheses
+        .iter()
+        .filter(|h| h.places >= min_places)
+        .map(|h| judge_hypothesis(cands, h, a, b, cfg))
+        .collect();
+    let passed: Vec<&PairDecision> = judged
+        .iter()
+        .filter(|d| d.status == MergeStatus::Merged)
+        .collect();
+    match passed.as_slice() {
+        [] => judged
+            .into_iter()
+            .next()
+            .unwrap_or_else(|| refuse(String::new())),
+        [one] => (*one).clone(),
+        [first, rest @ ..] => {
+            // Two transforms that both fit the maps: unless they are the same
+            // transform (found twice), the evidence is ambiguous.
+            let same = rest.iter().all(|d| match (first.pose, d.pose) {
+                (Some(p), Some(q)) => {
+                    (p.position() - q.position()).length() < cfg.consistency.translation_m
+                        && wrap_angle(p.theta - q.theta).abs() < cfg.consistency.angle_rad
+                }
+                _ => false,
+            });
+            if same {
+                (*first).clone()
+            } else {
+                let mut d = refuse(format!(
+                    "ambiguous: {} different transforms fit both the frames and the maps (a repeated layout?)",
+                    passed.len()
+                ));
+                d.support = first.support.clone();
+                d.places = first.places;
+                d
+            }
+        }
+    }
+}
+
+/// "maps contradict: …" when the overlay puts a long piece of wall, or too
+/// large a share of the wall cells, in the other map's free space.
+fn contradiction_reason(
+    agreement: &Agreement,
+    cfg: &VerdictConfig,
+    resolution_m: f64,
+) -> Option<String> {
+    if agreement.largest_contradiction >= cfg.max_contradiction_run {
+        return Some(format!(
+            "maps contradict: {:.1} m of one map's wall stands in the other map's free space",
+            agreement.largest_contradiction as f64 * resolution_m
+        ));
+    }
+    (agreement.contradiction() > cfg.max_contradiction).then(|| {
+        format!(
+            "maps contradict: {:.0} % of overlapping wall cells fall on the other map's free space ({} of {})",
+            100.0 * agreement.contradiction(),
+            agreement.occupied_contradict,
+            agreement.occupied_agree + agreement.occupied_contradict
+        )
+    })
+}
+
+/// Checks one hypothesis (an agreeing set of candidates, from
+/// [`consistent_hypotheses`]) against the maps: the verdict if it were the
+/// only one.
+pub fn judge_hypothesis(
+    cands: &[Candidate],
+    set: &ConsistentSet,
+    a: &OccupancyGrid,
+    b: &OccupancyGrid,
+    cfg: &VerdictConfig,
+) -> PairDecision {
+    let with_support = |mut d: PairDecision| {
+        d.support = set.members.clone();
+        d.places = set.places;
+        d
+    };
+    let Some(vision) = mean_pose(cands, &set.members) else {
+        return with_support(refuse(
+            "candidates disagree: no common transform".to_string(),
+        ));
+    };
+    let (vision_m, vision_rad) = spread(cands, &set.members, &vision);
+    let Some(Alignment { pose, .. }) = refine_alignment(a, b, &vision, &cfg.align) else {
+        return with_support(refuse(
+            "maps barely overlap: too few wall cells near the common places to confirm the transform"
+                .to_string(),
+        ));
+    };
+    // The refinement may polish the vision estimate, not replace it.
+    let (shift_m, turn_rad) = spread(cands, &set.members, &pose);
+    let moved_m = set
+        .members
+        .iter()
+        .map(|&i| {
+            let p = cands[i].place_b;
+            (pose.transform_point(p) - vision.transform_point(p)).length()
+        })
+        .fold(0.0, f64::max);
+    let turned = wrap_angle(pose.theta - vision.theta).abs();
+    let mut d = with_support(refuse(String::new()));
+    if moved_m > cfg.max_refine_shift_m || turned > cfg.max_refine_turn_rad {
+        // The grids pulled the transform away: say what the maps show at
+        // the transform vision proposed.
+        let at_vision = map_agreement(a, b, &vision);
+        d.pose = Some(vision);
+        d.agreement = Some(at_vision);
+        d.reason = contradiction_reason(&at_vision, cfg, a.resolution_m()).unwrap_or_else(|| {
+            format!(
+                "maps and vision disagree: aligning the grids moves the transform {:.2} m and {:.1}° from what {} frame pairs saw",
+                moved_m,
+                turned.to_degrees(),
+                set.members.len()
+            )
+        });
+        return d;
+    }
+    let agreement = map_agreement(a, b, &pose);
+    d.pose = Some(pose);
+    d.agreement = Some(agreement);
+    if let Some(reason) = contradiction_reason(&agreement, cfg, a.resolution_m()) {
+        d.reason = reason;
+        return d;
+    }
+    if agreement.min_direction_agree < cfg.min_agree_cells {
+        d.reason = format!(
+            "maps overlap too little to confirm: {} wall cells agree ({} of one map on the other's walls; {} needed)",
+            agreement.occupied_agree, agreement.min_direction_agree, cfg.min_agree_cells
+        );
+        return d;
+    }
+    if agreement.weak_constraint < cfg.min_weak_constraint {
+        d.reason = format!(
+            "maps overlap only along parallel walls: the shift along them is not confirmed ({:.0} cells of crossing wall; {:.0} needed)",
+            agreement.weak_constraint, cfg.min_weak_constraint
+        );
+        return d;
+    }
+    let evidence_places = 1.0 - (-(set.places as f64) / 2.0).exp();
+    let evidence_cells = 1.0 - (-(agreement.min_direction_agree as f64) / 200.0).exp();
+    d.status = MergeStatus::Merged;
+    d.confidence = (agreement.ratio * evidence_places * evidence_cells).clamp(0.0, 1.0);
+    d.reason = format!(
+        "merged: {} frame pairs from {} independent places agree within {:.2} m and {:.1}°; maps agree on {} wall cells",
+        set.members.len(),
+        set.places,
+        vision_m.max(shift_m),
+        vision_rad.max(turn_rad).to_degrees(),
+        agreement.occupied_agree
+    );
+    d
+}

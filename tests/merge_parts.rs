@@ -1,0 +1,741 @@
+//! The automatic map merge, part by part: lifting keypoints with the laser,
+//! the rigid MSAC, place recognition, the pairwise-consistency test, grid
+//! alignment, the verdict, fusion and the spanning tree; then the whole
+//! chain on simulated runs, scored against the truth (which only this test
+//! reads).
+
+use glam::DVec2;
+use slamlab::camera::texture::TextureBank;
+use slamlab::camera::{render, PinholeCamera};
+use slamlab::geom::{wrap_angle, Pose2};
+use slamlab::merge::align::{refine_alignment, AlignConfig};
+use slamlab::merge::consistency::{
+    independent_places, max_consistent_places, max_consistent_set, pairwise_consistent,
+    ConsistencyConfig,
+};
+use slamlab::merge::fuse::fuse;
+use slamlab::merge::graph::{spanning_tree, PairEdge};
+use slamlab::merge::lift::{
+    column_bearing_rad, laser_range_at, lift_keypoint, lift_keypoint_3d, liftable_features,
+};
+use slamlab::merge::rigid::{fit_rigid_least_squares, fit_rigid_msac, RigidConfig};
+use slamlab::merge::verdict::{decide_pair, map_agreement, VerdictConfig};
+use slamlab::merge::verify::{verify_pair, VerifyConfig};
+use slamlab::merge::vocabulary::{propose_pairs, similarity, Vocabulary, VocabularyConfig};
+use slamlab::merge::{Candidate, FrameInfo, MergeStatus};
+use slamlab::rng::Rng;
+use slamlab::scenario::{CameraSpec, Scenario, WallSpec};
+use slamlab::sensors::laser::{beam_bearing, LASER_BEAMS};
+use slamlab::sensors::sonar::SONAR_COUNT;
+use slamlab::sim::Simulation;
+use slamlab::slam::grid::{CellState, GridConfig, OccupancyGrid};
+use slamlab::slam::MapperKind;
+use slamlab::surf::{extract, Features, GrayImage, SurfConfig};
+use slamlab::world::World;
+use std::f64::consts::PI;
+use wasm_bindgen_test::wasm_bindgen_test;
+
+fn camera() -> PinholeCamera {
+    PinholeCamera::new(&CameraSpec::default())
+}
+
+/// A frame taken at `pose` with the given laser ranges (m; `None`: no
+/// return).
+fn frame_with_ranges(pose: Pose2, range: impl Fn(f64) -> Option<f64>) -> FrameInfo {
+    let mut laser_mm = [u16::MAX; LASER_BEAMS];
+    for (k, mm) in laser_mm.iter_mut().enumerate() {
+        if let Some(r) = range(beam_bearing(k)) {
+            *mm = (r * 1000.0).round() as u16;
+        }
+    }
+    FrameInfo {
+        index: 0,
+        step: 0,
+        pose,
+        odometry: pose,
+        turn_rad: 0.0,
+        sonar_m: [0.0; SONAR_COUNT],
+        laser_mm,
+    }
+}
+
+/// A flat wall `d` metres ahead of the robot, across its heading.
+fn facing_wall(pose: Pose2, d: f64) -> FrameInfo {
+    frame_with_ranges(pose, |b| {
+        let r = d / b.cos();
+        (b.cos() > 0.05 && r < 4.0).then_some(r)
+    })
+}
+
+// ----- lift -----------------------------------------------------------------
+
+#[wasm_bindgen_test(unsupported = test)]
+fn column_bearing_follows_the_pinhole_and_opencv_pixel_centres() {
+    let cam = camera();
+    // 320 px over 60°: f = 160 / tan 30° = 277.13 px; the optical axis is
+    // at u = 160, i.e. between SURF columns 159 and 160 (x = 159.5).
+    assert!((cam.f_px - 277.128).abs() < 1e-3);
+    assert!(column_bearing_rad(&cam, 159.5).abs() < 1e-12);
+    // The left edge of the image (u = 0, x = -0.5) is 30° to the left.
+    assert!((column_bearing_rad(&cam, -0.5) - 30f64.to_radians()).abs() < 1e-12);
+    assert!((column_bearing_rad(&cam, 319.5) + 30f64.to_radians()).abs() < 1e-12);
+    // x = 239.5: u = 240, 80 px right of centre: atan(80 / 277.13) = 16.10° right.
+    let b = column_bearing_rad(&cam, 239.5);
+    assert!((b.to_degrees() + 16.102).abs() < 1e-3, "{}", b.to_degrees());
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn laser_range_interpolates_between_beams_and_refuses_gaps_and_edges() {
+    let mut mm = [2000u16; LASER_BEAMS];
+    mm[91] = 2100; // +1°
+    mm[92] = 2100;
+    // Halfway between beam 90 (0°) and beam 91 (1°).
+    let r = laser_range_at(&mm, 0.5f64.to_radians()).expect("range");
+    assert!((r - 2.05).abs() < 1e-9, "{r}");
+    // Exactly on a beam.
+    assert!((laser_range_at(&mm, 0.0).expect("range") - 2.0).abs() < 1e-9);
+    // No return on either side of the bearing.
+    mm[100] = u16::MAX;
+    assert_eq!(laser_range_at(&mm, 9.5f64.to_radians()), None);
+    assert_eq!(laser_range_at(&mm, 10.5f64.to_radians()), None);
+    // A wall's end in front of a far wall: 2.0 m then 3.5 m.
+    for m in mm.iter_mut().skip(121) {
+        *m = 3500;
+    }
+    assert_eq!(laser_range_at(&mm, 30.5f64.to_radians()), None);
+    // One beam further from the jump the neighbours are still too close to it.
+    assert_eq!(laser_range_at(&mm, 29.5f64.to_radians()), None);
+    assert!(laser_range_at(&mm, 27.5f64.to_radians()).is_some());
+    // Outside the half-plane the laser sweeps.
+    assert_eq!(
+        laser_range_at(&[2000; LASER_BEAMS], 91f64.to_radians()),
+        None
+    );
+    assert_eq!(laser_range_at(&[2000; LASER_BEAMS], f64::NAN), None);
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn lifted_keypoints_land_on_the_wall_in_the_map_frame() {
+    let cam = camera();
+    // Robot at (1, 2) facing +y (90°), a flat wall 2 m ahead: the wall is
+    // the line y = 4 of the map frame.
+    let pose = Pose2::new(1.0, 2.0, PI / 2.0);
+    let frame = facing_wall(pose, 2.0);
+    let centre = lift_keypoint(&cam, &frame, 159.5).expect("lifts");
+    assert!((centre - DVec2::new(1.0, 4.0)).length() < 1e-9, "{centre}");
+    // 80 px right of centre: X/Z = 80/f, so the point is 2·80/f = 0.577 m to
+    // the robot's right, which is +x in the map. Interpolating 1/cos between
+    // beams costs well under a millimetre.
+    let right = lift_keypoint(&cam, &frame, 239.5).expect("lifts");
+    assert!((right.y - 4.0).abs() < 1e-3, "{right}");
+    assert!(
+        (right.x - (1.0 + 2.0 * 80.0 / cam.f_px)).abs() < 1e-3,
+        "{right}"
+    );
+    // Height on the wall from the row: the horizon row (v = 120, y = 119.5)
+    // is the camera's height, 0.4 m; 50 px higher is 0.4 + 50·Z/f.
+    let p = lift_keypoint_3d(&cam, &frame, 159.5, 119.5).expect("lifts");
+    assert!((p.z - 0.4).abs() < 1e-9);
+    let p = lift_keypoint_3d(&cam, &frame, 159.5, 69.5).expect("lifts");
+    assert!(
+        (p.z - (0.4 + 50.0 * 2.0 / cam.f_px)).abs() < 1e-9,
+        "{}",
+        p.z
+    );
+    // Where the laser saw nothing, nothing lifts.
+    let empty = frame_with_ranges(pose, |_| None);
+    assert_eq!(lift_keypoint(&cam, &empty, 159.5), None);
+}
+
+// ----- rigid ----------------------------------------------------------------
+
+#[wasm_bindgen_test(unsupported = test)]
+fn rigid_least_squares_is_exact_on_noise_free_points() {
+    let truth = Pose2::new(3.0, -1.5, 0.7);
+    let b = [
+        DVec2::new(0.0, 0.0),
+        DVec2::new(2.0, 0.5),
+        DVec2::new(-1.0, 3.0),
+    ];
+    let a: Vec<DVec2> = b.iter().map(|&p| truth.transform_point(p)).collect();
+    let fit = fit_rigid_least_squares(&a, &b).expect("fits");
+    assert!((fit.x - 3.0).abs() < 1e-12 && (fit.y + 1.5).abs() < 1e-12);
+    assert!((fit.theta - 0.7).abs() < 1e-12);
+    // Coincident points fix no angle.
+    let same = [DVec2::new(1.0, 1.0); 3];
+    assert_eq!(fit_rigid_least_squares(&same, &same), None);
+    assert_eq!(fit_rigid_least_squares(&[], &[]), None);
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn rigid_msac_recovers_a_known_transform_with_40_percent_outliers() {
+    let truth = Pose2::new(-4.2, 7.5, 2.4);
+    let mut rng = Rng::new(11);
+    let n = 50;
+    let b: Vec<DVec2> = (0..n)
+        .map(|_| DVec2::new(rng.range(-3.0, 3.0), rng.range(-2.0, 2.0)))
+        .collect();
+    let mut a: Vec<DVec2> = b
+        .iter()
+        .map(|&p| truth.transform_point(p) + DVec2::new(rng.normal(0.01), rng.normal(0.01)))
+        .collect();
+    // 20 of 50 (40 %) are wrong matches: anywhere within 5 m.
+    for p in a.iter_mut().take(20) {
+        *p = DVec2::new(rng.range(-9.0, 1.0), rng.range(2.5, 12.5));
+    }
+    let fit = fit_rigid_msac(&a, &b, &RigidConfig::default(), 7).expect("fits");
+    assert!((fit.pose.x - truth.x).abs() < 0.01, "{:?}", fit.pose);
+    assert!((fit.pose.y - truth.y).abs() < 0.01, "{:?}", fit.pose);
+    assert!(wrap_angle(fit.pose.theta - truth.theta).abs() < 0.3f64.to_radians());
+    // Every true match is an inlier, and an outlier only by bad luck (a
+    // random point within 8 cm of its partner's true place).
+    assert!((20..50).all(|i| fit.inliers.contains(&i)));
+    assert!(fit.inliers.iter().filter(|&&i| i < 20).count() <= 1);
+    assert!(fit.rms_m < 0.025, "rms {}", fit.rms_m);
+    // The same seed gives the same fit.
+    assert_eq!(
+        fit_rigid_msac(&a, &b, &RigidConfig::default(), 7),
+        Some(fit)
+    );
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn rigid_msac_refuses_degenerate_and_too_small_sets() {
+    let cfg = RigidConfig::default();
+    // All points within a few centimetres: no angle can be read.
+    let b: Vec<DVec2> = (0..20)
+        .map(|i| DVec2::new(0.01 * (i % 4) as f64, 0.01 * (i / 4) as f64))
+        .collect();
+    assert_eq!(fit_rigid_msac(&b, &b, &cfg, 1), None);
+    // Too few pairs, mismatched lengths, non-finite input.
+    assert_eq!(fit_rigid_msac(&b[..3], &b[..3], &cfg, 1), None);
+    assert_eq!(fit_rigid_msac(&[], &[], &cfg, 1), None);
+    let mut bad: Vec<DVec2> = (0..10).map(|i| DVec2::new(i as f64, 0.0)).collect();
+    bad[3] = DVec2::new(f64::NAN, 0.0);
+    assert_eq!(fit_rigid_msac(&bad, &bad, &cfg, 1), None);
+}
+
+// ----- vocabulary -----------------------------------------------------------
+
+fn wall(a: [f64; 2], b: [f64; 2], texture: &str) -> WallSpec {
+    WallSpec {
+        from: a,
+        to: b,
+        texture: Some(texture.into()),
+    }
+}
+
+fn upright() -> SurfConfig {
+    SurfConfig {
+        upright: true,
+        ..SurfConfig::default()
+    }
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn vocabulary_ranks_the_true_pair_first_among_frames_of_different_textures() {
+    // A 12 m × 12 m room, each wall its own style; robot A looks at each
+    // wall from 3 m, robot B from 3.6 m, 0.5 m aside and turned 8°.
+    let walls = vec![
+        wall([0.0, 0.0], [12.0, 0.0], "posters"),
+        wall([12.0, 0.0], [12.0, 12.0], "signs"),
+        wall([12.0, 12.0], [0.0, 12.0], "graffiti"),
+        wall([0.0, 12.0], [0.0, 0.0], "wood"),
+    ];
+    let world = World::new(walls.iter().map(|w| w.segment()).collect());
+    let mut bank = TextureBank::new(3, 2.5);
+    let cam = camera();
+    let centre = DVec2::new(6.0, 6.0);
+    let shot = |bank: &mut TextureBank, pose: Pose2| {
+        let img = render(&cam, &pose, &world, &walls, &[], bank, false, None);
+        let gray =
+            GrayImage::new(img.width as usize, img.height as usize, img.gray).expect("image");
+        extract(&gray, &upright())
+    };
+    let mut fa = Vec::new();
+    let mut fb = Vec::new();
+    for k in 0..4 {
+        // Facing wall k: headings -90°, 0°, 90°, 180°.
+        let heading = -PI / 2.0 + k as f64 * PI / 2.0;
+        let dir = DVec2::from_angle(heading);
+        let a = centre + dir * 3.0;
+        let b = centre + dir * 2.4 + dir.perp() * 0.5;
+        fa.push(shot(&mut bank, Pose2::new(a.x, a.y, heading)));
+        fb.push(shot(
+            &mut bank,
+            Pose2::new(b.x, b.y, heading + 8f64.to_radians()),
+        ));
+    }
+    for f in fa.iter().chain(&fb) {
+        assert!(f.len() > 50, "textured walls give keypoints: {}", f.len());
+    }
+    let sets: Vec<&Features> = fa.iter().chain(&fb).collect();
+    let (vocab, bags) = Vocabulary::train_with_bags(&sets, &VocabularyConfig::default(), 5);
+    assert!(vocab.len() > 100, "{} words", vocab.len());
+    // The bags from training are the bags `bag` gives.
+    assert_eq!(bags[1], vocab.bag(&fa[1]));
+    let (ba, bb) = (&bags[..4], &bags[4..]);
+    for (i, bag) in ba.iter().enumerate() {
+        let scores: Vec<f64> = bb.iter().map(|b| similarity(bag, b)).collect();
+        let best = (0..4)
+            .max_by(|&x, &y| scores[x].total_cmp(&scores[y]))
+            .unwrap_or(9);
+        assert_eq!(best, i, "frame {i}: {scores:?}");
+    }
+    // Proposals, best first: the four true pairs lead.
+    let props = propose_pairs(ba, bb, 1, 10);
+    let mut first: Vec<(usize, usize)> = props.iter().take(4).map(|p| (p.0, p.1)).collect();
+    first.sort_unstable();
+    assert_eq!(first, vec![(0, 0), (1, 1), (2, 2), (3, 3)], "{props:?}");
+    assert!(props.windows(2).all(|w| w[0].2 >= w[1].2));
+    // Nothing in common, nothing proposed.
+    let empty = vocab.bag(&Features::default());
+    assert!(empty.is_empty());
+    assert!(propose_pairs(std::slice::from_ref(&empty), bb, 3, 10).is_empty());
+    assert_eq!(similarity(&empty, &bb[0]), 0.0);
+}
+
+// ----- consistency ----------------------------------------------------------
+
+fn candidate(truth: &Pose2, place_b: DVec2, frame: usize) -> Candidate {
+    Candidate {
+        a_frame: frame,
+        b_frame: frame,
+        pose: *truth,
+        inliers: 30,
+        rms_m: 0.02,
+        place_a: truth.transform_point(place_b),
+        place_b,
+    }
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn pairwise_consistency_tolerates_more_between_distant_places() {
+    let cfg = ConsistencyConfig::default();
+    let truth = Pose2::new(5.0, 2.0, 0.5);
+    let c1 = candidate(&truth, DVec2::new(0.0, 0.0), 1);
+    // The same place, transform shifted 0.35 m: more than the 0.25 m allowed.
+    let mut c2 = candidate(&truth, DVec2::new(0.5, 0.0), 2);
+    c2.pose.x += 0.35;
+    assert!(!pairwise_consistent(&c1, &c2, &cfg));
+    // 10 m apart, the same shift is within 0.25 + 0.04·10 = 0.65 m.
+    let mut c3 = candidate(&truth, DVec2::new(10.0, 0.0), 3);
+    c3.pose.x += 0.35;
+    assert!(pairwise_consistent(&c1, &c3, &cfg));
+    // An angle 4° off at one place: beyond 3°.
+    let mut c4 = candidate(&truth, DVec2::new(0.5, 0.0), 4);
+    c4.pose.theta += 4f64.to_radians();
+    assert!(!pairwise_consistent(&c1, &c4, &cfg));
+    assert!(pairwise_consistent(&c1, &c1, &cfg));
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn pcm_rejects_an_inconsistent_candidate_and_counts_places_not_frames() {
+    let cfg = ConsistencyConfig::default();
+    let truth = Pose2::new(-3.0, 8.0, 2.0);
+    let mut cands: Vec<Candidate> = [
+        DVec2::new(0.0, 0.0),
+        DVec2::new(4.0, 1.0),
+        DVec2::new(8.0, -2.0),
+        DVec2::new(3.0, 6.0),
+    ]
+    .iter()
+    .enumerate()
+    .map(|(k, &p)| candidate(&truth, p, k))
+    .collect();
+    // A fifth, 1 m off (a repeated texture elsewhere), with the most inliers.
+    let mut wrong = candidate(&Pose2::new(-2.0, 8.0, 2.0), DVec2::new(6.0, 3.0), 9);
+    wrong.inliers = 90;
+    cands.push(wrong);
+    assert_eq!(max_consistent_set(&cands, &cfg), vec![0, 1, 2, 3]);
+    assert_eq!(max_consistent_places(&cands, &cfg).places, 4);
+    // Ten frames a second apart at one place are one place, whatever their
+    // number: they would all be fooled together.
+    let one_place: Vec<Candidate> = (0..10)
+        .map(|k| candidate(&truth, DVec2::new(0.1 * k as f64, 0.0), k))
+        .collect();
+    let set = max_consistent_places(&one_place, &cfg);
+    assert_eq!(set.members.len(), 10);
+    assert_eq!(set.places, 1);
+    assert_eq!(independent_places(&one_place, &set.members, &cfg), 1);
+    assert!(max_consistent_set(&[], &cfg).is_empty());
+}
+
+// ----- runs on simulated robots ---------------------------------------------
+
+/// A loop corridor 2 m wide around a 4 m × 2 m block, with a stub on the
+/// right to break the symmetry; each wall its own texture. The robots start
+/// on opposite sides, facing opposite ways, both following the outer wall.
+const CORRIDOR: &str = r#"{
+  "name": "corridor-loop", "seed": 3, "duration_s": 70,
+  "walls": [
+    {"from": [0, 0], "to": [9, 0], "texture": "posters"},
+    {"from": [9, 0], "to": [9, 6], "texture": "signs"},
+    {"from": [9, 6], "to": [0, 6], "texture": "graffiti"},
+    {"from": [0, 6], "to": [0, 0], "texture": "bookshelf"},
+    {"from": [2.5, 2], "to": [6.5, 2], "texture": "brick"},
+    {"from": [6.5, 2], "to": [6.5, 4], "texture": "maps"},
+    {"from": [6.5, 4], "to": [2.5, 4], "texture": "crates"},
+    {"from": [2.5, 4], "to": [2.5, 2], "texture": "tiles"},
+    {"from": [9, 3], "to": [8.3, 3], "texture": "mosaic"}
+  ],
+  "robots": [
+    {"name": "robot1", "start": [1.5, 0.9, 0.0], "follow": "right"},
+    {"name": "robot2", "start": [7.5, 5.1, 3.1416], "follow": "right"}
+  ]
+}"#;
+
+/// Two rooms 10 m apart, one robot in each.
+const TWO_ROOMS: &str = r#"{
+  "name": "two-rooms", "seed": 4, "duration_s": 50,
+  "walls": [
+    {"from": [0, 0], "to": [6, 0], "texture": "posters"},
+    {"from": [6, 0], "to": [6, 5], "texture": "signs"},
+    {"from": [6, 5], "to": [0, 5], "texture": "graffiti"},
+    {"from": [0, 5], "to": [0, 0], "texture": "wood"},
+    {"from": [16, 0], "to": [22, 0], "texture": "maps"},
+    {"from": [22, 0], "to": [22, 5], "texture": "crates"},
+    {"from": [22, 5], "to": [16, 5], "texture": "bookshelf"},
+    {"from": [16, 5], "to": [16, 0], "texture": "tiles"}
+  ],
+  "robots": [
+    {"name": "robot1", "start": [1.5, 1.0, 0.0], "follow": "right"},
+    {"name": "robot2", "start": [20.5, 4.0, 3.1416], "follow": "right"}
+  ]
+}"#;
+
+fn run(json: &str) -> Simulation {
+    let scenario = Scenario::parse(json).expect("scenario parses");
+    let mut sim = Simulation::new(&scenario).expect("scenario runs");
+    sim.run_to_end();
+    sim
+}
+
+/// Pose of robot 1's map frame in robot 0's, from the true starts (tests
+/// only).
+fn truth_b_in_a(sim: &Simulation) -> Pose2 {
+    let (a, b) = (
+        sim.robots[0].spec.start_pose(),
+        sim.robots[1].spec.start_pose(),
+    );
+    a.inverse().compose(&b)
+}
+
+/// What robot `i` knew at each frame: the SLAM estimate of the frame's step,
+/// the odometry turn over the last step.
+fn frame_infos(sim: &Simulation, i: usize) -> Vec<FrameInfo> {
+    let r = &sim.robots[i];
+    let odometry = &r.log.odometry;
+    r.frames
+        .frames
+        .iter()
+        .map(|f| {
+            let before = f.step.checked_sub(1).and_then(|s| odometry.get(s));
+            FrameInfo {
+                index: f.index,
+                step: f.step,
+                pose: r
+                    .mapping
+                    .estimates()
+                    .get(f.step)
+                    .copied()
+                    .unwrap_or(f.odometry),
+                odometry: f.odometry,
+                turn_rad: before.map_or(0.0, |b| wrap_angle(f.odometry.theta - b.theta)),
+                sonar_m: f.sonar_m,
+                laser_mm: f.laser_mm,
+            }
+        })
+        .collect()
+}
+
+fn features(sim: &Simulation, i: usize) -> Vec<Features> {
+    sim.robots[i]
+        .frames
+        .frames
+        .iter()
+        .map(|f| {
+            let img =
+                GrayImage::new(f.width as usize, f.height as usize, f.gray.clone()).expect("frame");
+            extract(&img, &upright())
+        })
+        .collect()
+}
+
+/// The automatic chain on a finished run: features, place recognition on
+/// the keypoints that lift, verification, verdict.
+fn merge_auto(sim: &Simulation) -> (Vec<Candidate>, slamlab::merge::verdict::PairDecision) {
+    let cam = sim.camera.clone();
+    let infos = [frame_infos(sim, 0), frame_infos(sim, 1)];
+    let feats = [features(sim, 0), features(sim, 1)];
+    let mean_kp = feats.iter().flatten().map(|f| f.len()).sum::<usize>() as f64
+        / feats.iter().map(|f| f.len()).sum::<usize>().max(1) as f64;
+    assert!(
+        (80.0..500.0).contains(&mean_kp),
+        "keypoints per 320 × 240 frame: {mean_kp}"
+    );
+    let lifted: Vec<Features> = (0..2)
+        .flat_map(|r| {
+            feats[r]
+                .iter()
+                .zip(&infos[r])
+                .map(|(f, info)| liftable_features(&cam, info, f))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let sets: Vec<&Features> = lifted.iter().collect();
+    let (_, bags) = Vocabulary::train_with_bags(&sets, &VocabularyConfig::default(), 1);
+    let n0 = feats[0].len();
+    let proposals = propose_pairs(&bags[..n0], &bags[n0..], 3, 300);
+    let cands: Vec<Candidate> = proposals
+        .iter()
+        .enumerate()
+        .filter_map(|(k, &(i, j, _))| {
+            verify_pair(
+                &cam,
+                &infos[0][i],
+                &feats[0][i],
+                &infos[1][j],
+                &feats[1][j],
+                &VerifyConfig::default(),
+                k as u64,
+            )
+            .candidate
+        })
+        .collect();
+    let map_a = sim.robots[0].mapping.map(MapperKind::Slam);
+    let map_b = sim.robots[1].mapping.map(MapperKind::Slam);
+    let d = decide_pair(&cands, map_a, map_b, &VerdictConfig::default());
+    (cands, d)
+}
+
+fn pose_error(p: &Pose2, truth: &Pose2) -> (f64, f64) {
+    (
+        (p.position() - truth.position()).length(),
+        wrap_angle(p.theta - truth.theta).abs().to_degrees(),
+    )
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn two_robots_touring_one_corridor_from_different_starts_are_merged_within_0_1_m_and_1_degree() {
+    let sim = run(CORRIDOR);
+    let truth = truth_b_in_a(&sim);
+    let (cands, d) = merge_auto(&sim);
+    assert!(cands.len() >= 4, "{} candidates", cands.len());
+    assert_eq!(d.status, MergeStatus::Merged, "{}", d.reason);
+    assert!(d.reason.starts_with("merged:"), "{}", d.reason);
+    let (m, deg) = pose_error(&d.pose.expect("pose"), &truth);
+    assert!(
+        m < 0.1 && deg < 1.0,
+        "error {m:.3} m {deg:.2}° ({})",
+        d.reason
+    );
+    assert!(d.places >= 2 && d.confidence > 0.5, "{d:?}");
+    // Every supporting candidate is right where its frames are.
+    for &i in &d.support {
+        let c = &cands[i];
+        let e = (c.pose.transform_point(c.place_b) - truth.transform_point(c.place_b)).length();
+        assert!(e < 0.15, "candidate {i} off by {e:.3} m");
+    }
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn robots_in_two_separate_rooms_are_not_merged() {
+    let sim = run(TWO_ROOMS);
+    let (_, d) = merge_auto(&sim);
+    assert_eq!(d.status, MergeStatus::NoMerge, "{}", d.reason);
+    assert!(d.confidence == 0.0);
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn grid_alignment_recovers_a_perturbed_transform_and_the_verdict_refuses_wrong_ones() {
+    let sim = run(CORRIDOR);
+    let truth = truth_b_in_a(&sim);
+    let map_a = sim.robots[0].mapping.map(MapperKind::Slam);
+    let map_b = sim.robots[1].mapping.map(MapperKind::Slam);
+    // Alignment: 0.25 m and 2° off, back to within 3 cm and 0.3°.
+    let guess = truth.compose(&Pose2::new(0.2, -0.15, 2f64.to_radians()));
+    let aligned = refine_alignment(map_a, map_b, &guess, &AlignConfig::default()).expect("aligns");
+    let (m, deg) = pose_error(&aligned.pose, &truth);
+    assert!(m < 0.03 && deg < 0.3, "aligned {m:.3} m {deg:.2}°");
+    assert!(aligned.matched_cells > 200, "{}", aligned.matched_cells);
+    // The maps agree at the truth, with no wall in the other's free space.
+    let at_truth = map_agreement(map_a, map_b, &truth);
+    assert!(at_truth.min_direction_agree > 200, "{at_truth:?}");
+    assert!(at_truth.contradiction() < 0.01, "{at_truth:?}");
+    // Candidates from two places that agree on the truth: merged.
+    let cand = |p: DVec2, pose: Pose2, k: usize| Candidate {
+        a_frame: k,
+        b_frame: k,
+        pose,
+        inliers: 20,
+        rms_m: 0.02,
+        place_a: pose.transform_point(p),
+        place_b: p,
+    };
+    let b_places = [
+        truth.inverse().transform_point(DVec2::new(4.5, 0.6)),
+        truth.inverse().transform_point(DVec2::new(4.5, 5.4)),
+    ];
+    let cfg = VerdictConfig::default();
+    let right: Vec<Candidate> = b_places
+        .iter()
+        .enumerate()
+        .map(|(k, &p)| cand(p, truth, k))
+        .collect();
+    let d = decide_pair(&right, map_a, map_b, &cfg);
+    assert_eq!(d.status, MergeStatus::Merged, "{}", d.reason);
+    let (m, deg) = pose_error(&d.pose.expect("pose"), &truth);
+    assert!(m < 0.05 && deg < 0.5, "{m:.3} m {deg:.2}°");
+    // The same two places agreeing on a transform 1 m off, or turned 30°
+    // about the corridor's centre: the overlaid maps contradict.
+    let shifted = Pose2::new(1.0, 0.0, 0.0).compose(&truth);
+    let centre = Pose2::new(4.5, 3.0, 0.0);
+    let turned = centre
+        .compose(&Pose2::new(0.0, 0.0, 30f64.to_radians()))
+        .compose(&centre.inverse())
+        .compose(&truth);
+    for wrong in [shifted, turned] {
+        let cands: Vec<Candidate> = b_places
+            .iter()
+            .enumerate()
+            .map(|(k, &p)| cand(p, wrong, k))
+            .collect();
+        let d = decide_pair(&cands, map_a, map_b, &cfg);
+        assert_eq!(d.status, MergeStatus::NoMerge);
+        assert!(d.reason.starts_with("maps contradict"), "{}", d.reason);
+        let a = d.agreement.expect("judged on the maps");
+        assert!(a.occupied_contradict > 50, "{a:?}");
+    }
+    // One place alone is not enough, however good.
+    let d = decide_pair(&right[..1], map_a, map_b, &cfg);
+    assert_eq!(d.status, MergeStatus::NoMerge);
+    assert!(d.reason.starts_with("too little evidence"), "{}", d.reason);
+    let d = decide_pair(&[], map_a, map_b, &cfg);
+    assert!(d.reason.starts_with("no common place seen"), "{}", d.reason);
+}
+
+// ----- fusion and the spanning tree -----------------------------------------
+
+/// A grid with one straight wall seen from `from`: beams to the points of
+/// the segment `a`–`b`.
+fn wall_grid(from: DVec2, a: DVec2, b: DVec2, scans: usize) -> OccupancyGrid {
+    let mut g = OccupancyGrid::new(GridConfig::default());
+    assert!(g.ensure_contains(a.min(b).min(from) - 1.0, a.max(b).max(from) + 1.0));
+    for _ in 0..scans {
+        for k in 0..=100 {
+            g.integrate_beam(from, a + (b - a) * (k as f64 / 100.0), true);
+        }
+    }
+    g
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn fusion_adds_log_odds_and_resamples_rotated_maps_without_holes() {
+    let cfg = GridConfig::default();
+    // A: a wall along y = 2 for x in [-1, 1], seen from the origin 3 times.
+    let a = wall_grid(DVec2::ZERO, DVec2::new(-1.0, 2.0), DVec2::new(1.0, 2.0), 3);
+    // The same wall in a frame turned 90° and shifted: B's frame at
+    // (0.5, 0, 90°) in A's, so A's (x, y) is B's (y, 0.5 − x).
+    let pose_b = Pose2::new(0.5, 0.0, PI / 2.0);
+    let to_b = |p: DVec2| pose_b.inverse_transform_point(p);
+    let b = wall_grid(
+        to_b(DVec2::ZERO),
+        to_b(DVec2::new(-1.0, 2.0)),
+        to_b(DVec2::new(1.0, 2.0)),
+        3,
+    );
+    let merged = fuse(&[(&a, Pose2::IDENTITY), (&b, pose_b)], cfg.clone());
+    let units = |g: &OccupancyGrid, p: DVec2| {
+        g.local(g.global_cell(p))
+            .map_or(0, |(x, y)| g.units(x, y) as i32)
+    };
+    // On the wall both maps say "occupied", in front of it both say "free":
+    // the merge holds the sum of the two, clamped to [−40, 70].
+    let b_units = |p: DVec2| units(&b, to_b(p));
+    for p in [
+        DVec2::new(0.025, 2.025),
+        DVec2::new(-0.725, 2.025),
+        DVec2::new(0.025, 1.025),
+        DVec2::new(0.475, 1.525),
+    ] {
+        let expected = (units(&a, p) + b_units(p)).clamp(-40, 70);
+        assert_eq!(units(&merged, p), expected, "at {p}");
+    }
+    let on_wall = DVec2::new(0.025, 2.025);
+    assert!(units(&a, on_wall) > 13 && b_units(on_wall) > 13);
+    assert_eq!(units(&merged, on_wall), 70);
+    let free = DVec2::new(0.025, 1.025);
+    assert!(units(&a, free) < -16 && b_units(free) < -16);
+    // Every cell of the triangle both maps cleared is free in the merge: no
+    // holes from the rotated lattice.
+    let mut holes = 0;
+    for iy in 0..merged.height() {
+        for ix in 0..merged.width() {
+            let c = merged.cell_centre(ix, iy);
+            if c.y > 0.3
+                && c.y < 1.7
+                && c.x.abs() < 0.3 * c.y
+                && merged.state(ix, iy) != CellState::Free
+            {
+                holes += 1;
+            }
+        }
+    }
+    assert_eq!(holes, 0);
+    // Fusing one map alone reproduces it; nothing to fuse gives an empty grid.
+    let alone = fuse(&[(&a, Pose2::IDENTITY)], cfg.clone());
+    assert_eq!(units(&alone, on_wall), units(&a, on_wall));
+    assert_eq!(alone.occupied_count(), a.occupied_count());
+    assert_eq!(fuse(&[], cfg.clone()).width(), 0);
+    let empty = OccupancyGrid::new(cfg.clone());
+    assert_eq!(fuse(&[(&empty, Pose2::IDENTITY)], cfg).width(), 0);
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn spanning_tree_joins_three_robots_by_the_surest_edges_and_lists_the_fourth() {
+    let e01 = Pose2::new(2.0, 0.0, PI / 2.0);
+    let e12 = Pose2::new(1.0, 1.0, 0.0);
+    let edges = [
+        PairEdge {
+            a: 0,
+            b: 1,
+            pose: e01,
+            confidence: 0.9,
+        },
+        // Stored from 2 to 1: robot 1's frame in robot 2's.
+        PairEdge {
+            a: 2,
+            b: 1,
+            pose: e12.inverse(),
+            confidence: 0.8,
+        },
+        // A weaker, slightly different direct edge: not used.
+        PairEdge {
+            a: 0,
+            b: 2,
+            pose: Pose2::new(1.1, 1.0, PI / 2.0),
+            confidence: 0.5,
+        },
+        // Robot 3 has only a worthless edge.
+        PairEdge {
+            a: 3,
+            b: 1,
+            pose: Pose2::IDENTITY,
+            confidence: 0.0,
+        },
+    ];
+    let joined = spanning_tree(4, &edges);
+    assert_eq!(joined.edges_used, vec![0, 1]);
+    assert_eq!(joined.poses[0], Some(Pose2::IDENTITY));
+    assert_eq!(joined.poses[1], Some(e01));
+    // Robot 2's frame = e01 ⊕ e12: (2, 0) + R(90°)·(1, 1) = (1, 1), heading 90°.
+    let p2 = joined.poses[2].expect("joined");
+    assert!((p2.x - 1.0).abs() < 1e-12 && (p2.y - 1.0).abs() < 1e-12);
+    assert!((p2.theta - PI / 2.0).abs() < 1e-12);
+    assert_eq!(joined.poses[3], None);
+    assert_eq!(joined.unjoined(), vec![3]);
+    // No edges: only robot 0; no robots: nothing.
+    assert_eq!(spanning_tree(2, &[]).unjoined(), vec![1]);
+    assert!(spanning_tree(0, &edges).poses.is_empty());
+}

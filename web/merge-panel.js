@@ -1,0 +1,424 @@
+// Merging the robots' maps (crate/src/merge), step by step in the page.
+//
+// "Merge maps" starts a merge of the current run with the chosen method.
+// The work runs in small slices from the animation loop (a few
+// milliseconds per frame), so the page stays responsive while the
+// matched-pair table fills in: one row per frame of the first robot, one
+// column per frame of the second, each checked pair a cell coloured by its
+// inlier count (the thesis's Table 1). Clicking a cell opens the two frames
+// with their matches and the matched-region quad (thesis Figure 8). At the
+// end the verdict appears with its reason, the transform of each robot's map
+// frame, its error against the ground truth, and the merged map with
+// downloads (PNG, ROS map_server PGM + YAML, report JSON).
+
+import { robotColour } from './robots-panel.js';
+
+const SLICE_MS = 12;
+const TABLE_W = 330;
+const MAP_W = 330;
+const MAP_H = 240;
+
+const METHODS = [
+  ['auto', 'Automatic (any view, verified)'],
+  ['thesis', 'Thesis §6.2 (square views)'],
+  ['map-only', 'Map-only baseline (grid features)'],
+];
+
+const fmt = (x, d = 2) => (Number.isFinite(x) ? x.toFixed(d) : '–');
+const deg = (rad) => (rad * 180) / Math.PI;
+
+function el(tag, props = {}, ...children) {
+  const e = document.createElement(tag);
+  for (const [k, v] of Object.entries(props)) {
+    if (k === 'class') e.className = v;
+    else if (k === 'text') e.textContent = v;
+    else e.setAttribute(k, v);
+  }
+  e.append(...children);
+  return e;
+}
+
+export class MergePanel {
+  /**
+   * @param {HTMLElement} host the panel's body
+   * @param {HTMLElement} pairHost an overlay element for the pair view
+   * @param {{lab: () => any, canMerge: () => boolean, onError: (e: unknown) => void,
+   *          setStatus: (text: string, kind: string) => void,
+   *          download: (name: string, data: BlobPart, type: string) => void,
+   *          report: () => string}} hooks
+   */
+  constructor(host, pairHost, hooks) {
+    this.host = host;
+    this.pairHost = pairHost;
+    this.hooks = hooks;
+    this.method = 'auto';
+    this.active = false; // a merge is being computed
+    this.view = null; // last mergeViewJson
+    this.build();
+  }
+
+  build() {
+    const select = el('select', { id: 'merge-method', 'aria-label': 'Merge method' });
+    for (const [value, text] of METHODS) {
+      const o = el('option', { value, text });
+      if (value === this.method) o.selected = true;
+      select.append(o);
+    }
+    select.addEventListener('change', () => {
+      this.method = select.value;
+    });
+    this.button = el('button', { type: 'button', id: 'merge-run', class: 'primary', text: 'Merge maps' });
+    this.button.addEventListener('click', () => this.start());
+    this.progress = el('progress', { id: 'merge-progress', max: '1', value: '0', 'aria-label': 'Merge progress' });
+    this.stageText = el('span', { class: 'hint', id: 'merge-stage', text: '' });
+    this.hint = el('p', { class: 'hint', id: 'merge-hint' });
+    this.tableTitle = el('div', { class: 'map-title', text: 'Matched-pair table' });
+    this.table = el('canvas', {
+      id: 'merge-table', class: 'merge-table', width: String(TABLE_W), height: '60',
+      role: 'img', tabindex: '0', 'aria-label': 'Matched-pair table: inlier counts per frame pair',
+    });
+    this.tableHint = el('p', { class: 'hint', id: 'merge-table-hint' });
+    this.table.addEventListener('mousemove', (e) => this.hover(e));
+    this.table.addEventListener('click', (e) => this.clickCell(e));
+    this.table.addEventListener('keydown', (e) => {
+      if (e.key !== 'Enter' || !this.bestCell()) return;
+      // Without this the same Enter would press the Close button that
+      // receives the focus when the pair view opens.
+      e.preventDefault();
+      this.openPair(...this.bestCell());
+    });
+    this.verdict = el('div', { id: 'merge-verdict', class: 'merge-verdict', role: 'status', 'aria-live': 'polite' });
+    this.transforms = el('table', { id: 'merge-transforms', class: 'merge-transforms' });
+    this.map = el('canvas', {
+      id: 'merge-map', class: 'map-view', width: String(MAP_W), height: String(MAP_H),
+      role: 'img', 'aria-label': 'Merged map',
+    });
+    this.downloads = el('div', { class: 'merge-downloads' });
+    for (const [label, fn] of [
+      ['Merged map PNG', () => this.hooks.download('merged.png', this.lab().mergedPng(), 'image/png')],
+      ['ROS map (PGM + YAML)', () => {
+        this.hooks.download('merged.pgm', this.lab().mergedPgm(), 'image/x-portable-graymap');
+        this.hooks.download('merged.yaml', this.lab().mergedYaml('merged.pgm'), 'text/yaml');
+      }],
+      ['Report JSON', () => this.hooks.download('report.json', this.hooks.report(), 'application/json')],
+    ]) {
+      const b = el('button', { type: 'button', class: 'linkish', text: label });
+      b.addEventListener('click', () => {
+        try {
+          fn();
+        } catch (e) {
+          this.hooks.onError(e);
+        }
+      });
+      this.downloads.append(b);
+    }
+    this.result = el('div', { class: 'merge-result', hidden: '' }, this.verdict, this.transforms, this.map, this.downloads);
+    this.tableBox = el('div', { class: 'merge-table-box', hidden: '' }, this.tableTitle, this.table, this.tableHint);
+    this.host.replaceChildren(
+      el('div', { class: 'merge-controls' }, select, this.button),
+      el('div', { class: 'merge-progress-row' }, this.progress, this.stageText),
+      this.hint,
+      this.tableBox,
+      this.result,
+    );
+    this.refreshIdle();
+  }
+
+  lab() {
+    return this.hooks.lab();
+  }
+
+  /** Called when the run changed: any merge of the old maps is gone. */
+  invalidate() {
+    this.active = false;
+    this.view = null;
+    this.tableBox.hidden = true;
+    this.result.hidden = true;
+    this.progress.value = 0;
+    this.stageText.textContent = '';
+    this.closePair();
+    this.refreshIdle();
+  }
+
+  refreshIdle() {
+    const can = this.hooks.canMerge();
+    this.button.disabled = !can || this.active;
+    if (!this.view && !this.active) {
+      this.hint.textContent = can
+        ? 'Merge the robots\u2019 maps now, or let them run longer first: the more they have seen in common, the better.'
+        : 'Run the robots (or pause them) to merge their maps.';
+    }
+  }
+
+  start() {
+    try {
+      this.lab().mergeStart(this.method);
+      this.active = true;
+      this.view = null;
+      this.result.hidden = true;
+      this.tableBox.hidden = this.method === 'map-only';
+      this.hint.textContent = '';
+      this.closePair();
+      this.refreshIdle();
+      this.hooks.setStatus('Merging the maps…', 'info');
+    } catch (e) {
+      this.hooks.onError(e);
+    }
+  }
+
+  /** Called every animation frame. */
+  update() {
+    if (!this.active) {
+      // Stepping, resetting or editing drops the lab's merge: follow it.
+      if (this.view && !this.lab().hasMerge()) this.invalidate();
+      this.refreshIdle();
+      return;
+    }
+    const lab = this.lab();
+    let p;
+    const t0 = performance.now();
+    try {
+      do {
+        p = JSON.parse(lab.mergeAdvance(2));
+      } while (!p.finished && performance.now() - t0 < SLICE_MS);
+      this.view = JSON.parse(lab.mergeViewJson());
+    } catch (e) {
+      this.active = false;
+      this.hooks.onError(e);
+      this.refreshIdle();
+      return;
+    }
+    this.progress.max = Math.max(1, p.total);
+    this.progress.value = p.done;
+    this.stageText.textContent = p.finished ? 'done' : `${p.stage} ${p.done} / ${p.total}`;
+    this.drawTable();
+    if (p.finished) {
+      this.active = false;
+      this.showResult();
+      this.refreshIdle();
+    }
+  }
+
+  table0() {
+    return this.view?.tables?.[0] ?? null;
+  }
+
+  geometry() {
+    const t = this.table0();
+    if (!t) return null;
+    const rows = Math.max(1, t.rows);
+    const cols = Math.max(1, t.cols);
+    const cell = Math.max(1, Math.min(16, Math.floor((TABLE_W - 24) / cols)));
+    const cellH = Math.max(1, Math.min(16, Math.floor(260 / rows), cell * 2));
+    return { t, rows, cols, cell, cellH, x0: 20, y0: 14 };
+  }
+
+  drawTable() {
+    const g = this.geometry();
+    if (!g) return;
+    const { t, rows, cols, cell, cellH, x0, y0 } = g;
+    const h = y0 + rows * cellH + 4;
+    if (this.table.height !== h) this.table.height = h;
+    const ctx = this.table.getContext('2d');
+    ctx.fillStyle = '#fff';
+    ctx.fillRect(0, 0, this.table.width, this.table.height);
+    ctx.fillStyle = '#eee';
+    ctx.fillRect(x0, y0, cols * cell, rows * cellH);
+    const max = Math.max(1, ...t.cells.map((c) => c[2]));
+    for (const [r, c, inl] of t.cells) {
+      const v = inl / max;
+      // white (0) → deep blue (max), checked-but-empty cells pale grey
+      const light = inl === 0 ? 92 : 95 - 60 * v;
+      ctx.fillStyle = inl === 0 ? 'hsl(0 0% 86%)' : `hsl(215 70% ${light}%)`;
+      ctx.fillRect(x0 + c * cell, y0 + r * cellH, Math.max(1, cell - (cell > 3 ? 1 : 0)), Math.max(1, cellH - (cellH > 3 ? 1 : 0)));
+      if (cell >= 14 && cellH >= 10 && inl > 0) {
+        ctx.fillStyle = v > 0.55 ? '#fff' : '#123';
+        ctx.font = '8px system-ui, sans-serif';
+        ctx.textAlign = 'center';
+        ctx.fillText(String(inl), x0 + c * cell + cell / 2, y0 + r * cellH + cellH / 2 + 3);
+      }
+    }
+    if (t.best) {
+      const [r, c] = t.best;
+      ctx.strokeStyle = '#e6550d';
+      ctx.lineWidth = 2;
+      ctx.strokeRect(x0 + c * cell - 1, y0 + r * cellH - 1, cell + 1, cellH + 1);
+    }
+    const names = this.view.robots;
+    ctx.fillStyle = robotColour(t.a);
+    ctx.font = '10px system-ui, sans-serif';
+    ctx.textAlign = 'left';
+    ctx.save();
+    ctx.translate(10, y0 + 2);
+    ctx.rotate(Math.PI / 2);
+    ctx.fillText(`${names[t.a].name} frames ↓`, 0, 0);
+    ctx.restore();
+    ctx.fillStyle = robotColour(t.b);
+    ctx.fillText(`${names[t.b].name} frames →`, x0, 10);
+    const checked = t.cells.length;
+    const planned = t.planned;
+    const extra = this.view.tables.length > 1 ? ` (first of ${this.view.tables.length} robot pairs)` : '';
+    this.tableHint.textContent =
+      `${rows} × ${cols} frames, ${checked} of ${planned} pairs checked${extra}. ` +
+      (this.view.method === 'thesis'
+        ? 'Cells: MSAC homography inliers, as the thesis\u2019s Table 1. '
+        : 'Cells: matches that agree on one rigid transform (laser-lifted keypoints). ') +
+      'Click a cell to see its matches; orange box: the best pair.';
+  }
+
+  cellAt(e) {
+    const g = this.geometry();
+    if (!g) return null;
+    const r = this.table.getBoundingClientRect();
+    const x = ((e.clientX - r.left) * this.table.width) / r.width;
+    const y = ((e.clientY - r.top) * this.table.height) / r.height;
+    const col = Math.floor((x - g.x0) / g.cell);
+    const row = Math.floor((y - g.y0) / g.cellH);
+    if (row < 0 || col < 0 || row >= g.rows || col >= g.cols) return null;
+    const found = g.t.cells.find((c) => c[0] === row && c[1] === col);
+    return { row, col, found };
+  }
+
+  hover(e) {
+    const c = this.cellAt(e);
+    if (!c) {
+      this.table.title = '';
+      return;
+    }
+    const names = this.view.robots;
+    const t = this.table0();
+    const fa = names[t.a].frames[c.row];
+    const fb = names[t.b].frames[c.col];
+    this.table.title = c.found
+      ? `${names[t.a].name} frame ${fa} × ${names[t.b].name} frame ${fb}: ${c.found[2]} inliers of ${c.found[3]} matches`
+      : `${names[t.a].name} frame ${fa} × ${names[t.b].name} frame ${fb}: not checked`;
+  }
+
+  bestCell() {
+    const t = this.table0();
+    return t?.best ? [t.best[0], t.best[1]] : null;
+  }
+
+  clickCell(e) {
+    const c = this.cellAt(e);
+    if (c?.found) this.openPair(c.row, c.col);
+  }
+
+  /** The two frames side by side with their matches and the quad. */
+  openPair(row, col) {
+    let pv;
+    const t = this.table0();
+    try {
+      pv = JSON.parse(this.lab().mergePairJson(t.pair, row, col));
+    } catch (e) {
+      this.hooks.onError(e);
+      return;
+    }
+    const lab = this.lab();
+    const ia = t.a;
+    const ib = t.b;
+    const meta = JSON.parse(lab.cameraInfo());
+    const w = meta.width;
+    const h = meta.height;
+    const gap = 12;
+    const canvas = el('canvas', { width: String(2 * w + gap), height: String(h), class: 'pair-canvas', role: 'img',
+      'aria-label': `Frame ${pv.a_frame} of ${pv.a} and frame ${pv.b_frame} of ${pv.b} with their matches` });
+    const ctx = canvas.getContext('2d');
+    ctx.fillStyle = '#fff';
+    ctx.fillRect(0, 0, canvas.width, canvas.height);
+    const tmp = document.createElement('canvas');
+    tmp.width = w;
+    tmp.height = h;
+    const tctx = tmp.getContext('2d');
+    lab.drawFrame(ia, pv.a_frame, tctx);
+    ctx.drawImage(tmp, 0, 0);
+    lab.drawFrame(ib, pv.b_frame, tctx);
+    ctx.drawImage(tmp, w + gap, 0);
+    // matches: grey outliers, green rigid inliers (auto) / homography inliers (thesis)
+    const useRigid = this.view.method !== 'thesis';
+    for (const [x1, y1, x2, y2, hIn, rIn] of pv.matches) {
+      const inl = useRigid ? rIn : hIn;
+      ctx.strokeStyle = inl ? 'rgba(20,170,60,0.85)' : 'rgba(220,40,40,0.35)';
+      ctx.lineWidth = inl ? 1.2 : 0.8;
+      ctx.beginPath();
+      ctx.moveTo(x1 + 0.5, y1 + 0.5);
+      ctx.lineTo(x2 + 0.5 + w + gap, y2 + 0.5);
+      ctx.stroke();
+    }
+    if (pv.quad) {
+      ctx.strokeStyle = '#ffb000';
+      ctx.lineWidth = 2;
+      ctx.beginPath();
+      pv.quad.forEach(([x, y], k) => {
+        const px = x + 0.5 + w + gap;
+        const py = y + 0.5;
+        if (k === 0) ctx.moveTo(px, py);
+        else ctx.lineTo(px, py);
+      });
+      ctx.closePath();
+      ctx.stroke();
+    }
+    const inliers = useRigid ? pv.rigid_inliers : pv.homography_inliers;
+    const cand = pv.candidate
+      ? `This pair alone puts ${pv.b}\u2019s map frame at x ${fmt(pv.candidate[0])} m, y ${fmt(pv.candidate[1])} m, ` +
+        `θ ${fmt(deg(pv.candidate[2]), 1)}° in ${pv.a}\u2019s.`
+      : 'This pair gives no transform on its own.';
+    const close = el('button', { type: 'button', text: 'Close', 'aria-label': 'Close the pair view' });
+    close.addEventListener('click', () => this.closePair());
+    this.pairHost.replaceChildren(
+      el('h2', { text: `${pv.a} frame ${pv.a_frame} ↔ ${pv.b} frame ${pv.b_frame}` }),
+      canvas,
+      el('p', { text: `${pv.matches.length} ratio-test matches, ${inliers} inliers (green; red: rejected). ` +
+        (pv.quad ? 'Yellow: the first image\u2019s outline mapped into the second by the homography (thesis Figure 8). ' : '') + cand }),
+      close,
+    );
+    this.pairHost.hidden = false;
+    close.focus();
+  }
+
+  closePair() {
+    this.pairHost.hidden = true;
+    this.pairHost.replaceChildren();
+  }
+
+  showResult() {
+    const r = this.view?.report;
+    if (!r) return;
+    this.result.hidden = false;
+    const merged = r.status === 'merged';
+    this.verdict.className = `merge-verdict ${merged ? 'ok' : 'no'}`;
+    this.verdict.replaceChildren(
+      el('b', { text: merged ? `Merged (confidence ${fmt(r.confidence)})` : 'No merge' }),
+      el('span', { text: merged ? `: ${r.reason}` : `, because ${r.reason}` }),
+    );
+    const head = el('tr', {}, ...['robot', 'x (m)', 'y (m)', 'θ (°)', 'error'].map((t) => el('th', { text: t })));
+    const rows = r.transforms.map((t) => {
+      const e = r.errors.find((x) => x.robot === t.robot);
+      const i = this.view.robots.findIndex((x) => x.name === t.robot);
+      const name = el('td', { text: t.robot });
+      name.style.color = robotColour(i);
+      return el('tr', {}, name, el('td', { text: fmt(t.pose[0]) }), el('td', { text: fmt(t.pose[1]) }),
+        el('td', { text: fmt(deg(t.pose[2]), 1) }),
+        el('td', { text: e ? `${fmt(e.error_m, 3)} m, ${fmt(e.error_deg, 2)}°` : '–' }));
+    });
+    this.transforms.replaceChildren(
+      el('caption', { text: 'Each robot\u2019s map frame in the merged frame (the first robot\u2019s); error against the ground truth' }),
+      head, ...rows);
+    this.transforms.hidden = !merged;
+    this.map.hidden = !merged;
+    this.downloads.querySelectorAll('button').forEach((b, k) => {
+      b.hidden = !merged && k < 2;
+    });
+    if (merged) {
+      try {
+        this.lab().drawMerged(this.map.getContext('2d'), MAP_W, MAP_H);
+      } catch (e) {
+        this.hooks.onError(e);
+      }
+    }
+    this.hooks.setStatus(
+      merged ? `Maps merged: ${r.transforms.length} robots joined.` : `No merge: ${r.reason}`,
+      merged ? 'ok' : 'warn',
+    );
+  }
+}
