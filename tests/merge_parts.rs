@@ -17,6 +17,7 @@ use slamlab::merge::fuse::fuse;
 use slamlab::merge::graph::{spanning_tree, PairEdge};
 use slamlab::merge::lift::{
     column_bearing_rad, laser_range_at, lift_keypoint, lift_keypoint_3d, liftable_features,
+    liftable_keypoints,
 };
 use slamlab::merge::rigid::{fit_rigid_least_squares, fit_rigid_msac, RigidConfig};
 use slamlab::merge::verdict::{decide_pair, map_agreement, VerdictConfig};
@@ -147,6 +148,32 @@ fn lifted_keypoints_land_on_the_wall_in_the_map_frame() {
     assert_eq!(lift_keypoint(&cam, &empty, 159.5), None);
 }
 
+#[wasm_bindgen_test(unsupported = test)]
+fn only_keypoints_the_laser_reaches_are_kept_for_place_recognition() {
+    let cam = camera();
+    // The laser sees a wall 2 m ahead only to the left of the axis (bearings
+    // above 2°): columns left of x ≈ 149.8 lift, those right of it do not.
+    let frame = frame_with_ranges(Pose2::IDENTITY, |b| {
+        (b > 2f64.to_radians()).then(|| 2.0 / b.cos())
+    });
+    let mut f = Features::default();
+    for x in [10.0f32, 100.0, 140.0, 170.0, 300.0] {
+        f.keypoints.push(slamlab::surf::Keypoint {
+            x,
+            y: 120.0,
+            scale: 2.0,
+            orientation: 0.0,
+            laplacian: 1,
+            response: x,
+        });
+        f.descriptors.push(slamlab::surf::Descriptor([0.125; 64]));
+    }
+    assert_eq!(liftable_keypoints(&cam, &frame, &f), vec![0, 1, 2]);
+    let copy = liftable_features(&cam, &frame, &f);
+    assert_eq!(copy.keypoints.len(), 3);
+    assert_eq!(copy.keypoints[2].x, 140.0);
+}
+
 // ----- rigid ----------------------------------------------------------------
 
 #[wasm_bindgen_test(unsupported = test)]
@@ -272,8 +299,11 @@ fn vocabulary_ranks_the_true_pair_first_among_frames_of_different_textures() {
     let sets: Vec<&Features> = fa.iter().chain(&fb).collect();
     let (vocab, bags) = Vocabulary::train_with_bags(&sets, &VocabularyConfig::default(), 5);
     assert!(vocab.len() > 100, "{} words", vocab.len());
-    // The bags from training are the bags `bag` gives.
+    // The bags from training are the bags `bag` gives, and a bag of all
+    // keypoints by index is the same bag.
     assert_eq!(bags[1], vocab.bag(&fa[1]));
+    let all: Vec<usize> = (0..fa[1].len()).collect();
+    assert_eq!(vocab.bag_of(&fa[1], &all), bags[1]);
     let (ba, bb) = (&bags[..4], &bags[4..]);
     for (i, bag) in ba.iter().enumerate() {
         let scores: Vec<f64> = bb.iter().map(|b| similarity(bag, b)).collect();
@@ -474,17 +504,17 @@ fn merge_auto(sim: &Simulation) -> (Vec<Candidate>, slamlab::merge::verdict::Pai
         (80.0..500.0).contains(&mean_kp),
         "keypoints per 320 × 240 frame: {mean_kp}"
     );
-    let lifted: Vec<Features> = (0..2)
+    let sets: Vec<&Features> = feats.iter().flatten().collect();
+    let keep: Vec<Vec<usize>> = (0..2)
         .flat_map(|r| {
             feats[r]
                 .iter()
                 .zip(&infos[r])
-                .map(|(f, info)| liftable_features(&cam, info, f))
+                .map(|(f, info)| liftable_keypoints(&cam, info, f))
                 .collect::<Vec<_>>()
         })
         .collect();
-    let sets: Vec<&Features> = lifted.iter().collect();
-    let (_, bags) = Vocabulary::train_with_bags(&sets, &VocabularyConfig::default(), 1);
+    let (_, bags) = Vocabulary::train_with_bags_on(&sets, &keep, &VocabularyConfig::default(), 1);
     let n0 = feats[0].len();
     let proposals = propose_pairs(&bags[..n0], &bags[n0..], 3, 300);
     let cands: Vec<Candidate> = proposals
@@ -525,6 +555,7 @@ fn two_robots_touring_one_corridor_from_different_starts_are_merged_within_0_1_m
     assert_eq!(d.status, MergeStatus::Merged, "{}", d.reason);
     assert!(d.reason.starts_with("merged:"), "{}", d.reason);
     let (m, deg) = pose_error(&d.pose.expect("pose"), &truth);
+    println!("{} (error {m:.3} m, {deg:.2}°)", d.reason);
     assert!(
         m < 0.1 && deg < 1.0,
         "error {m:.3} m {deg:.2}° ({})",
@@ -543,6 +574,7 @@ fn two_robots_touring_one_corridor_from_different_starts_are_merged_within_0_1_m
 fn robots_in_two_separate_rooms_are_not_merged() {
     let sim = run(TWO_ROOMS);
     let (_, d) = merge_auto(&sim);
+    println!("{}", d.reason);
     assert_eq!(d.status, MergeStatus::NoMerge, "{}", d.reason);
     assert!(d.confidence == 0.0);
 }
@@ -738,4 +770,103 @@ fn spanning_tree_joins_three_robots_by_the_surest_edges_and_lists_the_fourth() {
     // No edges: only robot 0; no robots: nothing.
     assert_eq!(spanning_tree(2, &[]).unjoined(), vec![1]);
     assert!(spanning_tree(0, &edges).poses.is_empty());
+}
+
+// ----- timing ---------------------------------------------------------------
+
+/// Milliseconds from an arbitrary origin (the wall clock of the host: the
+/// core itself reads no clock).
+fn now_ms() -> f64 {
+    #[cfg(target_arch = "wasm32")]
+    {
+        js_sys::Date::now()
+    }
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        use std::time::{SystemTime, UNIX_EPOCH};
+        SystemTime::now()
+            .duration_since(UNIX_EPOCH)
+            .map_or(0.0, |d| d.as_secs_f64() * 1e3)
+    }
+}
+
+/// Stage times of the automatic merge on a 300 s random maze (about 300
+/// frames per robot). Natively:
+/// `cargo test --release -p slamlab --test merge_parts -- --ignored --nocapture`;
+/// in node, the same with `--target wasm32-unknown-unknown`.
+#[wasm_bindgen_test(unsupported = test)]
+#[ignore = "benchmark"]
+fn bench_automatic_merge_stages() {
+    let spec = slamlab::maze::MazeSpec {
+        seed: 2,
+        ..slamlab::maze::MazeSpec::default()
+    };
+    let sim = run(&slamlab::maze::random_maze(&spec));
+    let cam = sim.camera.clone();
+    let t = now_ms();
+    let infos = [frame_infos(&sim, 0), frame_infos(&sim, 1)];
+    let feats = [features(&sim, 0), features(&sim, 1)];
+    let t_features = now_ms() - t;
+    let t = now_ms();
+    let keep: Vec<Vec<usize>> = (0..2)
+        .flat_map(|r| {
+            feats[r]
+                .iter()
+                .zip(&infos[r])
+                .map(|(f, info)| liftable_keypoints(&cam, info, f))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let t_lift = now_ms() - t;
+    let t = now_ms();
+    let sets: Vec<&Features> = feats.iter().flatten().collect();
+    let (_, bags) = Vocabulary::train_with_bags_on(&sets, &keep, &VocabularyConfig::default(), 1);
+    let t_vocabulary = now_ms() - t;
+    let t = now_ms();
+    let n0 = feats[0].len();
+    let proposals = propose_pairs(&bags[..n0], &bags[n0..], 3, 600);
+    let t_proposals = now_ms() - t;
+    let t = now_ms();
+    let cands: Vec<Candidate> = proposals
+        .iter()
+        .enumerate()
+        .filter_map(|(k, &(i, j, _))| {
+            let (a, b) = (&infos[0][i], &infos[1][j]);
+            let cfg = VerifyConfig::default();
+            verify_pair(&cam, a, &feats[0][i], b, &feats[1][j], &cfg, k as u64).candidate
+        })
+        .collect();
+    let t_verify = now_ms() - t;
+    let t = now_ms();
+    let map_a = sim.robots[0].mapping.map(MapperKind::Slam);
+    let map_b = sim.robots[1].mapping.map(MapperKind::Slam);
+    let d = decide_pair(&cands, map_a, map_b, &VerdictConfig::default());
+    let t_decide = now_ms() - t;
+    let t = now_ms();
+    let merged = fuse(
+        &[
+            (map_a, Pose2::IDENTITY),
+            (map_b, d.pose.unwrap_or_default()),
+        ],
+        map_a.config.clone(),
+    );
+    let t_fuse = now_ms() - t;
+    let report = format!(
+        "frames {}+{}, {} proposals, {} candidates: {}\n\
+         ms: features {t_features:.0}, lift filter {t_lift:.1}, vocabulary+bags {t_vocabulary:.1}, \
+         proposals {t_proposals:.1}, verify {t_verify:.0} ({:.2}/pair), decide {t_decide:.1}, \
+         fuse {t_fuse:.1} ({} cells)",
+        infos[0].len(),
+        infos[1].len(),
+        proposals.len(),
+        cands.len(),
+        d.reason,
+        t_verify / proposals.len().max(1) as f64,
+        merged.width() * merged.height()
+    );
+    #[cfg(target_arch = "wasm32")]
+    wasm_bindgen_test::console_log!("{report}");
+    #[cfg(not(target_arch = "wasm32"))]
+    println!("{report}");
+    assert_eq!(d.status, MergeStatus::Merged, "{}", d.reason);
 }

@@ -166,3 +166,59 @@ fn ros_export_has_the_map_server_layout() {
         assert!(yaml.contains(line), "{line} in {yaml}");
     }
 }
+
+#[wasm_bindgen_test(unsupported = test)]
+fn the_surface_layer_keeps_the_mean_of_the_hits_in_each_cell() {
+    let mut g = OccupancyGrid::new(GridConfig {
+        surface_points: true,
+        ..GridConfig::default()
+    });
+    assert!(g.ensure_contains(DVec2::new(-1.0, -1.0), DVec2::new(1.0, 1.0)));
+    // Three hits in cell (10, 4) = [0.50, 0.55) × [0.20, 0.25).
+    let from = DVec2::new(0.0, 0.0);
+    for p in [
+        DVec2::new(0.510, 0.210),
+        DVec2::new(0.520, 0.240),
+        DVec2::new(0.545, 0.225),
+    ] {
+        g.integrate_beam(from, p, true);
+    }
+    let (x, y) = g.local([10, 4]).expect("inside");
+    let s = g.surface_point(x, y).expect("a surface");
+    assert_eq!(s.hits, 3);
+    // Mean (0.525, 0.225), stored to 1/65536 of a cell.
+    assert!(
+        (s.position - DVec2::new(0.525, 0.225)).length() < 1e-6,
+        "{:?}",
+        s.position
+    );
+    // Enough passing beams clear the cell, and its surface goes with it.
+    for _ in 0..10 {
+        g.integrate_beam(from, DVec2::new(0.9, 0.9 * 0.225 / 0.525), true);
+    }
+    assert!(g.units(x, y) <= 0);
+    assert!(g.surface_point(x, y).is_none());
+    // A grid without the layer has no surface anywhere.
+    let mut plain = grid();
+    plain.integrate_beam(from, DVec2::new(0.52, 0.22), true);
+    let (x, y) = plain.local([10, 4]).expect("inside");
+    assert!(plain.units(x, y) > 0 && plain.surface_point(x, y).is_none());
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn the_surface_layer_survives_growth() {
+    let mut g = OccupancyGrid::new(GridConfig {
+        surface_points: true,
+        ..GridConfig::default()
+    });
+    assert!(g.ensure_contains(DVec2::new(-1.0, -1.0), DVec2::new(1.0, 1.0)));
+    g.integrate_beam(DVec2::ZERO, DVec2::new(0.512, 0.233), true);
+    let before = g.origin_cell();
+    assert!(g.ensure_contains(DVec2::new(-20.0, -20.0), DVec2::new(20.0, 20.0)));
+    assert_ne!(g.origin_cell(), before, "the grid grew down and left");
+    let (x, y) = g
+        .local(g.global_cell(DVec2::new(0.512, 0.233)))
+        .expect("inside");
+    let s = g.surface_point(x, y).expect("kept");
+    assert!((s.position - DVec2::new(0.512, 0.233)).length() < 1e-6);
+}

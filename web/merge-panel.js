@@ -89,6 +89,7 @@ export class MergePanel {
     });
     this.verdict = el('div', { id: 'merge-verdict', class: 'merge-verdict', role: 'status', 'aria-live': 'polite' });
     this.transforms = el('table', { id: 'merge-transforms', class: 'merge-transforms' });
+    this.distance = el('div', { id: 'merge-distance', class: 'merge-distance', hidden: '' });
     this.map = el('canvas', {
       id: 'merge-map', class: 'map-view', width: String(MAP_W), height: String(MAP_H),
       role: 'img', 'aria-label': 'Merged map',
@@ -112,7 +113,7 @@ export class MergePanel {
       });
       this.downloads.append(b);
     }
-    this.result = el('div', { class: 'merge-result', hidden: '' }, this.verdict, this.transforms, this.map, this.downloads);
+    this.result = el('div', { class: 'merge-result', hidden: '' }, this.verdict, this.distance, this.transforms, this.map, this.downloads);
     this.tableBox = el('div', { class: 'merge-table-box', hidden: '' }, this.tableTitle, this.table, this.tableHint);
     this.host.replaceChildren(
       el('div', { class: 'merge-controls' }, select, this.button),
@@ -381,6 +382,24 @@ export class MergePanel {
     this.pairHost.replaceChildren();
   }
 
+  /** Thesis §6.2.4: the two equations with the measured numbers. */
+  showDistance(r) {
+    const d = r.pairs.find((p) => p.distance)?.distance;
+    this.distance.hidden = !d;
+    if (!d) return;
+    const p = r.pairs.find((q) => q.distance);
+    const line = (text) => el('div', { text });
+    this.distance.replaceChildren(
+      el('b', { text: `Distance between the robots (§6.2.4), pairs ${JSON.stringify(p.best)} and ${JSON.stringify(p.second)}` }),
+      line(`tan(θ/2) = (B'C'/2 − FJ/2)·K / AD      tan(θ/2) = (B'C'/2 − GH/2)·K / (AD + DE)`),
+      line(`θ = ${fmt(deg(d.hfov_rad), 1)}°, B'C' = ${fmt(d.bc_px, 0)} px, FJ = ${fmt(d.fj_px, 1)} px, ` +
+        `GH = ${fmt(d.gh_px, 1)} px, DE = ${fmt(d.de_m, 3)} m (robot 2's odometry)`),
+      line(`⇒ K = ${fmt(d.k_m_per_px * 1000, 3)} mm/px, AD = ${fmt(d.ad_m, 3)} m, AA' = ${fmt(d.aa_m, 3)} m; ` +
+        `robot 1 stood ${fmt(d.depth_a_m, 2)} m from the wall` +
+        (d.laser_depth_a_m != null ? ` (its laser: ${fmt(d.laser_depth_a_m, 2)} m)` : '')),
+    );
+  }
+
   showResult() {
     const r = this.view?.report;
     if (!r) return;
@@ -405,6 +424,7 @@ export class MergePanel {
       el('caption', { text: 'Each robot\u2019s map frame in the merged frame (the first robot\u2019s); error against the ground truth' }),
       head, ...rows);
     this.transforms.hidden = !merged;
+    this.showDistance(r);
     this.map.hidden = !merged;
     this.downloads.querySelectorAll('button').forEach((b, k) => {
       b.hidden = !merged && k < 2;

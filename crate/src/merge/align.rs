@@ -18,7 +18,10 @@
 //!    Kohlbrecher et al. 2011) refines it below a cell.
 //!
 //! Cells of B that land far outside A's grid at the guess cannot score and
-//! are left out, which keeps the search proportional to the overlap.
+//! are left out, which keeps the search proportional to the overlap. The
+//! search turns B's cells about their centroid, not about B's origin: a
+//! degree about an origin 20 m away would move the overlap by 0.35 m, out
+//! of the translation window.
 //!
 //! The window is small on purpose (`±linear_window_m`, `±angular_window_rad`):
 //! this step polishes a transform that vision found; it does not search
@@ -80,13 +83,19 @@ pub struct Alignment {
 pub fn occupied_cells(grid: &OccupancyGrid) -> Vec<DVec2> {
     let mut out = Vec::new();
     for iy in 0..grid.height() {
-        for ix in 0..grid.width() {
-            if grid.state(ix, iy) == CellState::Occupied {
-                out.push(grid.cell_centre(ix, iy));
-            }
-        }
+        occupied_in_row(grid, iy, &mut out);
     }
     out
+}
+
+/// The occupied cell centres of row `iy`. (A function per row: a wasm
+/// engine optimises a function after a few calls, never a running loop.)
+fn occupied_in_row(grid: &OccupancyGrid, iy: usize, out: &mut Vec<DVec2>) {
+    for ix in 0..grid.width() {
+        if grid.state(ix, iy) == CellState::Occupied {
+            out.push(grid.cell_centre(ix, iy));
+        }
+    }
 }
 
 /// The extent of a grid in its own frame, as (lower-left, upper-right).
@@ -111,10 +120,13 @@ pub fn refine_alignment(
     }
     let reach = cfg.linear_window_m + 1.0;
     let (lo_a, hi_a) = extent(a);
+    let (sin, cos) = guess.theta.sin_cos();
+    let to_a =
+        |p: DVec2| guess.position() + DVec2::new(cos * p.x - sin * p.y, sin * p.x + cos * p.y);
     let points: Vec<DVec2> = occupied_cells(b)
         .into_iter()
         .filter(|&p| {
-            let q = guess.transform_point(p);
+            let q = to_a(p);
             q.x >= lo_a.x - reach
                 && q.y >= lo_a.y - reach
                 && q.x <= hi_a.x + reach

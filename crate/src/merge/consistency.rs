@@ -43,6 +43,14 @@
 //! agree. The answer lists every member of those groups that agrees with
 //! all chosen representatives.
 //!
+//! ## Rival hypotheses
+//! With a texture repeated on every wall, wrong candidates can agree among
+//! themselves too (a maze shifted by a whole cell lays walls on walls), and
+//! their clique may even be the largest. [`consistent_hypotheses`] therefore
+//! lists the runners-up as well: the maximum clique, then the maximum clique
+//! among the places that do not support it, and so on. The verdict
+//! ([`super::verdict`]) judges each against the maps.
+//!
 //! ## The maximum clique
 //! Bron–Kerbosch with pivoting (Tomita et al. 2006) on bit sets, which is
 //! exact and fast on these sparse graphs. Maximum clique is NP-hard, so the
@@ -67,7 +75,7 @@ pub struct ConsistencyConfig {
     /// Candidates whose places lie this close in both maps are one piece of
     /// evidence, metres. Default 1.5.
     pub same_place_m: f64,
-    /// Recursive calls the clique search may make. Default 200,000.
+    /// Recursive calls the clique search may make. Default 50,000.
     pub clique_budget: usize,
 }
 
@@ -79,7 +87,7 @@ impl Default for ConsistencyConfig {
             angle_rad: 3f64.to_radians(),
             angle_per_m_rad: 0.1f64.to_radians(),
             same_place_m: 1.5,
-            clique_budget: 200_000,
+            clique_budget: 50_000,
         }
     }
 }
@@ -191,7 +199,7 @@ impl Bits {
     }
 }
 
-/// Maximum-weight-ish clique search: largest size, ties by total weight.
+/// The search for the largest clique (ties: the larger total weight).
 struct CliqueSearch<'a> {
     adjacency: &'a [Bits],
     weight: &'a [usize],

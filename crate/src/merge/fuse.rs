@@ -48,6 +48,28 @@ fn write_cell(grid: &mut OccupancyGrid, p: DVec2, units: i8) {
     grid.config.hit = hit;
 }
 
+/// Fills row `iy` of the merged grid: the clamped sum of what every map
+/// holds under each cell's centre. (A function per row: a wasm engine
+/// optimises a function after a few calls, never a loop already running.)
+fn fuse_row(
+    merged: &mut OccupancyGrid,
+    iy: usize,
+    maps: &[&OccupancyGrid],
+    to_maps: &[impl Fn(DVec2) -> DVec2],
+) {
+    let (min, max) = (merged.config.min as i32, merged.config.max as i32);
+    for ix in 0..merged.width() {
+        let centre = merged.cell_centre(ix, iy);
+        let mut sum = 0i32;
+        for (g, to_map) in maps.iter().zip(to_maps) {
+            if let Some((x, y)) = g.local(g.global_cell(to_map(centre))) {
+                sum += g.units(x, y) as i32;
+            }
+        }
+        write_cell(merged, centre, sum.clamp(min, max) as i8);
+    }
+}
+
 /// The merged grid: each map's frame at its pose in the merged frame,
 /// log-odds added and clamped to `config`'s range (see the module doc).
 /// Maps that are empty or have a non-finite pose are skipped; with nothing
@@ -80,19 +102,18 @@ pub fn fuse(maps: &[(&OccupancyGrid, Pose2)], config: GridConfig) -> OccupancyGr
             return merged;
         }
     }
-    let inverses: Vec<Pose2> = usable.iter().map(|(_, p)| p.inverse()).collect();
-    let (min, max) = (config.min as i32, config.max as i32);
+    // Each map's inverse pose as a function, its sine and cosine taken once.
+    let to_maps: Vec<_> = usable
+        .iter()
+        .map(|(_, p)| {
+            let inv = p.inverse();
+            let (s, c) = inv.theta.sin_cos();
+            move |q: DVec2| inv.position() + DVec2::new(c * q.x - s * q.y, s * q.x + c * q.y)
+        })
+        .collect();
+    let maps: Vec<&OccupancyGrid> = usable.iter().map(|(g, _)| *g).collect();
     for iy in 0..merged.height() {
-        for ix in 0..merged.width() {
-            let centre = merged.cell_centre(ix, iy);
-            let mut sum = 0i32;
-            for ((g, _), inv) in usable.iter().zip(&inverses) {
-                if let Some((x, y)) = g.local(g.global_cell(inv.transform_point(centre))) {
-                    sum += g.units(x, y) as i32;
-                }
-            }
-            write_cell(&mut merged, centre, sum.clamp(min, max) as i8);
-        }
+        fuse_row(&mut merged, iy, &maps, &to_maps);
     }
     merged
 }

@@ -116,7 +116,9 @@ fn nearest(p: &[f32; 64], centres: &[[f32; 64]], half_norm2: &[f32], dots: &mut 
 
 /// k-means++ seeding then Lloyd iterations. Returns the centres (at most
 /// `k`, fewer when there are fewer distinct points) and each point's
-/// nearest centre.
+/// nearest centre. (Each pass over the points is a function of its own: a
+/// wasm engine optimises a function after a few calls, never a loop that is
+/// already running.)
 fn kmeans(
     points: &[[f32; 64]],
     k: usize,
@@ -128,13 +130,11 @@ fn kmeans(
     }
     let norms: Vec<f32> = points.iter().map(norm2).collect();
     let mut dots = vec![0f32; points.len()];
+    // Squared distance of every point to its nearest centre so far.
+    let mut nearest_d2 = vec![f32::INFINITY; points.len()];
     let first = rng.below(points.len());
     let mut centres: Vec<[f32; 64]> = vec![points[first]];
-    // Squared distance of every point to its nearest centre so far.
-    dot64_many(&points[first], points, &mut dots);
-    let mut nearest_d2: Vec<f32> = (0..points.len())
-        .map(|i| (norms[i] + norms[first] - 2.0 * dots[i]).max(0.0))
-        .collect();
+    seed_distances(points, &norms, first, &mut dots, &mut nearest_d2);
     while centres.len() < k {
         let total: f64 = nearest_d2.iter().map(|&d| d as f64).sum();
         if total <= 1e-9 {
@@ -142,56 +142,94 @@ fn kmeans(
         }
         // Draw a point with probability proportional to its squared distance.
         let target = (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64 * total;
-        let mut acc = 0.0;
-        let mut pick = None;
-        for (i, &d) in nearest_d2.iter().enumerate() {
-            acc += d as f64;
-            if d > 0.0 {
-                pick = Some(i);
-                if acc >= target {
-                    break;
-                }
-            }
-        }
-        let Some(pick) = pick else { break };
-        let c = points[pick];
-        dot64_many(&c, points, &mut dots);
-        for i in 0..points.len() {
-            let d2 = (norms[i] + norms[pick] - 2.0 * dots[i]).max(0.0);
-            nearest_d2[i] = nearest_d2[i].min(d2);
-        }
-        centres.push(c);
+        let Some(pick) = draw(&nearest_d2, target) else {
+            break;
+        };
+        seed_distances(points, &norms, pick, &mut dots, &mut nearest_d2);
+        centres.push(points[pick]);
     }
     let mut assign = vec![0usize; points.len()];
     let mut cdots = vec![0f32; centres.len()];
     for it in 0..=iterations {
         let half: Vec<f32> = centres.iter().map(|c| 0.5 * norm2(c)).collect();
-        let mut changed = false;
-        for (p, a) in points.iter().zip(assign.iter_mut()) {
-            let best = nearest(p, &centres, &half, &mut cdots);
-            changed |= best != *a;
-            *a = best;
-        }
+        let changed = assign_points(points, &centres, &half, &mut assign, &mut cdots);
         if it == iterations || (!changed && it > 0) {
             break;
         }
-        let mut sums = vec![[0f64; 64]; centres.len()];
-        let mut counts = vec![0usize; centres.len()];
-        for (p, &a) in points.iter().zip(&assign) {
-            counts[a] += 1;
-            for (s, v) in sums[a].iter_mut().zip(p) {
-                *s += *v as f64;
-            }
-        }
-        for ((c, s), &n) in centres.iter_mut().zip(&sums).zip(&counts) {
-            if n > 0 {
-                for (cv, sv) in c.iter_mut().zip(s) {
-                    *cv = (*sv / n as f64) as f32;
-                }
+        move_centres(points, &assign, &mut centres);
+    }
+    (centres, assign)
+}
+
+/// Lowers every point's distance to its nearest centre with the new centre
+/// `points[c]`.
+fn seed_distances(
+    points: &[[f32; 64]],
+    norms: &[f32],
+    c: usize,
+    dots: &mut [f32],
+    nearest_d2: &mut [f32],
+) {
+    dot64_many(&points[c], points, dots);
+    for ((n, &d), &norm) in nearest_d2.iter_mut().zip(dots.iter()).zip(norms) {
+        *n = n.min((norm + norms[c] - 2.0 * d).max(0.0));
+    }
+}
+
+/// The first point at which the running sum of `weights` reaches `target`
+/// (the last positive one if rounding leaves it short); `None` when all are
+/// zero.
+fn draw(weights: &[f32], target: f64) -> Option<usize> {
+    let mut acc = 0.0;
+    let mut pick = None;
+    for (i, &d) in weights.iter().enumerate() {
+        acc += d as f64;
+        if d > 0.0 {
+            pick = Some(i);
+            if acc >= target {
+                break;
             }
         }
     }
-    (centres, assign)
+    pick
+}
+
+/// Assigns every point to its nearest centre; whether any assignment
+/// changed.
+fn assign_points(
+    points: &[[f32; 64]],
+    centres: &[[f32; 64]],
+    half_norm2: &[f32],
+    assign: &mut [usize],
+    dots: &mut [f32],
+) -> bool {
+    let mut changed = false;
+    for (p, a) in points.iter().zip(assign.iter_mut()) {
+        let best = nearest(p, centres, half_norm2, dots);
+        changed |= best != *a;
+        *a = best;
+    }
+    changed
+}
+
+/// Moves every centre to the mean of its points (a centre without points
+/// stays where it is).
+fn move_centres(points: &[[f32; 64]], assign: &[usize], centres: &mut [[f32; 64]]) {
+    let mut sums = vec![[0f64; 64]; centres.len()];
+    let mut counts = vec![0usize; centres.len()];
+    for (p, &a) in points.iter().zip(assign) {
+        counts[a] += 1;
+        for (s, v) in sums[a].iter_mut().zip(p) {
+            *s += *v as f64;
+        }
+    }
+    for ((c, s), &n) in centres.iter_mut().zip(&sums).zip(&counts) {
+        if n > 0 {
+            for (cv, sv) in c.iter_mut().zip(s) {
+                *cv = (*sv / n as f64) as f32;
+            }
+        }
+    }
 }
 
 /// Index of the largest value (the first on ties; 0 when empty).
@@ -205,18 +243,22 @@ fn argmax(values: impl Iterator<Item = f32>) -> usize {
     best.0
 }
 
-/// The strongest `max` keypoints of a frame with a usable descriptor:
-/// indices, strongest first.
-fn strongest(f: &Features, max: usize) -> Vec<usize> {
-    let mut idx: Vec<usize> = (0..f.keypoints.len().min(f.descriptors.len()))
-        .filter(|&i| f.descriptors[i].0.iter().any(|&v| v != 0.0))
-        .collect();
+/// The strongest `max` keypoints of a frame with a usable descriptor,
+/// among `keep` (all keypoints when `None`): indices, strongest first.
+fn strongest(f: &Features, keep: Option<&[usize]>, max: usize) -> Vec<usize> {
+    let n = f.keypoints.len().min(f.descriptors.len());
+    let usable = |&i: &usize| i < n && f.descriptors[i].0.iter().any(|&v| v != 0.0);
+    let mut idx: Vec<usize> = match keep {
+        Some(k) => k.iter().copied().filter(usable).collect(),
+        None => (0..n).filter(usable).collect(),
+    };
     idx.sort_by(|&a, &b| {
         f.keypoints[b]
             .response
             .total_cmp(&f.keypoints[a].response)
             .then(a.cmp(&b))
     });
+    idx.dedup();
     idx.truncate(max);
     idx
 }
@@ -239,8 +281,25 @@ impl Vocabulary {
         cfg: &VocabularyConfig,
         seed: u64,
     ) -> (Vocabulary, Vec<Bag>) {
+        Self::train_with_bags_on(sets, &[], cfg, seed)
+    }
+
+    /// [`Vocabulary::train_with_bags`] on a subset of each frame's
+    /// keypoints: `keep[i]` lists the keypoints of `sets[i]` that count (for
+    /// example [`super::lift::liftable_keypoints`]); frames beyond
+    /// `keep.len()` use all theirs. Choosing by index copies no descriptor.
+    pub fn train_with_bags_on(
+        sets: &[&Features],
+        keep: &[Vec<usize>],
+        cfg: &VocabularyConfig,
+        seed: u64,
+    ) -> (Vocabulary, Vec<Bag>) {
         let per_frame = cfg.max_words_per_frame.max(1);
-        let chosen: Vec<Vec<usize>> = sets.iter().map(|f| strongest(f, per_frame)).collect();
+        let chosen: Vec<Vec<usize>> = sets
+            .iter()
+            .enumerate()
+            .map(|(i, f)| strongest(f, keep.get(i).map(Vec::as_slice), per_frame))
+            .collect();
         // Descriptors by sign of the Laplacian, an even stride over all.
         let total: usize = chosen.iter().map(Vec::len).sum();
         let stride = total.div_ceil(cfg.max_training.max(1)).max(1);
@@ -412,7 +471,13 @@ impl Vocabulary {
     /// words, unit length (empty for a frame without features, or when
     /// every word it has is on every training frame).
     pub fn bag(&self, f: &Features) -> Bag {
-        let idx = strongest(f, self.max_words_per_frame);
+        let idx = strongest(f, None, self.max_words_per_frame);
+        self.weigh(&self.words_of(f, &idx), idx.len())
+    }
+
+    /// [`Vocabulary::bag`] of the keypoints `keep` of `f` only.
+    pub fn bag_of(&self, f: &Features, keep: &[usize]) -> Bag {
+        let idx = strongest(f, Some(keep), self.max_words_per_frame);
         self.weigh(&self.words_of(f, &idx), idx.len())
     }
 }
@@ -434,6 +499,19 @@ pub fn similarity(a: &Bag, b: &Bag) -> f64 {
         }
     }
     s
+}
+
+/// One row of the similarity matrix: `bag` against every frame of the
+/// inverted file. (A function per row: a wasm engine optimises a function
+/// after a few calls, never a loop that is already running.)
+fn score_row(bag: &Bag, postings: &[Vec<(u32, f32)>], row: &mut [f64]) {
+    for &(w, va) in &bag.words {
+        for &(j, vb) in &postings[w as usize] {
+            if let Some(r) = row.get_mut(j as usize) {
+                *r += va as f64 * vb as f64;
+            }
+        }
+    }
 }
 
 /// The `k` best `(index, score)` of `scores` with a positive score, best
@@ -479,12 +557,11 @@ pub fn propose_pairs(
     // The full similarity matrix, row by row.
     let mut matrix = vec![0f64; bags_a.len() * bags_b.len()];
     for (i, bag) in bags_a.iter().enumerate() {
-        let row = &mut matrix[i * bags_b.len()..(i + 1) * bags_b.len()];
-        for &(w, va) in &bag.words {
-            for &(j, vb) in &postings[w as usize] {
-                row[j as usize] += va as f64 * vb as f64;
-            }
-        }
+        score_row(
+            bag,
+            &postings,
+            &mut matrix[i * bags_b.len()..(i + 1) * bags_b.len()],
+        );
     }
     let mut pairs: Vec<(usize, usize, f64)> = Vec::new();
     for i in 0..bags_a.len() {

@@ -18,8 +18,14 @@
 //! Ties go to the candidate nearest the prior, so a flat response (a
 //! featureless corridor) does not pull the pose anywhere.
 //!
-//! The result is accurate to one cell and `angular_step`;
-//! [`super::gauss_newton`] refines it to sub-cell precision.
+//! The result is accurate to one cell and `angular_step`; the mapper
+//! refines it with [`super::surface`] (or, on a grid without surface means,
+//! [`super::gauss_newton`]). The mapper searches only when refining from
+//! the prior finds too few points on mapped surfaces — the prior is then off
+//! by more than the refinement can see, as after a long stretch without
+//! matches or on returning to an area mapped long ago; a step's odometry is
+//! otherwise good to millimetres and the search would cost ten times the
+//! refinement for nothing.
 
 use super::likelihood::LikelihoodField;
 use crate::geom::{wrap_angle, Pose2};

@@ -21,11 +21,13 @@
 //! correction only across the weak direction and takes odometry's word
 //! along it ([`super::mapper`]).
 //!
-//! Normals come from each point's neighbours in beam order: the chord
-//! between the nearest neighbours at least 0.1 m away on each side (closer
-//! ones are dominated by range noise), skipped across depth jumps. Only
-//! points that land on walls *already in the map* count: a corridor's end
-//! wall seen for the first time constrains nothing until it is mapped.
+//! Normals come from each point's neighbours in beam order ([`scan_normals`]):
+//! the principal axes of the points within 0.12 m along the same surface
+//! (no gap over 0.3 m between consecutive beams), a line fit that averages
+//! the range noise; where the points do not lie on a line (a corner, a
+//! pillar narrower than the window) the point gets no normal. Only points
+//! that land on walls *already in the map* count: a corridor's end wall seen
+//! for the first time constrains nothing until it is mapped.
 
 use glam::DVec2;
 
@@ -65,44 +67,76 @@ pub fn symmetric_eigen2(a: f64, b: f64, c: f64) -> (f64, f64, DVec2) {
     (l1, l2, v.normalize_or(DVec2::X))
 }
 
-/// Analyses the end points of a scan, given in beam order (robot frame).
-/// Only points with `counts[i]` contribute a normal (all serve as
-/// neighbours).
-pub fn analyse(points: &[DVec2], counts: &[bool]) -> ScanConstraint {
-    const MIN_CHORD_M: f64 = 0.1;
-    const MAX_GAP_M: f64 = 0.3;
-    const REACH: usize = 8;
+/// Neighbourhood of a point for its normal (m).
+const NORMAL_RADIUS_M: f64 = 0.12;
+/// Consecutive beams farther apart than this lie on different surfaces (m).
+const MAX_GAP_M: f64 = 0.3;
+/// At most this many beams on each side take part in a normal.
+const REACH: usize = 8;
+/// A neighbourhood narrower than this along its main axis is too short to
+/// orient (m).
+const MIN_EXTENT_M: f64 = 0.05;
+/// A neighbourhood whose variance across its main axis exceeds this share
+/// of its variance along it is not a line: no normal. Range noise alone
+/// gives σ² / (L² / 12), 0.08 for σ = 1 cm over L = 0.12 m; a right-angled
+/// corner with equal arms gives 0.25.
+const MAX_FLATNESS: f64 = 0.15;
+
+/// The unit surface normal at every point of a scan (robot frame, beam
+/// order), or `None` where the neighbours do not define one. The sign is
+/// arbitrary: only `n nᵀ` and `n·(q − s)` use it.
+pub fn scan_normals(points: &[DVec2]) -> Vec<Option<DVec2>> {
+    (0..points.len())
+        .map(|i| {
+            let p = points[i];
+            // Walk out along the beam order while the surface continues.
+            let mut lo = i;
+            while lo > 0
+                && i - lo < REACH
+                && (points[lo - 1] - points[lo]).length() <= MAX_GAP_M
+                && (points[lo - 1] - p).length() <= NORMAL_RADIUS_M
+            {
+                lo -= 1;
+            }
+            let mut hi = i;
+            while hi + 1 < points.len()
+                && hi - i < REACH
+                && (points[hi + 1] - points[hi]).length() <= MAX_GAP_M
+                && (points[hi + 1] - p).length() <= NORMAL_RADIUS_M
+            {
+                hi += 1;
+            }
+            if lo == i || hi == i {
+                return None;
+            }
+            let nbrs = &points[lo..=hi];
+            let mean = nbrs.iter().copied().sum::<DVec2>() / nbrs.len() as f64;
+            let (mut a, mut b, mut c) = (0.0, 0.0, 0.0);
+            for &q in nbrs {
+                let d = q - mean;
+                a += d.x * d.x;
+                b += d.x * d.y;
+                c += d.y * d.y;
+            }
+            let n = nbrs.len() as f64;
+            let (along, across, normal) = symmetric_eigen2(a / n, b / n, c / n);
+            // Spread along the line: a uniform spread of extent L has
+            // variance L²/12.
+            if (12.0 * along).sqrt() < MIN_EXTENT_M || across > MAX_FLATNESS * along {
+                return None;
+            }
+            Some(normal)
+        })
+        .collect()
+}
+
+/// The translational information `A = Σ n nᵀ` of the normals with
+/// `counts[i]`, decomposed.
+pub fn constraint_of(normals: &[Option<DVec2>], counts: &[bool]) -> ScanConstraint {
     let (mut a, mut b, mut c) = (0.0, 0.0, 0.0);
     let mut count = 0;
-    for i in 0..points.len() {
-        if !counts.get(i).copied().unwrap_or(false) {
-            continue;
-        }
-        let p = points[i];
-        let find = |range: &mut dyn Iterator<Item = usize>| -> Option<DVec2> {
-            let mut prev = p;
-            for j in range {
-                let q = points[j];
-                if (q - prev).length() > MAX_GAP_M {
-                    return None;
-                }
-                if (q - p).length() >= MIN_CHORD_M {
-                    return Some(q);
-                }
-                prev = q;
-            }
-            None
-        };
-        let before = find(&mut (i.saturating_sub(REACH)..i).rev());
-        let after = find(&mut (i + 1..(i + 1 + REACH).min(points.len())));
-        let (Some(q0), Some(q1)) = (before, after) else {
-            continue;
-        };
-        let t = (q1 - q0).normalize_or_zero();
-        if t == DVec2::ZERO {
-            continue;
-        }
-        let n = t.perp();
+    for (n, &k) in normals.iter().zip(counts) {
+        let (Some(n), true) = (n, k) else { continue };
         a += n.x * n.x;
         b += n.x * n.y;
         c += n.y * n.y;
@@ -115,4 +149,11 @@ pub fn analyse(points: &[DVec2], counts: &[bool]) -> ScanConstraint {
         weak: weak.max(0.0),
         weak_direction,
     }
+}
+
+/// Analyses the end points of a scan, given in beam order (robot frame).
+/// Only points with `counts[i]` contribute a normal (all serve as
+/// neighbours).
+pub fn analyse(points: &[DVec2], counts: &[bool]) -> ScanConstraint {
+    constraint_of(&scan_normals(points), counts)
 }

@@ -20,6 +20,12 @@
 //!           [ 0  1   cos θ·s_x − sin θ·s_y ]
 //! ```
 //!
+//! The SLAM mapper refines scans with [`super::surface`] instead: a
+//! bilinear interpolant peaks at cell centres, so this refinement draws a
+//! wall that lies on a cell boundary half a cell off (see that module). It
+//! serves grids without surface means, and map merging's alignment of whole
+//! maps, where hundreds of cells at all sub-cell phases average it out.
+//!
 //! The correlative search has already put the pose within a cell of the
 //! optimum, inside the basin the gradient can see. Each step is damped
 //! (Levenberg), limited to a cell and a degree, and halved until it scores

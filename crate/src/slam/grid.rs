@@ -12,10 +12,11 @@
 //! A laser beam from the robot's centre to its end point says:
 //!
 //! * every cell the beam passes through is free (`l += l_free`, negative),
-//!   except the cells its last cell-length touches, which are left alone: with range noise, beams that end just behind a wall would
+//!   except the cells its last `hit_margin_m` touches, which are left
+//!   alone: with range noise, beams that end just behind a wall would
 //!   otherwise clear the wall's own cell, and walls would drift half a cell
-//!   away from wherever the robot saw them from;
-//!   A cell already at the upper clamp (a wall seen many times) is not
+//!   away from wherever the robot saw them from. A cell already at the
+//!   upper clamp (a wall seen many times) is not
 //!   lowered by passing beams either: at a grazing angle a beam crosses the
 //!   cells of the wall it ends on, and such erosion, strongest far along the
 //!   wall, would tilt every wall the robot follows;
@@ -27,11 +28,26 @@
 //!
 //! Cells along a beam are visited with the traversal of Amanatides and Woo
 //! (1987), the same walk [`crate::world`] uses for ray casting, so every cell
-//! the segment touches is visited exactly once. Log-odds are clamped to
+//! the segment touches is visited exactly once. It is the mapper's hottest
+//! loop (≈ 11,000 cells per scan and map), so when both ends of a beam lie
+//! in the grid, as they do once it has grown to the scan's reach, the walk
+//! steps the cells' index directly instead of converting coordinates. Log-odds are clamped to
 //! `[l_min, l_max]`, so a cell that was wrong (a robot that stood there) can
 //! be cleared again after a few scans, and stored quantised in steps of
 //! [`LOG_ODDS_UNIT`] as one byte per cell: integer sums are exact, so the
 //! map is the same on every machine.
+//!
+//! ## Where in the cell: the surface layer
+//! A cell is 5 cm wide; a wall is a line. A grid that keeps only log-odds
+//! knows a wall to half a cell, and a scan matcher that aligns scans to it
+//! inherits that error. With [`GridConfig::surface_points`] the grid also
+//! keeps, per cell, the running mean of the hits that ended in it (over the
+//! last [`SURFACE_WINDOW`] hits) and how many there were: where in the cell
+//! the surface lies, to a fraction of a millimetre after a few scans. A
+//! wall on a cell boundary splits its hits between two rows, each holding
+//! the mean of its half; weighted by their counts the two give the wall back
+//! ([`super::surface`]). A cell cleared to free loses its surface. The
+//! layer costs 6 bytes per cell, so only the SLAM map keeps it.
 //!
 //! ## Growth and origin bookkeeping
 //! Cells are addressed by *global* indices `(⌊x / r⌋, ⌊y / r⌋)` in the odometry
@@ -75,6 +91,10 @@ pub struct GridConfig {
     pub hit_margin_m: f64,
     /// Most cells this grid may hold.
     pub max_cells: usize,
+    /// Keep, per cell, where inside it the surface lies (the running mean
+    /// of the hits that fell in it): the sub-cell layer the SLAM matcher
+    /// aligns scans to. Off for maps that are only drawn.
+    pub surface_points: bool,
 }
 
 impl Default for GridConfig {
@@ -87,6 +107,7 @@ impl Default for GridConfig {
             max: 70,
             hit_margin_m: 0.1,
             max_cells: 1 << 22,
+            surface_points: false,
         }
     }
 }
@@ -100,11 +121,40 @@ pub enum CellState {
     Occupied,
 }
 
+/// Where the surface lies inside one cell: the running mean of the hits
+/// that ended in it, as an offset from the cell's centre in units of
+/// 1/65536 of a cell, over the last [`SURFACE_WINDOW`] hits, and how many
+/// hits it has had in all.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct SurfaceCell {
+    hits: u16,
+    offset: [i16; 2],
+}
+
+/// The surface mean forgets with this window (hits): long enough that a
+/// mapped wall stays where it was first seen well (the map is the matcher's
+/// fixed reference), short enough to follow a correction.
+pub const SURFACE_WINDOW: u16 = 64;
+
+/// One cell's surface: where it lies (odometry frame) and how many hits
+/// ended in the cell (the weight of this cell against its neighbours: a
+/// wall on a cell boundary splits its hits between two rows).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfacePoint {
+    pub position: DVec2,
+    pub hits: u16,
+}
+/// Fixed-point scale of a surface offset (per cell).
+const SURFACE_SCALE: f64 = 65536.0;
+
 /// A log-odds occupancy grid in one robot's odometry frame.
 #[derive(Clone, Debug)]
 pub struct OccupancyGrid {
     pub config: GridConfig,
     cells: Vec<i8>,
+    /// Per-cell surface means, same layout as `cells` (empty unless
+    /// [`GridConfig::surface_points`]).
+    surface: Vec<SurfaceCell>,
     width: usize,
     height: usize,
     /// Global index of local cell (0, 0).
@@ -124,6 +174,7 @@ impl OccupancyGrid {
         OccupancyGrid {
             config,
             cells: Vec::new(),
+            surface: Vec::new(),
             width: 0,
             height: 0,
             origin_cell: [0, 0],
@@ -161,7 +212,7 @@ impl OccupancyGrid {
     }
     /// Bytes held by the cells.
     pub fn memory_bytes(&self) -> usize {
-        self.cells.capacity()
+        self.cells.capacity() + self.surface.capacity() * std::mem::size_of::<SurfaceCell>()
     }
 
     /// Global cell index of a point of the odometry frame.
@@ -191,6 +242,32 @@ impl OccupancyGrid {
     /// If the cell is outside the grid.
     pub fn units(&self, ix: usize, iy: usize) -> i8 {
         self.cells[iy * self.width + ix]
+    }
+
+    /// Where the surface lies in local cell `(ix, iy)` (odometry frame):
+    /// the mean of the hits that ended in it. `None` without the surface
+    /// layer, outside the grid, or where the cell is not believed occupied
+    /// (no hit yet, or cleared since).
+    #[inline]
+    pub fn surface_point(&self, ix: usize, iy: usize) -> Option<SurfacePoint> {
+        if ix >= self.width || iy >= self.height {
+            return None;
+        }
+        let i = iy * self.width + ix;
+        let s = self.surface.get(i)?;
+        if s.hits == 0 || self.cells[i] <= 0 {
+            return None;
+        }
+        let offset = DVec2::new(s.offset[0] as f64, s.offset[1] as f64) / SURFACE_SCALE;
+        Some(SurfacePoint {
+            position: self.cell_centre(ix, iy) + offset * self.config.resolution_m,
+            hits: s.hits,
+        })
+    }
+
+    /// Whether this grid keeps surface means.
+    pub fn has_surface(&self) -> bool {
+        self.config.surface_points
     }
 
     /// Log-odds of a global cell (0 outside the grid).
@@ -258,6 +335,15 @@ impl OccupancyGrid {
             cells[start..start + self.width].copy_from_slice(src);
         }
         self.cells = cells;
+        if self.config.surface_points {
+            let mut surface = vec![SurfaceCell::default(); nw * nh];
+            for row in 0..self.height {
+                let src = &self.surface[row * self.width..(row + 1) * self.width];
+                let start = (row + dy) * nw + dx;
+                surface[start..start + self.width].copy_from_slice(src);
+            }
+            self.surface = surface;
+        }
         self.width = nw;
         self.height = nh;
         self.origin_cell = [nx0, ny0];
@@ -275,8 +361,35 @@ impl OccupancyGrid {
                 *c = (*c as i16 + delta as i16)
                     .clamp(self.config.min as i16, self.config.max as i16)
                     as i8;
+                if *c <= 0 {
+                    // Cleared: whatever surface was here is gone.
+                    if let Some(s) = self.surface.get_mut(y * self.width + x) {
+                        s.hits = 0;
+                    }
+                }
             }
             None => self.dropped_updates += 1,
+        }
+    }
+
+    /// Moves the surface mean of the cell holding `p` towards `p`.
+    fn add_surface_hit(&mut self, p: DVec2) {
+        if self.surface.is_empty() {
+            return;
+        }
+        let Some((x, y)) = self.local(self.global_cell(p)) else {
+            return;
+        };
+        let r = self.config.resolution_m;
+        let centre = self.cell_centre(x, y);
+        let i = y * self.width + x;
+        let s = &mut self.surface[i];
+        s.hits = s.hits.saturating_add(1);
+        let target = (p - centre) / r * SURFACE_SCALE;
+        let w = 1.0 / s.hits.min(SURFACE_WINDOW) as f64;
+        for (o, t) in s.offset.iter_mut().zip([target.x, target.y]) {
+            let m = *o as f64;
+            *o = (m + (t - m) * w).round().clamp(-32768.0, 32767.0) as i16;
         }
     }
 
@@ -286,23 +399,115 @@ impl OccupancyGrid {
     /// cell up to and including the end cell is cleared and nothing marked.
     pub fn integrate_beam(&mut self, from: DVec2, to: DVec2, hit: bool) {
         let end = self.global_cell(to);
-        let (miss, occ) = (self.config.miss, self.config.hit);
+        let occ = self.config.hit;
         let r = self.config.resolution_m;
         if hit {
             let len = (to - from).length();
             let margin = self.config.hit_margin_m;
             if len > margin {
                 let stop = from + (to - from) * ((len - margin) / len);
-                let last = self.global_cell(stop);
-                traverse(from / r, stop / r, |c| {
-                    if c != end && c != last {
-                        self.add(c, miss);
-                    }
-                });
+                // Every cell up to the one holding `stop`, not that one: the
+                // end cell is that one or lies beyond it on the beam.
+                self.clear(from / r, stop / r, false);
             }
             self.add(end, occ);
+            self.add_surface_hit(to);
         } else {
-            traverse(from / r, to / r, |c| self.add(c, miss));
+            // Nothing to spare: `end` is cleared too.
+            self.clear(from / r, to / r, true);
+        }
+    }
+
+    /// Lowers every cell the segment `a → b` (in cell units of the odometry
+    /// frame) crosses by `miss`, the cell holding `b` only if `include_last`.
+    fn clear(&mut self, a: DVec2, b: DVec2, include_last: bool) {
+        let miss = self.config.miss;
+        let last = [b.x.floor() as i64, b.y.floor() as i64];
+        let first = [a.x.floor() as i64, a.y.floor() as i64];
+        let (Some(start), Some(_)) = (self.local(first), self.local(last)) else {
+            // Partly outside a grid at its cap: the careful path, which
+            // counts what it drops.
+            traverse(a, b, |c| {
+                if include_last || c != last {
+                    self.add(c, miss);
+                }
+            });
+            return;
+        };
+        // Both ends inside the (rectangular) grid, so is every cell between:
+        // the same walk as `traverse`, stepping the cells' index directly.
+        let w = self.width as i64;
+        let mut index = start.1 as i64 * w + start.0 as i64;
+        let d = b - a;
+        let step = [
+            if d.x > 0.0 { 1 } else { -1 },
+            if d.y > 0.0 { 1 } else { -1 },
+        ];
+        let index_step = [step[0], step[1] * w];
+        let t_delta = [1.0 / d.x.abs(), 1.0 / d.y.abs()];
+        let boundary = |p: f64, c: i64, s: i64| {
+            if s > 0 {
+                (c + 1) as f64 - p
+            } else {
+                p - c as f64
+            }
+        };
+        let mut t_max = [
+            if d.x != 0.0 {
+                boundary(a.x, first[0], step[0]) * t_delta[0]
+            } else {
+                f64::INFINITY
+            },
+            if d.y != 0.0 {
+                boundary(a.y, first[1], step[1]) * t_delta[1]
+            } else {
+                f64::INFINITY
+            },
+        ];
+        let left = [(last[0] - first[0]).abs(), (last[1] - first[1]).abs()];
+        // An axis with no steps left is never chosen again: rounding cannot
+        // carry the walk past the end cell.
+        for axis in 0..2 {
+            if left[axis] == 0 {
+                t_max[axis] = f64::INFINITY;
+            }
+        }
+        let (min, max) = (self.config.min as i16, self.config.max);
+        let (cells, surface) = (&mut self.cells, &mut self.surface);
+        let mut lower = |index: i64| {
+            let Some(v) = usize::try_from(index).ok().and_then(|i| cells.get_mut(i)) else {
+                return;
+            };
+            let was = *v;
+            // A saturated wall is not cleared by a passing beam.
+            if was >= max {
+                return;
+            }
+            *v = (was as i16 + miss as i16).max(min) as i8;
+            if was > 0 && *v <= 0 {
+                if let Some(s) = surface.get_mut(index as usize) {
+                    s.hits = 0;
+                }
+            }
+        };
+        let ([mut tx, mut ty], [dtx, dty]) = (t_max, t_delta);
+        let ([mut nx, mut ny], [sx, sy]) = (left, index_step);
+        for _ in 0..nx + ny {
+            lower(index);
+            // Plain scalars, not arrays indexed by the axis: this loop is
+            // the mapper's hottest.
+            if tx < ty {
+                index += sx;
+                nx -= 1;
+                tx = if nx == 0 { f64::INFINITY } else { tx + dtx };
+            } else {
+                index += sy;
+                ny -= 1;
+                ty = if ny == 0 { f64::INFINITY } else { ty + dty };
+            }
+        }
+        if include_last {
+            lower(index);
         }
     }
 
@@ -312,14 +517,29 @@ impl OccupancyGrid {
         let reach = scan.range_max_m + 2.0 * self.config.resolution_m;
         let c = pose.position();
         self.ensure_contains(c - reach, c + reach);
-        for i in 0..scan.ranges_m.len() {
-            let a = pose.theta + beam_bearing(i);
-            let end = c + DVec2::new(a.cos(), a.sin()) * scan.ranges_m[i];
+        for (i, dir) in beam_directions(pose.theta, scan.ranges_m.len()).enumerate() {
+            let end = c + dir * scan.ranges_m[i];
             let hit = !scan.max_range[i] && !scan.reflective[i];
             self.integrate_beam(c, end, hit);
         }
         self.scans += 1;
     }
+}
+
+/// Unit directions of beams `0..n` for a robot facing `heading` (odometry
+/// frame): the first from its bearing, each next one turned by the beam
+/// spacing (one complex multiplication instead of a sine and a cosine per
+/// beam; the rounding it accumulates over 181 beams is ~1e-15).
+pub fn beam_directions(heading: f64, n: usize) -> impl Iterator<Item = DVec2> {
+    let first = heading + beam_bearing(0);
+    let spacing = beam_bearing(1) - beam_bearing(0);
+    let start = DVec2::new(first.cos(), first.sin());
+    let turn = DVec2::new(spacing.cos(), spacing.sin());
+    (0..n).scan(start, move |d, _| {
+        let here = *d;
+        *d = d.rotate(turn);
+        Some(here)
+    })
 }
 
 /// The state a stored log-odds value stands for.
@@ -345,18 +565,7 @@ pub fn traverse(a: DVec2, b: DVec2, mut visit: impl FnMut([i64; 2])) {
         if d.x > 0.0 { 1 } else { -1 },
         if d.y > 0.0 { 1 } else { -1 },
     ];
-    let t_delta = [
-        if d.x != 0.0 {
-            1.0 / d.x.abs()
-        } else {
-            f64::INFINITY
-        },
-        if d.y != 0.0 {
-            1.0 / d.y.abs()
-        } else {
-            f64::INFINITY
-        },
-    ];
+    let t_delta = [1.0 / d.x.abs(), 1.0 / d.y.abs()];
     let boundary = |p: f64, c: i64, s: i64| {
         if s > 0 {
             (c + 1) as f64 - p
@@ -376,20 +585,15 @@ pub fn traverse(a: DVec2, b: DVec2, mut visit: impl FnMut([i64; 2])) {
             f64::INFINITY
         },
     ];
-    // At most |Δx| + |Δy| cell steps; the bound also guards rounding.
-    let n = (end[0] - cell[0]).abs() + (end[1] - cell[1]).abs();
+    // |Δx| + |Δy| steps, each axis stepping exactly as far as the end cell
+    // (rounding cannot carry the walk past it on one axis).
+    let mut left = [(end[0] - cell[0]).abs(), (end[1] - cell[1]).abs()];
     visit(cell);
-    for _ in 0..n {
-        if t_max[0] < t_max[1] {
-            cell[0] += step[0];
-            t_max[0] += t_delta[0];
-        } else {
-            cell[1] += step[1];
-            t_max[1] += t_delta[1];
-        }
+    while left != [0, 0] {
+        let axis = usize::from(!(left[1] == 0 || (left[0] > 0 && t_max[0] < t_max[1])));
+        cell[axis] += step[axis];
+        t_max[axis] += t_delta[axis];
+        left[axis] -= 1;
         visit(cell);
-        if cell == end {
-            break;
-        }
     }
 }

@@ -1,20 +1,22 @@
 //! # The smoothed grid the matcher scores scans against
 //!
 //! Scan matching asks "how well do these laser end points land on walls of
-//! the map?". Both matchers read the answer from a *likelihood field*: a
-//! local window of the occupancy grid around the search area, where each cell
-//! holds how wall-like it is (0 for free or unknown, rising to 1 for a
-//! confidently occupied cell), blurred so that a point a cell away from a
-//! wall still scores a little:
+//! the map?". The correlative search (and map merging's alignment) read the
+//! answer from a *likelihood field*: a local window of the occupancy grid
+//! around the search area, where each cell holds how wall-like it is (0 for
+//! free or unknown, rising to 1 for a confidently occupied cell), blurred
+//! so that a point a cell away from a wall still scores a little:
 //!
 //! ```text
-//! F(c) = max over d of  H(c + d) · exp(−|d|² / 2σ²)        (|dx|, |dy| ≤ 2 cells)
+//! F(c) = Σ_d w(d) · H(c + d),   w(d) ∝ exp(−|d|² / 2σ²),  Σ w = 1
+//!                                               (|dx|, |dy| ≤ 2 cells)
 //! ```
 //!
 //! That is Olson's "rasterised cost table" (E. Olson, *Real-Time Correlative
-//! Scan Matching*, ICRA 2009, §III-B), with σ of one cell. The max of a
-//! product of Gaussians is separable, so the blur is a row pass then a column
-//! pass.
+//! Scan Matching*, ICRA 2009, §III-B) with σ of one cell, except that Olson
+//! takes the maximum over `d` where this sums (a normalised Gaussian blur);
+//! on a wall, a line of cells, the two differ by a constant factor. The
+//! kernel is separable, so the blur is a row pass then a column pass.
 //!
 //! Two views of the same field serve the two matchers:
 //!

@@ -10,8 +10,10 @@
 //! | log-odds occupancy grid, beam model, growth | [`grid`] | Thrun et al., *Probabilistic Robotics* §9.2 |
 //! | smoothed map for matching | [`likelihood`] | Olson 2009 §III-B; Hector SLAM §IV-A |
 //! | multi-resolution correlative search | [`correlative`] | Olson, ICRA 2009 |
-//! | Gauss–Newton refinement | [`gauss_newton`] | Kohlbrecher et al., SSRR 2011 |
+//! | Gauss–Newton on the smoothed map (map merging) | [`gauss_newton`] | Kohlbrecher et al., SSRR 2011 |
+//! | Gauss–Newton of scan points onto mapped surfaces | [`surface`] | Chen & Medioni 1992 (point-to-plane) |
 //! | corridor degeneracy guard | [`degeneracy`] | Zhang, Kaess, Singh, ICRA 2016 |
+//! | pose filter with odometry self-calibration | [`filter`] | Thrun et al. §7.4; Martinelli 2007 |
 //! | the two mappers, online | [`mapper`] | thesis §4.3 (online SLAM) |
 //! | scoring against ground truth | [`scoring`] | Sturm et al., IROS 2012 (ATE) |
 //! | drawing and ROS map export | [`export`] | ROS `map_server` format |
@@ -22,12 +24,14 @@
 pub mod correlative;
 pub mod degeneracy;
 pub mod export;
+pub mod filter;
 pub mod gauss_newton;
 pub mod grid;
 pub mod lab;
 pub mod likelihood;
 pub mod mapper;
 pub mod scoring;
+pub mod surface;
 
 pub use grid::{CellState, GridConfig, OccupancyGrid};
 pub use mapper::{MapperKind, MatchStatus, RobotMapping, SlamConfig};
