@@ -23,6 +23,15 @@ function scenarioFile(name, obj) {
   return p;
 }
 
+
+/** Parses a binary PGM: "P5", width, height, 255 (comment lines allowed
+ *  between), one whitespace, then the w*h bytes. */
+function readPgm(file) {
+  const pgm = readFileSync(file);
+  const header = pgm.subarray(0, 200).toString('latin1').match(/^P5(?:\s+|#[^\n]*\n)+(\d+)\s+(\d+)\s+255\s/);
+  assert.ok(header, `a P5 header in ${file}`);
+  return { w: Number(header[1]), h: Number(header[2]), data: pgm.subarray(header[0].length) };
+}
 test('run --json prints only the report, with aligned trajectories', () => {
   const r = run('run', 'scenarios/thesis.json', '--json', '--duration', '20');
   assert.equal(r.code, 0, r.stderr);
@@ -173,11 +182,7 @@ test('map writes a ROS map_server PGM + YAML and a PNG', () => {
   assert.match(yaml, /^free_thresh: 0\.196$/m);
   // Binary PGM: "P5", width, height, 255 (comment lines allowed between),
   // one whitespace, then w*h bytes of 254 / 0 / 205 only.
-  const pgm = readFileSync(path.join(path.dirname(out), 'thesis.pgm'));
-  const header = pgm.subarray(0, 200).toString('latin1').match(/^P5(?:\s+|#[^\n]*\n)+(\d+)\s+(\d+)\s+255\s/);
-  assert.ok(header, 'a P5 header');
-  const [w, h] = [Number(header[1]), Number(header[2])];
-  const data = pgm.subarray(header[0].length);
+  const { w, h, data } = readPgm(path.join(path.dirname(out), 'thesis.pgm'));
   assert.equal(data.length, w * h);
   const counts = { 0: 0, 205: 0, 254: 0 };
   for (const v of data) {
@@ -323,12 +328,12 @@ test('merge writes the merged map as ROS map_server PGM + YAML and a PNG', () =>
   const yaml = readFileSync(out, 'utf8');
   assert.match(yaml, /^image: "?thesis\.pgm"?$/m);
   assert.match(yaml, /^resolution: 0\.05/m);
-  const pgm = readFileSync(out.replace(/yaml$/, 'pgm'));
-  const header = pgm.subarray(0, 20).toString('latin1');
-  const [magic, w, h, max] = header.split(/\s+/);
-  assert.equal(magic, 'P5');
-  assert.equal(max, '255');
-  assert.ok(Number(w) > 100 && Number(h) > 100, `${w} x ${h}`);
+  const { w, h, data } = readPgm(out.replace(/yaml$/, 'pgm'));
+  assert.equal(data.length, w * h);
+  assert.ok(w > 100 && h > 100, `${w} x ${h}`);
+  // A merged map holds walls, free space and unknown cells, nothing else.
+  const seen = new Set(data);
+  assert.deepEqual([...seen].sort((a, b) => a - b), [0, 205, 254]);
   const png = readFileSync(out.replace(/yaml$/, 'png'));
   assert.deepEqual([...png.subarray(1, 4)], [0x50, 0x4e, 0x47]);
 });
