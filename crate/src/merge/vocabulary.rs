@@ -32,7 +32,16 @@
 //!   is cut to `max_pairs`.
 //!
 //! Similar-looking frames are only *proposals*: repeated textures make
-//! different places look alike. [`super::verify`] checks each geometrically.
+//! different places look alike. [`super::verify`] checks each geometrically,
+//! through keypoints the laser can range; so a frame is best described by
+//! those keypoints alone ([`Vocabulary::train_with_bags_on`] with
+//! [`super::lift::liftable_keypoints`]), or far walls seen beyond the
+//! laser's reach fill the proposals with pairs that cannot verify.
+//!
+//! Cost, for 2 × 301 frames of 200-350 keypoints (150 strongest per bag,
+//! 512 words): training and all bags about 60-80 ms natively, proposals
+//! about 10 ms; in wasm (SIMD128, node) about 70 ms and 35 ms once the
+//! engine has optimised the code, two to four times that on a first call.
 
 use crate::surf::prng::SplitMix64;
 use crate::surf::simd::dot64_many;

@@ -519,7 +519,9 @@ impl OccupancyGrid {
         self.ensure_contains(c - reach, c + reach);
         for (i, dir) in beam_directions(pose.theta, scan.ranges_m.len()).enumerate() {
             let end = c + dir * scan.ranges_m[i];
-            let hit = !scan.max_range[i] && !scan.reflective[i];
+            // A beam without its flags counts as max-range: clear, mark nothing.
+            let hit =
+                scan.max_range.get(i) == Some(&false) && scan.reflective.get(i) == Some(&false);
             self.integrate_beam(c, end, hit);
         }
         self.scans += 1;

@@ -131,7 +131,11 @@ pub struct MatchOutcome {
 pub fn scan_points(scan: &LaserScan) -> Vec<DVec2> {
     beam_directions(0.0, scan.ranges_m.len())
         .enumerate()
-        .filter(|&(i, _)| !scan.max_range[i] && !scan.reflective[i] && scan.ranges_m[i] > 0.05)
+        .filter(|&(i, _)| {
+            scan.max_range.get(i) == Some(&false)
+                && scan.reflective.get(i) == Some(&false)
+                && scan.ranges_m[i] > 0.05
+        })
         .map(|(i, d)| d * scan.ranges_m[i])
         .collect()
 }
@@ -177,7 +181,7 @@ pub fn match_scan(
         let Some((field, coarse)) = coarse_search(map, scan, &points, prior, cfg) else {
             return keep;
         };
-        let (pose, _) = gauss_newton::refine(&field, &points, &coarse, 6);
+        let (pose, _) = gauss_newton::refine(&field, &points, &coarse, FIELD_REFINE_ITERATIONS);
         let associated: Vec<bool> = points
             .iter()
             .map(|&p| field.bilinear(pose.transform_point(p)).0 >= ON_WALL_FIELD)
@@ -222,9 +226,10 @@ pub fn match_scan(
     }
 }
 
-/// Smoothed-map value above which a point counts as on a wall (for grids
-/// without surface means).
+/// Smoothed-map value above which a point counts as on a wall, and
+/// Gauss–Newton steps on the smoothed map (for grids without surface means).
 const ON_WALL_FIELD: f64 = 0.15;
+const FIELD_REFINE_ITERATIONS: usize = 6;
 
 /// Olson's correlative search around `prior` on the smoothed map (which it
 /// returns too).
