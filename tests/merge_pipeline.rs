@@ -137,3 +137,64 @@ fn lab_merges_in_increments_scores_against_truth_and_forgets_on_step() {
     lab.reset();
     assert!(lab.merge_view().is_err());
 }
+
+/// Three robots in one maze and a fourth alone in a room of its own: the
+/// pairwise results form a graph, the three are joined along its most
+/// confident spanning tree, each within the 0.1 m and 1° of the
+/// truth, and the fourth is listed as not joined rather than placed
+/// anywhere.
+#[wasm_bindgen_test(unsupported = test)]
+fn three_robots_join_and_a_fourth_that_shares_nothing_is_listed() {
+    use slamlab::lab::Lab;
+    use slamlab::merge::{MergeMethod, MergeStatus};
+    let spec = MazeSpec {
+        seed: 5,
+        robots: 3,
+        ..MazeSpec::default()
+    };
+    let mut v: serde_json::Value = serde_json::from_str(&random_maze(&spec)).expect("maze is JSON");
+    // A 4 × 4 m room 6 m east of the 12.5 m wide maze.
+    let (x0, y0, s) = (18.5, 2.0, 4.0);
+    let corners = [[x0, y0], [x0 + s, y0], [x0 + s, y0 + s], [x0, y0 + s]];
+    for k in 0..4 {
+        v["walls"]
+            .as_array_mut()
+            .expect("walls")
+            .push(serde_json::json!({ "from": corners[k], "to": corners[(k + 1) % 4] }));
+    }
+    v["robots"]
+        .as_array_mut()
+        .expect("robots")
+        .push(serde_json::json!({
+            "name": "robot4", "start": [x0 + 2.0, y0 + 2.0, 0.3], "follow": "left"
+        }));
+    let mut lab = Lab::new(&v.to_string()).expect("lab");
+    lab.run_to_end().expect("runs");
+    lab.merge_start(MergeMethod::Auto).expect("starts");
+    while !lab.merge_advance(usize::MAX).expect("advances").finished {}
+    let report = lab.merge_report().expect("report");
+    println!("{:?}: {}", report.status, report.reason);
+    assert_eq!(report.status, MergeStatus::Merged, "{}", report.reason);
+    assert_eq!(report.unjoined, ["robot4"], "{}", report.reason);
+    assert!(
+        report.reason.contains("not joined: robot4"),
+        "{}",
+        report.reason
+    );
+    let joined: Vec<&str> = report.transforms.iter().map(|t| t.robot.as_str()).collect();
+    assert_eq!(joined, ["robot1", "robot2", "robot3"]);
+    // All six pairs were tried; robot4's three all failed.
+    assert_eq!(report.pairs.len(), 6);
+    for e in &report.errors {
+        println!("{}: {:.3} m {:.2} deg", e.robot, e.error_m, e.error_deg);
+        assert!(
+            e.error_m < 0.1 && e.error_deg.abs() < 1.0,
+            "{} off by {} m, {} deg",
+            e.robot,
+            e.error_m,
+            e.error_deg
+        );
+    }
+    assert_eq!(report.errors.len(), 3);
+    assert_eq!(report.robot_poses.len(), 3);
+}
