@@ -4,8 +4,11 @@
 //! simulated runs; the truth is used only to score.
 //!
 //! ```text
-//! cargo run --release -p slamlab --example bench_merge -- [--runs 20] [--others 5] [--duration 300] [--methods auto,thesis,map-only] [--verbose]
+//! cargo run --release -p slamlab --example bench_merge -- [--runs 20] [--others 5] [--multi 5] [--duration 300] [--methods auto,thesis,map-only] [--verbose]
 //! ```
+//!
+//! `--multi N` adds N mazes with three robots each, scored robot by robot:
+//! each robot's map frame in the merged frame against the truth.
 //!
 //! A run "has a common region" when, placed with the true transform, the
 //! two SLAM maps share at least `COMMON_CELLS` wall cells. A merge is
@@ -93,7 +96,14 @@ fn main() {
         .split(',')
         .map(|m| MergeMethod::parse(m).expect("method"))
         .collect();
+    let multi: u64 = arg(&args, "--multi")
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0);
     let verbose = args.iter().any(|a| a == "--verbose");
+    // `--only maze-14`: just that case, with the whole reason.
+    let only = arg(&args, "--only");
+    // `--min-places N`: the verdict's independent places (an experiment).
+    let min_places: Option<usize> = arg(&args, "--min-places").and_then(|s| s.parse().ok());
     let mut cases: Vec<(String, String)> = Vec::new();
     for seed in 1..=runs {
         let spec = MazeSpec {
@@ -118,16 +128,29 @@ fn main() {
         };
         cases.push((format!("repeated-{}", 200 + seed), random_maze(&spec)));
     }
+    for seed in 1..=multi {
+        let spec = MazeSpec {
+            seed: 300 + seed,
+            robots: 3,
+            duration_s: duration,
+            ..bench_maze()
+        };
+        cases.push((format!("three-{}", 300 + seed), random_maze(&spec)));
+    }
     let mut tallies: Vec<(String, Tally)> = methods
         .iter()
         .flat_map(|m| {
-            ["maze", "disjoint", "repeated"]
+            ["maze", "disjoint", "repeated", "three"]
                 .into_iter()
                 .map(move |k| (format!("{}/{k}", m.name()), Tally::default()))
         })
         .collect();
+    let mut multi_tally: Vec<(&'static str, MultiTally)> = Vec::new();
     println!("case            method    common  status    error_m  error_deg  ms     reason");
     for (name, json) in &cases {
+        if only.as_ref().is_some_and(|o| o != name) {
+            continue;
+        }
         let scenario = Scenario::parse(json).expect("scenario parses");
         let mut sim = Simulation::new(&scenario).expect("scenario runs");
         sim.run_to_end();
@@ -142,8 +165,11 @@ fn main() {
         let has_common = kind != "disjoint" && common >= COMMON_CELLS;
         for &method in &methods {
             let t0 = Instant::now();
-            let mut job =
-                MergeJob::new(&sim, MergeConfig::new(method, scenario.seed)).expect("job");
+            let mut cfg = MergeConfig::new(method, scenario.seed);
+            if let Some(n) = min_places {
+                cfg.verdict.min_places = n;
+            }
+            let mut job = MergeJob::new(&sim, cfg).expect("job");
             let mut stage_ms: Vec<(&'static str, f64)> = Vec::new();
             while !job.is_done() {
                 let stage = job.stage().name();
@@ -177,6 +203,10 @@ fn main() {
             }
             let outcome = job.outcome().expect("outcome");
             let merged = outcome.status == MergeStatus::Merged;
+            if kind == "three" {
+                score_robots(&sim, &starts, outcome, &mut multi_tally, method, name, ms);
+                continue;
+            }
             let err = outcome
                 .transforms
                 .iter()
@@ -215,7 +245,11 @@ fn main() {
                     tally.imprecise += 1;
                 }
             }
-            let reason: String = outcome.reason.chars().take(90).collect();
+            let reason: String = if only.is_some() {
+                outcome.reason.clone()
+            } else {
+                outcome.reason.chars().take(90).collect()
+            };
             println!(
                 "{name:<15} {:<9} {common:>6}  {:<8} {:>8} {:>9} {ms:>6.0}  {reason}",
                 method.name(),
@@ -247,4 +281,70 @@ fn main() {
             ms[ms.len() / 2]
         );
     }
+    for (method, t) in &multi_tally {
+        println!(
+            "{method}/three: {} robots to join in {} runs, {} joined ({} correct, {} imprecise, {} wrong)",
+            t.robots, t.runs, t.joined, t.correct, t.imprecise, t.wrong
+        );
+    }
+}
+
+/// Three-robot runs, scored robot by robot.
+#[derive(Default)]
+struct MultiTally {
+    runs: usize,
+    /// Robots other than the first (each needs joining).
+    robots: usize,
+    joined: usize,
+    correct: usize,
+    imprecise: usize,
+    wrong: usize,
+}
+
+fn score_robots(
+    sim: &Simulation,
+    starts: &[Pose2],
+    outcome: &slamlab::merge::job::MergeOutcome,
+    tallies: &mut Vec<(&'static str, MultiTally)>,
+    method: MergeMethod,
+    name: &str,
+    ms: f64,
+) {
+    if !tallies.iter().any(|(m, _)| *m == method.name()) {
+        tallies.push((method.name(), MultiTally::default()));
+    }
+    let t = &mut tallies
+        .iter_mut()
+        .find(|(m, _)| *m == method.name())
+        .expect("tally")
+        .1;
+    t.runs += 1;
+    let mut parts = Vec::new();
+    for (i, r) in sim.robots.iter().enumerate().skip(1) {
+        t.robots += 1;
+        let truth = starts[0].inverse().compose(&starts[i]);
+        let Some(tf) = outcome.transforms.iter().find(|x| x.robot == r.spec.name) else {
+            parts.push(format!("{} unjoined", r.spec.name));
+            continue;
+        };
+        t.joined += 1;
+        let p = Pose2::new(tf.pose[0], tf.pose[1], tf.pose[2]);
+        let (m, d) = (
+            (p.position() - truth.position()).length(),
+            wrap_angle(p.theta - truth.theta).to_degrees().abs(),
+        );
+        if m <= 0.1 && d <= 1.0 {
+            t.correct += 1;
+        } else if m > 0.3 || d > 3.0 {
+            t.wrong += 1;
+        } else {
+            t.imprecise += 1;
+        }
+        parts.push(format!("{} {m:.3} m {d:.2}°", r.spec.name));
+    }
+    println!(
+        "{name:<15} {:<9} {ms:>6.0}  {}",
+        method.name(),
+        parts.join(", ")
+    );
 }

@@ -35,7 +35,7 @@ use super::fuse::fuse;
 use super::graph::{spanning_tree, PairEdge};
 use super::selection::{select_frames, SelectionConfig};
 use super::thesis::{thesis_merge, DistanceSolution, PairMatch};
-use super::verdict::{decide_pair, VerdictConfig};
+use super::verdict::{decide_pair_after_search, SearchSummary, VerdictConfig};
 use super::verify::{verify_pair, PairCheck, VerifyConfig};
 use super::vocabulary::{propose_pairs, Bag, Vocabulary, VocabularyConfig};
 use super::{Candidate, FrameInfo, MergeMethod, MergeStatus};
@@ -154,6 +154,10 @@ pub struct Cell {
     pub inliers: u32,
     /// Ratio-test matches.
     pub matches: u32,
+    /// Rigid-fit inliers, also when too few for a candidate (automatic
+    /// method): the "too few inliers" reason quotes the best.
+    #[serde(skip)]
+    pub rigid_inliers: u32,
     /// The candidate transform this pair gives (automatic method).
     #[serde(skip)]
     pub candidate: Option<Candidate>,
@@ -564,6 +568,7 @@ impl MergeJob {
                         col,
                         inliers: inliers as u32,
                         matches: check.matches.len() as u32,
+                        rigid_inliers: check.rigid_inliers as u32,
                         candidate: check.candidate,
                         homography: check.homography,
                         quad: check.quad,
@@ -574,6 +579,7 @@ impl MergeJob {
                     col,
                     inliers: 0,
                     matches: 0,
+                    rigid_inliers: 0,
                     candidate: None,
                     homography: None,
                     quad: None,
@@ -601,7 +607,23 @@ impl MergeJob {
                 MergeMethod::Auto => {
                     let cands: Vec<Candidate> =
                         p.cells.iter().filter_map(|c| c.candidate.clone()).collect();
-                    let d = decide_pair(&cands, map_a, map_b, &self.config.verdict);
+                    let summary = SearchSummary {
+                        proposed_pairs: p.cells.len(),
+                        best_rigid_inliers: p
+                            .cells
+                            .iter()
+                            .map(|c| c.rigid_inliers as usize)
+                            .max()
+                            .unwrap_or(0),
+                        min_inliers: self.config.verify.min_inliers,
+                    };
+                    let d = decide_pair_after_search(
+                        &cands,
+                        &summary,
+                        map_a,
+                        map_b,
+                        &self.config.verdict,
+                    );
                     PairOutcome {
                         a: name_a,
                         b: name_b,
