@@ -3,7 +3,7 @@
 
 use glam::DVec2;
 use slamlab::geom::Pose2;
-use slamlab::slam::export::{to_pgm, to_yaml};
+use slamlab::slam::export::{to_pgm, to_yaml, GridPicture};
 use slamlab::slam::grid::{traverse, CellState, GridConfig, OccupancyGrid, LOG_ODDS_UNIT};
 use wasm_bindgen_test::wasm_bindgen_test;
 
@@ -221,4 +221,38 @@ fn the_surface_layer_survives_growth() {
         .expect("inside");
     let s = g.surface_point(x, y).expect("kept");
     assert!((s.position - DVec2::new(0.512, 0.233)).length() < 1e-6);
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn grid_picture_fits_the_grid_y_up_and_draws_in_map_coordinates() {
+    let mut g = OccupancyGrid::new(GridConfig::default());
+    g.ensure_contains(DVec2::new(-0.5, -0.5), DVec2::new(0.5, 0.5));
+    for _ in 0..5 {
+        g.integrate_beam(DVec2::new(0.01, 0.01), DVec2::new(0.301, 0.01), true);
+    }
+    let (w, h) = (g.width() as u32, g.height() as u32);
+    // Twice the grid's size in both directions: 2 × 2 pixels a cell, no margin.
+    let mut pic = GridPicture::new(&g, 2 * w, 2 * h).expect("picture");
+    let o = g.origin_m();
+    assert_eq!(pic.to_px(o), (0.0, (2 * h) as f32));
+    let cell = |gx: i64, gy: i64| {
+        let (ix, iy) = g.local([gx, gy]).expect("in the grid");
+        // Bottom-left pixel of the cell's 2 × 2 block, image rows down.
+        (2 * ix, 2 * (h as usize - 1 - iy) + 1)
+    };
+    let px = |rgba: &[u8], (x, y): (usize, usize)| rgba[(y * 2 * w as usize + x) * 4];
+    let before = {
+        let p = GridPicture::new(&g, 2 * w, 2 * h).expect("picture");
+        p.into_rgba()
+    };
+    assert_eq!(px(&before, cell(6, 0)), 30, "the wall cell is dark");
+    assert_eq!(px(&before, cell(2, 0)), 250, "free cells are light");
+    assert_eq!(px(&before, (0, 0)), 205, "unknown is grey");
+    // A red dot drawn at the wall cell's centre lands on its pixels.
+    pic.dot(DVec2::new(0.325, 0.025), 2.0, [255, 0, 0, 255]);
+    let after = pic.into_rgba();
+    let (x, y) = cell(6, 0);
+    let i = (y * 2 * w as usize + x) * 4;
+    assert_eq!(&after[i..i + 4], &[255, 0, 0, 255]);
+    assert!(GridPicture::new(&g, 0, 10).is_err());
 }

@@ -15,8 +15,9 @@ use super::job::{MergeConfig, MergeJob, MergeOutcome, PairOutcome, RobotTransfor
 use super::{MergeMethod, MergeStatus};
 use crate::geom::{wrap_angle, Pose2};
 use crate::lab::Lab;
-use crate::slam::export::{to_pgm, to_png, to_yaml};
-use crate::slam::{CellState, OccupancyGrid};
+use crate::slam::export::{to_pgm, to_png, to_yaml, GridPicture};
+use crate::slam::OccupancyGrid;
+use glam::DVec2;
 use serde::Serialize;
 
 /// Where a merge stands.
@@ -413,92 +414,31 @@ impl Lab {
     /// The merged map as RGBA pixels fitted to `width × height`, with each
     /// joined robot's SLAM path (in the merged frame) in its colour.
     pub fn merged_rgba(&self, width: u32, height: u32) -> Result<Vec<u8>, String> {
-        use tiny_skia::{Color, Paint, PathBuilder, Pixmap, Stroke, Transform};
         let g = self.merged()?;
         let sim = self.simulation().ok_or("nothing has run yet")?;
         let job = self.merge.as_ref().ok_or("no merge has been started")?;
         let outcome = job.outcome().ok_or("the merge has not finished yet")?;
-        let mut pm = Pixmap::new(width, height)
-            .ok_or_else(|| format!("cannot make a {width}x{height} image"))?;
-        pm.fill(Color::from_rgba8(205, 205, 205, 255));
+        let mut pic = GridPicture::new(g, width, height)?;
         if g.width() == 0 {
-            return Ok(pm.take());
+            return Ok(pic.into_rgba());
         }
-        let scale = (width as f64 / g.width() as f64).min(height as f64 / g.height() as f64);
-        let ox = (width as f64 - scale * g.width() as f64) / 2.0;
-        let oy = (height as f64 - scale * g.height() as f64) / 2.0;
-        let data = pm.data_mut();
-        for py in 0..height as usize {
-            let gy = ((height as f64 - 0.5 - py as f64 - oy) / scale).floor();
-            if gy < 0.0 || gy >= g.height() as f64 {
-                continue;
-            }
-            for px in 0..width as usize {
-                let gx = ((px as f64 + 0.5 - ox) / scale).floor();
-                if gx < 0.0 || gx >= g.width() as f64 {
-                    continue;
-                }
-                let v = match g.state(gx as usize, gy as usize) {
-                    CellState::Free => 250,
-                    CellState::Occupied => 30,
-                    CellState::Unknown => 205,
-                };
-                let i = (py * width as usize + px) * 4;
-                data[i..i + 3].fill(v);
-            }
-        }
-        let (origin, res) = (g.origin_m(), g.resolution_m());
-        let to_px = |p: glam::DVec2| {
-            let u = (p - origin) / res;
-            (
-                (ox + u.x * scale) as f32,
-                (height as f64 - oy - u.y * scale) as f32,
-            )
-        };
         for t in &outcome.transforms {
             let Some(i) = sim.robots.iter().position(|r| r.spec.name == t.robot) else {
                 continue;
             };
             let frame = pose_of(t.pose);
             let est = sim.robots[i].mapping.estimates();
-            let mut pb = PathBuilder::new();
-            let stride = (est.len() / 2000).max(1);
-            for (k, p) in est.iter().step_by(stride).enumerate() {
-                let (x, y) = to_px(frame.transform_point(p.position()));
-                if k == 0 {
-                    pb.move_to(x, y);
-                } else {
-                    pb.line_to(x, y);
-                }
-            }
+            let path: Vec<DVec2> = est
+                .iter()
+                .map(|p| frame.transform_point(p.position()))
+                .collect();
             let [r, gr, b] = crate::render::ROBOT_COLOURS[i % crate::render::ROBOT_COLOURS.len()];
-            let mut paint = Paint::default();
-            paint.set_color_rgba8(r, gr, b, 220);
-            paint.anti_alias = true;
-            if let Some(path) = pb.finish() {
-                let stroke = Stroke {
-                    width: 1.5,
-                    ..Stroke::default()
-                };
-                pm.stroke_path(&path, &paint, &stroke, Transform::identity(), None);
-            }
+            pic.polyline(&path, [r, gr, b, 220], 1.5);
             if let Some(last) = est.last() {
-                let on_map = frame.compose(last);
-                let (x, y) = to_px(on_map.position());
-                if let Some(dot) = PathBuilder::from_circle(x, y, 4.0) {
-                    pm.fill_path(
-                        &dot,
-                        &paint,
-                        tiny_skia::FillRule::Winding,
-                        Transform::identity(),
-                        None,
-                    );
-                }
+                pic.dot(frame.compose(last).position(), 4.0, [r, gr, b, 220]);
             }
         }
-        // Un-premultiply is unnecessary: everything drawn is opaque or
-        // blended onto an opaque background.
-        Ok(pm.take())
+        Ok(pic.into_rgba())
     }
 }
 

@@ -13,6 +13,7 @@
 //! picture the page draws and the PNG written beside the PGM.
 
 use super::grid::{state_of, CellState, OccupancyGrid};
+use glam::DVec2;
 
 /// ROS map_server values.
 pub const PGM_FREE: u8 = 254;
@@ -80,4 +81,129 @@ pub fn to_png(grid: &OccupancyGrid) -> Result<Vec<u8>, String> {
         .write_image(&pixels, w as u32, h as u32, image::ExtendedColorType::L8)
         .map_err(|e| format!("PNG encoding failed: {e}"))?;
     Ok(out)
+}
+
+/// A grid drawn to fit an RGBA image (y up, centred, cells as the three
+/// shades of the PGM but lighter free space), with paths and dots drawn over
+/// it in map coordinates. The page's map views (one robot's grid, the
+/// merged grid) are all made this way.
+pub struct GridPicture {
+    pixmap: tiny_skia::Pixmap,
+    scale: f64,
+    offset: DVec2,
+    origin: DVec2,
+    resolution: f64,
+}
+
+impl GridPicture {
+    /// `grid` fitted into `width × height` pixels; an empty grid gives an
+    /// all-unknown image.
+    pub fn new(grid: &OccupancyGrid, width: u32, height: u32) -> Result<Self, String> {
+        let mut pixmap = tiny_skia::Pixmap::new(width, height)
+            .ok_or_else(|| format!("cannot make a {width}x{height} image"))?;
+        pixmap.fill(tiny_skia::Color::from_rgba8(205, 205, 205, 255));
+        let (gw, gh) = (grid.width().max(1) as f64, grid.height().max(1) as f64);
+        let scale = (width as f64 / gw).min(height as f64 / gh);
+        let offset = DVec2::new(
+            (width as f64 - scale * gw) / 2.0,
+            (height as f64 - scale * gh) / 2.0,
+        );
+        if grid.width() > 0 {
+            let data = pixmap.data_mut();
+            for py in 0..height as usize {
+                let gy = ((height as f64 - 0.5 - py as f64 - offset.y) / scale).floor();
+                if gy < 0.0 || gy >= gh {
+                    continue;
+                }
+                for px in 0..width as usize {
+                    let gx = ((px as f64 + 0.5 - offset.x) / scale).floor();
+                    if gx < 0.0 || gx >= gw {
+                        continue;
+                    }
+                    let v = match grid.state(gx as usize, gy as usize) {
+                        CellState::Free => 250,
+                        CellState::Occupied => 30,
+                        CellState::Unknown => 205,
+                    };
+                    let i = (py * width as usize + px) * 4;
+                    data[i..i + 3].fill(v);
+                }
+            }
+        }
+        Ok(GridPicture {
+            pixmap,
+            scale,
+            offset,
+            origin: grid.origin_m(),
+            resolution: grid.resolution_m(),
+        })
+    }
+
+    /// Pixel position of map point `p` (metres, the grid's frame).
+    pub fn to_px(&self, p: DVec2) -> (f32, f32) {
+        let u = (p - self.origin) / self.resolution;
+        (
+            (self.offset.x + u.x * self.scale) as f32,
+            (self.pixmap.height() as f64 - self.offset.y - u.y * self.scale) as f32,
+        )
+    }
+
+    /// A polyline through `points` (at most about 2000 of them are used,
+    /// evenly, always including the last).
+    pub fn polyline(&mut self, points: &[DVec2], rgba: [u8; 4], width: f32) {
+        let mut pb = tiny_skia::PathBuilder::new();
+        let stride = (points.len() / 2000).max(1);
+        for (k, p) in points.iter().step_by(stride).enumerate() {
+            let (x, y) = self.to_px(*p);
+            if k == 0 {
+                pb.move_to(x, y);
+            } else {
+                pb.line_to(x, y);
+            }
+        }
+        if let Some(last) = points.last().filter(|_| points.len() > 1) {
+            let (x, y) = self.to_px(*last);
+            pb.line_to(x, y);
+        }
+        if let Some(path) = pb.finish() {
+            let stroke = tiny_skia::Stroke {
+                width,
+                ..tiny_skia::Stroke::default()
+            };
+            self.pixmap.stroke_path(
+                &path,
+                &paint(rgba),
+                &stroke,
+                tiny_skia::Transform::identity(),
+                None,
+            );
+        }
+    }
+
+    /// A filled dot of `radius_px` at map point `p`.
+    pub fn dot(&mut self, p: DVec2, radius_px: f32, rgba: [u8; 4]) {
+        let (x, y) = self.to_px(p);
+        if let Some(dot) = tiny_skia::PathBuilder::from_circle(x, y, radius_px) {
+            self.pixmap.fill_path(
+                &dot,
+                &paint(rgba),
+                tiny_skia::FillRule::Winding,
+                tiny_skia::Transform::identity(),
+                None,
+            );
+        }
+    }
+
+    /// The RGBA bytes. Everything drawn is blended onto an opaque
+    /// background, so the premultiplied pixels are plain RGBA.
+    pub fn into_rgba(self) -> Vec<u8> {
+        self.pixmap.take()
+    }
+}
+
+fn paint(rgba: [u8; 4]) -> tiny_skia::Paint<'static> {
+    let mut p = tiny_skia::Paint::default();
+    p.set_color_rgba8(rgba[0], rgba[1], rgba[2], rgba[3]);
+    p.anti_alias = true;
+    p
 }

@@ -5,12 +5,13 @@
 //! files or as a picture, its metadata, and the figures that score it.
 //! Scoring reads the truth, as display and scoring may; the mappers never do.
 
-use super::export::{to_pgm, to_png, to_yaml};
-use super::grid::{CellState, OccupancyGrid};
+use super::export::{to_pgm, to_png, to_yaml, GridPicture};
+use super::grid::OccupancyGrid;
 use super::mapper::{MapperKind, RobotMapping};
 use super::scoring::{ate_m, map_accuracy, position_errors_m};
 use crate::lab::Lab;
 use crate::sim::{RobotSim, Simulation};
+use glam::DVec2;
 use serde::Serialize;
 
 /// The figures of one robot's two mappers (the report's `robots[].slam`).
@@ -181,83 +182,26 @@ impl Lab {
         width: u32,
         height: u32,
     ) -> Result<Vec<u8>, String> {
-        use tiny_skia::{Color, Paint, PathBuilder, Pixmap, Stroke, Transform};
         let (_, r) = self.robot_sim(robot)?;
         let g = r.mapping.map(which);
-        let mut pm = Pixmap::new(width, height)
-            .ok_or_else(|| format!("cannot make a {width}x{height} image"))?;
-        pm.fill(Color::from_rgba8(205, 205, 205, 255));
+        let mut pic = GridPicture::new(g, width, height)?;
         if g.width() == 0 {
-            return Ok(pm.take());
+            return Ok(pic.into_rgba());
         }
-        // Fit the grid to the image, y up.
-        let scale = (width as f64 / g.width() as f64).min(height as f64 / g.height() as f64);
-        let ox = (width as f64 - scale * g.width() as f64) / 2.0;
-        let oy = (height as f64 - scale * g.height() as f64) / 2.0;
-        let data = pm.data_mut();
-        for py in 0..height as usize {
-            let gy = ((height as f64 - 0.5 - py as f64 - oy) / scale).floor();
-            if gy < 0.0 || gy >= g.height() as f64 {
-                continue;
-            }
-            for px in 0..width as usize {
-                let gx = ((px as f64 + 0.5 - ox) / scale).floor();
-                if gx < 0.0 || gx >= g.width() as f64 {
-                    continue;
-                }
-                let v = match g.state(gx as usize, gy as usize) {
-                    CellState::Free => 250,
-                    CellState::Occupied => 30,
-                    CellState::Unknown => 205,
-                };
-                let i = (py * width as usize + px) * 4;
-                data[i..i + 3].fill(v);
-            }
-        }
-        let origin = g.origin_m();
-        let res = g.resolution_m();
-        let to_px = |p: glam::DVec2| {
-            let u = (p - origin) / res;
-            (
-                (ox + u.x * scale) as f32,
-                (height as f64 - oy - u.y * scale) as f32,
-            )
-        };
         let inv_start = r.spec.start_pose().inverse();
-        let truth: Vec<_> = r.log.truth.iter().map(|t| inv_start.compose(t)).collect();
+        let truth: Vec<DVec2> = r
+            .log
+            .truth
+            .iter()
+            .map(|t| inv_start.compose(t).position())
+            .collect();
         let est: &[crate::geom::Pose2] = match which {
             MapperKind::Slam => r.mapping.estimates(),
             MapperKind::Odometry => &r.log.odometry,
         };
-        for (poses, rgb, w) in [
-            (&truth[..], (40u8, 160u8, 60u8), 1.5f32),
-            (est, (200, 40, 40), 1.5),
-        ] {
-            let mut pb = PathBuilder::new();
-            let stride = (poses.len() / 2000).max(1);
-            for (k, p) in poses.iter().step_by(stride).enumerate() {
-                let (x, y) = to_px(p.position());
-                if k == 0 {
-                    pb.move_to(x, y);
-                } else {
-                    pb.line_to(x, y);
-                }
-            }
-            if let Some(last) = poses.last() {
-                let (x, y) = to_px(last.position());
-                pb.line_to(x, y);
-            }
-            if let Some(path) = pb.finish() {
-                let mut paint = Paint::default();
-                paint.set_color_rgba8(rgb.0, rgb.1, rgb.2, 255);
-                paint.anti_alias = true;
-                let stroke = Stroke {
-                    width: w,
-                    ..Stroke::default()
-                };
-                pm.stroke_path(&path, &paint, &stroke, Transform::identity(), None);
-            }
-        }
-        Ok(pm.take())
+        let est: Vec<DVec2> = est.iter().map(|p| p.position()).collect();
+        pic.polyline(&truth, [40, 160, 60, 255], 1.5);
+        pic.polyline(&est, [200, 40, 40, 255], 1.5);
+        Ok(pic.into_rgba())
     }
 }
