@@ -1,97 +1,19 @@
 // End-to-end test of the page (index.html + web/) in headless Chromium.
 //
-// Serves the repository root from a tiny static server of its own (on a free
-// port of 127.0.0.1), drives /usr/bin/chromium with playwright-core, and
-// walks through what a student does: load a preset, draw a wall, run, pause,
-// step, read the sensors, reset, reload (autosave), and survive a corrupt
-// save. Screenshots go to test-artifacts/.
+// Serves the repository root and drives /usr/bin/chromium with
+// playwright-core (tests/support/browser.mjs), and walks through what a
+// student does: load a preset, draw a wall, run, pause, step, read the
+// sensors, reset, reload (autosave), and survive a corrupt save. Screenshots go to test-artifacts/.
 //
 // Needs the wasm build in web/pkg (`./build.sh build`). Run alone with
 //   node --test tests/page.test.mjs
-import { test, before, after } from 'node:test';
+import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import http from 'node:http';
-import { readFile, mkdir, access } from 'node:fs/promises';
 import path from 'node:path';
-import { fileURLToPath } from 'node:url';
-import { chromium } from 'playwright-core';
+import { ARTIFACTS, newPage, useBrowser, waitReady } from './support/browser.mjs';
 
-const ROOT = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
-const ARTIFACTS = path.join(ROOT, 'test-artifacts');
-const CHROMIUM_FLAGS = [
-  '--headless',
-  '--no-sandbox',
-  '--disable-gpu',
-  '--disable-quic',
-  '--no-first-run',
-  '--disable-background-networking',
-  '--disable-component-update',
-  '--disable-sync',
-];
-const MIME = {
-  '.html': 'text/html; charset=utf-8',
-  '.js': 'text/javascript; charset=utf-8',
-  '.mjs': 'text/javascript; charset=utf-8',
-  '.css': 'text/css; charset=utf-8',
-  '.json': 'application/json',
-  '.wasm': 'application/wasm',
-  '.png': 'image/png',
-  '.svg': 'image/svg+xml',
-  '.ts': 'text/plain; charset=utf-8',
-};
 const STORAGE_KEY = 'slamlab.scenario.v1';
-
-/** A static file server for the repository root; resolves to {server, url}. */
-function serveRoot() {
-  const server = http.createServer(async (req, res) => {
-    try {
-      const url = new URL(req.url, 'http://localhost');
-      let rel = decodeURIComponent(url.pathname);
-      if (rel.endsWith('/')) rel += 'index.html';
-      const file = path.resolve(ROOT, `.${rel}`);
-      if (!file.startsWith(ROOT + path.sep)) {
-        res.writeHead(403).end();
-        return;
-      }
-      const body = await readFile(file);
-      res.writeHead(200, {
-        'Content-Type': MIME[path.extname(file)] ?? 'application/octet-stream',
-        'Cache-Control': 'no-store',
-      });
-      res.end(body);
-    } catch {
-      res.writeHead(404, { 'Content-Type': 'text/plain' }).end('not found');
-    }
-  });
-  return new Promise((resolve, reject) => {
-    server.once('error', reject);
-    server.listen(0, '127.0.0.1', () => resolve({ server, url: `http://127.0.0.1:${server.address().port}/` }));
-  });
-}
-
-let server;
-let baseUrl;
-let browser;
-
-before(async () => {
-  await access(path.join(ROOT, 'web/pkg/slamlab_bg.wasm')).catch(() => {
-    throw new Error('web/pkg is missing: run ./build.sh build first');
-  });
-  await mkdir(ARTIFACTS, { recursive: true });
-  ({ server, url: baseUrl } = await serveRoot());
-  browser = await chromium.launch({ executablePath: '/usr/bin/chromium', args: CHROMIUM_FLAGS });
-});
-
-after(async () => {
-  await browser?.close();
-  await new Promise((resolve) => (server ? server.close(resolve) : resolve()));
-});
-
-async function waitReady(page) {
-  await page.waitForFunction(() => window.slamlab?.ready === true && document.body.dataset.ready === 'true', null, {
-    timeout: 15000,
-  });
-}
+const env = useBrowser();
 
 const state = (page) => page.evaluate(() => window.slamlab.state());
 const scenario = (page) => page.evaluate(() => window.slamlab.scenario());
@@ -108,15 +30,9 @@ async function dragWorld(page, from, to) {
 }
 
 test('the lab page: edit, run, step, read sensors, reset, autosave, corrupt save', { timeout: 60000 }, async () => {
-  const context = await browser.newContext({ viewport: { width: 1280, height: 720 } });
-  const page = await context.newPage();
-  const problems = [];
-  page.on('console', (m) => {
-    if (m.type() === 'error') problems.push(`console error: ${m.text()} (${m.location().url})`);
-  });
-  page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
+  const { context, page, problems } = await newPage(env.browser);
 
-  await page.goto(baseUrl);
+  await page.goto(env.baseUrl);
   await waitReady(page);
 
   // Load a preset, then the thesis preset, through the select.
@@ -246,14 +162,8 @@ test('the lab page: edit, run, step, read sensors, reset, autosave, corrupt save
 });
 
 test('merging in the page: the table fills, a pair shows its matches, the verdict and transform appear', { timeout: 180000 }, async () => {
-  const context = await browser.newContext({ viewport: { width: 1280, height: 720 } });
-  const page = await context.newPage();
-  const problems = [];
-  page.on('console', (m) => {
-    if (m.type() === 'error') problems.push(`console error: ${m.text()} (${m.location().url})`);
-  });
-  page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
-  await page.goto(baseUrl);
+  const { context, page, problems } = await newPage(env.browser);
+  await page.goto(env.baseUrl);
   await waitReady(page);
   await page.selectOption('#preset', 'thesis');
   await page.waitForFunction(() => window.slamlab.scenario().name === 'thesis');

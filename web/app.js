@@ -15,13 +15,17 @@
 //
 // Every call into wasm that can throw runs inside `guard`, which shows the
 // message in the status line: the page never throws an uncaught exception.
+//
+// A link carries the scenario and its seed in the URL (web/share.js):
+// opening one restores them, ahead of the autosave, and from then on (or
+// once the user pressed Copy link) the address bar follows every edit, so a
+// reload or a bookmark keeps the current scenario. The guided mode (web/guided.js) and the printable summary
+// (web/summary.js) are wired here too.
 
 import init, { Lab, validateScenario, version, simdEnabled, robotColours } from './pkg/slamlab.js';
 import {
   View,
   clamp,
-  deg,
-  fmt,
   handlePoint,
   hitRobot,
   hitWall,
@@ -31,10 +35,14 @@ import {
   wallEnd,
   wrapAngle,
 } from './geometry.js';
+import { deg, fmt } from './dom.js';
 import { RobotsPanel, robotColour, setRobotColours } from './robots-panel.js';
 import { CameraPanel } from './camera-panel.js';
 import { MapsPanel } from './maps-panel.js';
 import { MergePanel } from './merge-panel.js';
+import { GuidedTour } from './guided.js';
+import { decodeShare, encodeShare } from './share.js';
+import { buildSummary } from './summary.js';
 
 const STORAGE_KEY = 'slamlab.scenario.v1';
 const LAYERS_KEY = 'slamlab.layers.v1';
@@ -52,7 +60,13 @@ const ctx = canvas.getContext('2d');
 const app = {
   lab: null,
   scenario: null, // source of truth while editing
-  preset: DEFAULT_PRESET, // preset the scenario came from; '' once edited
+  preset: DEFAULT_PRESET, // the preset the scenario is (seed and duration aside); '' once edited
+  origin: DEFAULT_PRESET, // the preset it was loaded from, kept through edits ('' for New / Import)
+  presetDurations: {}, // preset name → its own duration_s, as fetched
+  shareHash: '', // the URL fragment last written (see web/share.js)
+  shareInUrl: false, // keep the address bar's fragment in step with the scenario
+  currentLink: '', // the link to the current scenario, as last computed
+  guideMarkers: null, // selected frames the guided mode marks on the map
   view: new View(),
   dpr: 1,
   sized: false,
@@ -121,11 +135,12 @@ window.addEventListener('unhandledrejection', (e) => setStatus(`Unexpected error
 const clone = (o) => JSON.parse(JSON.stringify(o));
 
 /** Replaces the Lab's scenario with `text` (throws, keeping the old one, if bad). */
-function loadScenarioText(text, { preset = '', fit = true } = {}) {
+function loadScenarioText(text, { preset = '', origin = preset, fit = true } = {}) {
   if (app.lab) app.lab.setScenario(text);
   else app.lab = new Lab(text);
   app.scenario = JSON.parse(app.lab.scenarioJson());
   app.preset = preset;
+  app.origin = origin;
   app.running = false;
   app.selection = null;
   app.drag = null;
@@ -140,6 +155,7 @@ async function loadPreset(name) {
   const text = await res.text();
   pushUndo();
   loadScenarioText(text, { preset: name });
+  app.presetDurations[name] = app.scenario.duration_s;
   return app.scenario;
 }
 
@@ -191,6 +207,7 @@ function afterScenarioChange() {
   $('duration').value = String(app.scenario.duration_s);
   $('preset').value = app.preset;
   autosave();
+  scheduleShareHash();
   refreshPanels();
   refreshControls();
   app.dirty = true;
@@ -198,14 +215,155 @@ function afterScenarioChange() {
 
 function autosave() {
   try {
-    localStorage.setItem(STORAGE_KEY, JSON.stringify({ version: 1, preset: app.preset, scenario: app.scenario }));
+    localStorage.setItem(
+      STORAGE_KEY,
+      JSON.stringify({ version: 1, preset: app.preset, origin: app.origin, scenario: app.scenario }),
+    );
   } catch (e) {
     setStatus(`Could not autosave in this browser: ${message(e)}`, 'warn');
   }
 }
 
-/** Restores the autosaved scenario; a corrupt save is reported, never fatal. */
+// ---------------------------------------------------------------------------
+// Sharing: the scenario and seed in the URL (web/share.js)
+
+/** The URL fragment that restores the current scenario and seed. */
+function currentShareHash() {
+  return encodeShare(app.scenario, {
+    preset: app.preset,
+    presetDuration: app.presetDurations[app.preset],
+    origin: app.origin,
+  });
+}
+
+/** A link that opens this scenario with this seed. */
+async function shareLink() {
+  return `${location.origin}${location.pathname}#${await currentShareHash()}`;
+}
+
+let shareTimer = 0;
+/** Keeps the current link ready (for the printed summary) and, once the page
+ *  was opened from a link or a link was copied, the address bar's fragment in
+ *  step with the scenario (debounced). */
+function scheduleShareHash() {
+  clearTimeout(shareTimer);
+  shareTimer = setTimeout(async () => {
+    try {
+      const hash = await currentShareHash();
+      app.currentLink = `${location.origin}${location.pathname}#${hash}`;
+      if (!app.shareInUrl) return;
+      app.shareHash = hash;
+      if (location.hash.slice(1) !== hash || location.search) {
+        history.replaceState(history.state, '', `${location.pathname}#${hash}`);
+      }
+    } catch (e) {
+      setStatus(`Could not put the scenario in the address bar: ${message(e)}`, 'warn');
+    }
+  }, 250);
+}
+
+/** Opens what a shared link asks for; throws, keeping the scenario, if it cannot. */
+async function openShared(shared) {
+  if (shared.kind === 'preset') {
+    await loadPreset(shared.preset);
+    if (shared.seed != null && shared.seed !== app.scenario.seed) {
+      app.lab.setSeed(shared.seed);
+      app.scenario.seed = shared.seed;
+    }
+    if (shared.duration != null && shared.duration !== app.scenario.duration_s) {
+      app.lab.setDuration(shared.duration);
+      app.scenario.duration_s = shared.duration;
+    }
+    afterScenarioChange();
+  } else {
+    const before = app.scenario ? JSON.stringify(app.scenario) : null;
+    loadScenarioText(shared.text, { preset: '', origin: shared.origin });
+    if (before) app.undo.push(before);
+  }
+}
+
+/** Loads the scenario of a shared link, else the autosave, else the thesis preset. */
 async function restore() {
+  let problem = '';
+  try {
+    const shared = await decodeShare(location.hash, location.search);
+    if (shared) {
+      app.shareInUrl = true;
+      const saved = savedScenarioText(); // before the link replaces the autosave
+      await openShared(shared);
+      app.undo = [];
+      const same = saved !== null && saved === validateScenario(app.lab.scenarioJson());
+      setStatus(same
+        ? `Restored your last scenario “${app.scenario.name}” (seed ${app.scenario.seed}) from the address bar.`
+        : `Opened a shared link: “${app.scenario.name}” with seed ${app.scenario.seed}. Press Run (Space) to run it.`, 'ok');
+      return;
+    }
+  } catch (e) {
+    problem = `The link could not be opened (${message(e)}). `;
+  }
+  await restoreSaved();
+  if (problem) setStatus(problem + $('status').textContent, 'warn');
+}
+
+/** The autosaved scenario in the Lab's canonical JSON, or null. */
+function savedScenarioText() {
+  try {
+    const saved = JSON.parse(localStorage.getItem(STORAGE_KEY) ?? 'null');
+    return saved?.scenario ? validateScenario(JSON.stringify(saved.scenario)) : null;
+  } catch {
+    return null;
+  }
+}
+
+/** A link pasted into the address bar of an open page. */
+window.addEventListener('hashchange', async () => {
+  if (!app.lab || location.hash.slice(1) === app.shareHash) return;
+  try {
+    const shared = await decodeShare(location.hash);
+    if (!shared) return;
+    app.shareInUrl = true;
+    await openShared(shared);
+    setStatus(`Opened the link: “${app.scenario.name}” with seed ${app.scenario.seed} (Ctrl+Z goes back).`, 'ok');
+  } catch (e) {
+    setStatus(`The link could not be opened: ${message(e)}. The scenario is unchanged.`, 'error');
+  }
+});
+
+const copyLink = async () => {
+  let link;
+  try {
+    link = await shareLink();
+  } catch (e) {
+    setStatus(`Could not make a link: ${message(e)}`, 'error');
+    return;
+  }
+  // From now on the address bar holds the link too, and follows edits.
+  app.shareInUrl = true;
+  scheduleShareHash();
+  try {
+    await navigator.clipboard.writeText(link);
+    setStatus(`Link copied: it opens “${app.scenario.name}” with seed ${app.scenario.seed} (${link.length} characters).`, 'ok');
+  } catch {
+    setStatus('The browser did not let the page use the clipboard: copy the address bar instead, it holds the same link.', 'warn');
+  }
+};
+
+const resetToPreset = async () => {
+  const name = app.origin || app.preset;
+  if (!name) {
+    setStatus('This scenario did not come from a preset (New or Import): there is no preset to reset to.', 'info');
+    return;
+  }
+  try {
+    await loadPreset(name);
+    setStatus(`Back to the ${name} preset as shipped, seed ${app.scenario.seed} (Ctrl+Z goes back to what you had).`, 'ok');
+  } catch (e) {
+    setStatus(`Could not load the ${name} preset: ${message(e)}`, 'error');
+  }
+};
+
+/** Restores the autosaved scenario; a corrupt save is reported, never fatal. */
+async function restoreSaved() {
   let saved = null;
   try {
     saved = localStorage.getItem(STORAGE_KEY);
@@ -225,7 +383,8 @@ async function restore() {
       throw new Error(`not valid JSON (${message(e)})`);
     }
     if (!obj || typeof obj !== 'object' || !obj.scenario) throw new Error('it holds no scenario');
-    loadScenarioText(JSON.stringify(obj.scenario), { preset: typeof obj.preset === 'string' ? obj.preset : '' });
+    const preset = typeof obj.preset === 'string' ? obj.preset : '';
+    loadScenarioText(JSON.stringify(obj.scenario), { preset, origin: typeof obj.origin === 'string' ? obj.origin : preset });
     app.undo = [];
     setStatus(`Restored your last scenario “${app.scenario.name}” from this browser.`, 'ok');
   } catch (e) {
@@ -366,6 +525,8 @@ function resize() {
     fitView();
   }
   app.dirty = true;
+  // Resizing cleared the canvas: draw now rather than show a blank frame.
+  if (app.lab && app.scenario) draw();
 }
 
 function fitView() {
@@ -443,6 +604,34 @@ function drawOverlay() {
   ctx.setTransform(app.dpr, 0, 0, app.dpr, 0, 0);
   ctx.font = '600 12px system-ui, sans-serif';
   ctx.textBaseline = 'alphabetic';
+
+  // The guided mode's selected frames: a triangle where each kept picture
+  // was taken, pointing along the camera's axis; A', D and E labelled.
+  if (app.guideMarkers) {
+    for (const m of app.guideMarkers) {
+      const [px, py] = v.toPx(m.pose);
+      const r = m.label ? 10 : 6;
+      const [dx, dy] = [Math.cos(m.pose[2]), -Math.sin(m.pose[2])]; // screen y points down
+      ctx.beginPath();
+      ctx.moveTo(px + dx * r, py + dy * r);
+      ctx.lineTo(px - 0.6 * r * (dx + dy), py - 0.6 * r * (dy - dx));
+      ctx.lineTo(px - 0.6 * r * (dx - dy), py - 0.6 * r * (dy + dx));
+      ctx.closePath();
+      ctx.fillStyle = robotColour(m.robot);
+      ctx.fill();
+      ctx.lineWidth = m.label ? 2 : 1;
+      ctx.strokeStyle = m.label ? '#111' : '#fff';
+      ctx.stroke();
+      if (m.label) {
+        // Labels sit away from the middle of the labelled group, so that
+        // A', D and E (a few decimetres apart) do not overprint each other.
+        const [ox, oy] = m.labelDir ?? [0.7, 0.7];
+        ctx.font = '700 13px system-ui, sans-serif';
+        label(m.label, px + 16 * ox, py - 16 * oy + 4, '#111', ox < -0.3 ? 'right' : ox > 0.3 ? 'left' : 'center');
+        ctx.font = '600 12px system-ui, sans-serif';
+      }
+    }
+  }
 
   // Robot names next to the robots.
   const poses = robotPoses();
@@ -611,6 +800,179 @@ const mergePanel = new MergePanel($('merge'), $('pair-overlay'), {
   report: () => app.lab.reportJson('{}'),
 });
 
+// The guided mode: thesis §6.2.1-6.2.5 on the live lab (web/guided.js).
+const guide = new GuidedTour($('guide'), $('guided-open'), {
+  lab: () => app.lab,
+  run: () => {
+    const st = readState();
+    return {
+      steps: st.steps,
+      time_s: st.time_s,
+      finished: st.finished,
+      running: app.running,
+      duration_s: app.scenario.duration_s,
+      robots: app.scenario.robots.map((r) => r.name),
+      thesis: app.preset === 'thesis',
+      name: app.scenario.name,
+      seed: app.scenario.seed,
+    };
+  },
+  loadThesisAndRun: async () => {
+    await loadPreset('thesis');
+    setSpeed(50);
+    run();
+  },
+  merge: mergePanel,
+  setMarkers: (m) => {
+    app.guideMarkers = m;
+    app.dirty = true;
+  },
+  reveal: (id, block = 'start') => {
+    const e = $(id);
+    (block === 'start' ? e?.closest('.panel') : e)?.scrollIntoView({ block, behavior: 'smooth' });
+  },
+  zoomTo: (points) => {
+    if (!points) {
+      fitView();
+      return;
+    }
+    // World points to show, with 2.5 m around them (Figure 18's corner).
+    const xs = points.map((p) => p[0]);
+    const ys = points.map((p) => p[1]);
+    const v = app.view;
+    v.center = [(Math.min(...xs) + Math.max(...xs)) / 2, (Math.min(...ys) + Math.max(...ys)) / 2];
+    const span = Math.max(Math.max(...xs) - Math.min(...xs), Math.max(...ys) - Math.min(...ys)) + 5;
+    v.scale = clamp(Math.min(v.width, v.height) / span, 2, 2000);
+    app.autoFit = false;
+    app.dirty = true;
+  },
+  onError: (e) => setStatus(message(e), 'error'),
+  onToggle: (open) => {
+    document.body.classList.toggle('guided', open);
+    app.dirty = true;
+  },
+});
+
+// ---------------------------------------------------------------------------
+// The run summary (web/summary.js): a full-page view, and what the page prints
+
+/** The whole scenario, fitted into a `w × h` image with the robots' names
+ *  (PNG data URL); the on-screen view is restored on the next frame. */
+function worldSnapshot(w, h) {
+  const c = document.createElement('canvas');
+  c.width = w;
+  c.height = h;
+  const fit = JSON.parse(app.lab.fitView(w, h));
+  app.lab.setView(JSON.stringify({
+    width: w, height: h, center: fit.center, scale: fit.scale, layers: app.layers,
+    selected_wall: null, selected_robot: null, preview_wall: null, marker: null, marker_fov: Math.PI / 3,
+  }));
+  const g = c.getContext('2d');
+  app.lab.draw(g);
+  const v = new View();
+  Object.assign(v, { width: w, height: h, center: fit.center, scale: fit.scale });
+  g.font = '600 12px system-ui, sans-serif';
+  g.lineJoin = 'round';
+  g.fillStyle = '#1e1e1e';
+  g.fillText(metres(JSON.parse(app.lab.viewMetrics()).scale_bar_m), 14, h - 22); // the renderer's scale bar
+  robotPoses().forEach((p, i) => {
+    const [px, py] = v.toPx(p);
+    g.lineWidth = 3;
+    g.strokeStyle = 'rgba(255,255,255,0.9)';
+    g.strokeText(app.scenario.robots[i].name, px + 10, py - 10);
+    g.fillStyle = darker(i);
+    g.fillText(app.scenario.robots[i].name, px + 10, py - 10);
+  });
+  app.dirty = true; // the next frame pushes the on-screen view back
+  return c.toDataURL('image/png');
+}
+
+/** Builds the summary from what the page shows now; `link` restores the scenario. */
+function buildSummaryNow(link = app.currentLink || location.href) {
+  const lab = app.lab;
+  const st = readState();
+  const started = st.steps > 0;
+  const robots = app.scenario.robots.map((r, i) => ({
+    name: r.name,
+    follow: r.follow,
+    distance: r.distance ?? 0.6,
+    frames: started ? lab.frameCount(i) : 0,
+    bumps: st.robots[i]?.bumps ?? 0,
+    figures: started ? JSON.parse(lab.slamFiguresJson(i)) : null,
+  }));
+  const plots = started
+    ? [...document.querySelectorAll('.map-block')].filter((b) => !b.hidden).map((b) => ({
+      name: b.querySelector('.map-title').textContent.replace(/'s map$/, ''),
+      src: b.querySelector('.map-plot').toDataURL('image/png'),
+    }))
+    : [];
+  const view = mergePanel.view;
+  let mergedImage = null;
+  if (view?.report?.status === 'merged') {
+    const c = document.createElement('canvas');
+    c.width = 480;
+    c.height = 350;
+    lab.drawMerged(c.getContext('2d'), c.width, c.height);
+    mergedImage = c.toDataURL('image/png');
+  }
+  buildSummary(
+    $('summary'),
+    {
+      scenario: app.scenario,
+      link,
+      when: new Date(),
+      run: { time_s: st.time_s, finished: st.finished, steps: st.steps },
+      robots,
+      worldImage: worldSnapshot(720, 540),
+      plots,
+      merge: view ? {
+        report: view.report,
+        tableImage: mergePanel.tableBox.hidden ? null : mergePanel.table.toDataURL('image/png'),
+        mergedImage,
+        results: mergePanel.results,
+      } : { report: null, results: mergePanel.results },
+    },
+    { onPrint: () => window.print(), onClose: () => closeSummary() },
+  );
+}
+
+async function openSummary() {
+  if (app.running) pause();
+  buildSummaryNow(await shareLink());
+  $('summary').hidden = false;
+  $('summary-print').focus();
+}
+
+function closeSummary() {
+  $('summary').hidden = true;
+  $('summary-open').focus({ preventScroll: true });
+}
+
+/** Keeps Tab inside `box` (the summary is modal). */
+function trapFocus(e, box) {
+  const items = [...box.querySelectorAll('button, a[href]')].filter((x) => !x.hidden);
+  if (!items.length) return;
+  const first = items[0];
+  const last = items[items.length - 1];
+  if (e.shiftKey && document.activeElement === first) {
+    e.preventDefault();
+    last.focus();
+  } else if (!e.shiftKey && document.activeElement === last) {
+    e.preventDefault();
+    first.focus();
+  }
+}
+
+// Ctrl+P anywhere prints the summary (the print stylesheet shows only it).
+window.addEventListener('beforeprint', () => {
+  if (!app.lab || !$('summary').hidden) return;
+  try {
+    buildSummaryNow();
+  } catch (e) {
+    setStatus(`Could not build the summary: ${message(e)}`, 'error');
+  }
+});
+
 function refreshPanels() {
   if (!app.scenario) return;
   cameraPanel.sync(app.scenario);
@@ -738,6 +1100,7 @@ function refreshControls(st = app.state) {
   $('add-robot').title =
     app.scenario.robots.length >= MAX_ROBOTS ? `At most ${MAX_ROBOTS} robots` : 'Add a robot near the middle of the view';
   $('delete').disabled = !ed || !app.selection;
+  $('reset-preset').disabled = !(app.origin || app.preset);
   const badge = $('mode-badge');
   const [cls, text] = app.running
     ? ['run', 'Running']
@@ -1182,6 +1545,12 @@ document.addEventListener(
   guard((e) => {
     if (!app.lab) return;
     const t = e.target;
+    if (!$('summary').hidden) {
+      // The summary covers the page: only Escape (close) and Tab (kept inside) work.
+      if (e.key === 'Escape') closeSummary();
+      else if (e.key === 'Tab') trapFocus(e, $('summary'));
+      return;
+    }
     if (typingTarget(t)) {
       if (e.key === 'Escape') t.blur();
       return;
@@ -1251,6 +1620,8 @@ document.addEventListener(
       case 'Escape':
         if (cancelDrag()) break;
         if (!$('help-overlay').hidden) toggleHelp(false);
+        else if (!$('pair-overlay').hidden) mergePanel.closePair();
+        else if (guide.isOpen) guide.close();
         else if (app.tool === 'wall') setTool('select');
         else if (app.selection) {
           app.selection = null;
@@ -1261,6 +1632,10 @@ document.addEventListener(
         break;
       case '?':
         toggleHelp();
+        break;
+      case 'g':
+      case 'G':
+        guide.toggle();
         break;
       default:
         break;
@@ -1377,12 +1752,14 @@ function wire() {
   });
 
   const speed = $('speed');
-  const showSpeed = () => {
-    app.speed = Number(speed.value);
-    $('speed-value').textContent = `${app.speed}×`;
-  };
-  speed.addEventListener('input', showSpeed);
-  showSpeed();
+  speed.addEventListener('input', () => setSpeed(Number(speed.value)));
+  setSpeed(Number(speed.value));
+
+  $('reset-preset').addEventListener('click', resetToPreset);
+  $('copy-link').addEventListener('click', copyLink);
+  $('summary-open').addEventListener('click', () =>
+    openSummary().catch((e) => setStatus(`Could not build the summary: ${message(e)}`, 'error')));
+  $('guided-open').addEventListener('click', () => guide.toggle());
 
   $('seed').addEventListener(
     'change',
@@ -1413,6 +1790,7 @@ function wire() {
       }
       app.scenario.duration_s = s;
       autosave();
+      scheduleShareHash();
       updateReadouts(true);
       setStatus(`Duration ${s} s.`, 'info');
     }),
@@ -1430,6 +1808,12 @@ function wire() {
       app.dirty = true;
     });
   }
+}
+
+function setSpeed(v) {
+  app.speed = v;
+  $('speed').value = String(v);
+  $('speed-value').textContent = `${v}×`;
 }
 
 function restoreLayers() {
@@ -1457,6 +1841,7 @@ function frame(now) {
     cameraPanel.update(now, changed || app.running);
     mapsPanel.update(now, changed || app.running);
     mergePanel.update(now);
+    guide.update(now);
     if (app.running) updateReadouts(false);
   } catch (e) {
     app.running = false;
@@ -1501,6 +1886,11 @@ async function main() {
       return [r.left + px, r.top + py];
     },
     view: () => ({ center: [...app.view.center], scale: app.view.scale }),
+    /** The link that restores the current scenario and seed (web/share.js). */
+    shareLink,
+    guide,
+    mergePanel,
+    markers: () => clone(app.guideMarkers),
   };
   document.body.dataset.ready = 'true';
   requestAnimationFrame(frame);

@@ -133,11 +133,3 @@ export function hitRobot(poses, p, margin) {
 export function handlePoint(pose, reachM) {
   return [pose[0] + reachM * Math.cos(pose[2]), pose[1] + reachM * Math.sin(pose[2])];
 }
-
-export function fmt(v, digits = 2) {
-  return Number.isFinite(v) ? v.toFixed(digits) : '–';
-}
-
-export function deg(rad) {
-  return (rad * 180) / Math.PI;
-}

@@ -161,10 +161,22 @@ export class MapsPanel {
       c.stroke();
     }
     c.setLineDash([]);
-    c.fillStyle = '#c0392b';
-    c.fillText('SLAM', 40, 10);
-    c.fillStyle = '#7f6a5a';
-    c.fillText('- - odometry', 74, 10);
+    // Legend with line samples, and what is plotted (right-aligned).
+    for (const [x0, colour, dash, text] of [[40, '#c0392b', [], 'SLAM'], [92, '#7f6a5a', [4, 3], 'odometry']]) {
+      c.strokeStyle = colour;
+      c.setLineDash(dash);
+      c.beginPath();
+      c.moveTo(x0, 7);
+      c.lineTo(x0 + 14, 7);
+      c.stroke();
+      c.fillStyle = colour;
+      c.fillText(text, x0 + 17, 10);
+    }
+    c.setLineDash([]);
+    c.fillStyle = '#555';
+    c.textAlign = 'right';
+    c.fillText('position error over time', w - 4, 10);
+    c.textAlign = 'left';
   }
 
   downloadPgm(i, name) {

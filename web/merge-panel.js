@@ -10,33 +10,28 @@
 // end the verdict appears with its reason, the transform of each robot's map
 // frame, its error against the ground truth, and the merged map with
 // downloads (PNG, ROS map_server PGM + YAML, report JSON).
+//
+// The panel remembers each method's result on the current run, and a small
+// chart compares their transform errors (position and heading against the
+// ground truth) as the user merges with one method after another; a new run
+// clears it. The guided mode (web/guided.js) drives the same panel: it
+// starts a thesis merge and may hold it before the matching starts.
 
 import { robotColour } from './robots-panel.js';
+import { deg, el, fmt } from './dom.js';
 
 const SLICE_MS = 12;
 const TABLE_W = 330;
 const MAP_W = 330;
 const MAP_H = 240;
+const CHART_W = 330;
+const CHART_H = 104;
 
 const METHODS = [
   ['auto', 'Automatic (any view, verified)'],
   ['thesis', 'Thesis §6.2 (square views)'],
   ['map-only', 'Map-only baseline (grid features)'],
 ];
-
-const fmt = (x, d = 2) => (Number.isFinite(x) ? x.toFixed(d) : '–');
-const deg = (rad) => (rad * 180) / Math.PI;
-
-function el(tag, props = {}, ...children) {
-  const e = document.createElement(tag);
-  for (const [k, v] of Object.entries(props)) {
-    if (k === 'class') e.className = v;
-    else if (k === 'text') e.textContent = v;
-    else e.setAttribute(k, v);
-  }
-  e.append(...children);
-  return e;
-}
 
 export class MergePanel {
   /**
@@ -54,6 +49,9 @@ export class MergePanel {
     this.method = 'auto';
     this.active = false; // a merge is being computed
     this.view = null; // last mergeViewJson
+    this.hold = false; // started but not advanced (the guided mode's step 6.2.2)
+    /** Per method, the result on the current run: {status, error_m, error_deg, robot, reason}. */
+    this.results = {};
     this.build();
   }
 
@@ -67,6 +65,7 @@ export class MergePanel {
     select.addEventListener('change', () => {
       this.method = select.value;
     });
+    this.select = select;
     this.button = el('button', { type: 'button', id: 'merge-run', class: 'primary', text: 'Merge maps' });
     this.button.addEventListener('click', () => this.start());
     this.progress = el('progress', { id: 'merge-progress', max: '1', value: '0', 'aria-label': 'Merge progress' });
@@ -114,6 +113,13 @@ export class MergePanel {
       this.downloads.append(b);
     }
     this.result = el('div', { class: 'merge-result', hidden: '' }, this.verdict, this.distance, this.transforms, this.map, this.downloads);
+    this.chart = el('canvas', {
+      id: 'merge-methods-chart', class: 'merge-chart', width: String(CHART_W), height: String(CHART_H),
+      role: 'img', 'aria-label': 'Transform error of each method: no method has merged this run yet',
+    });
+    this.chartNote = el('p', { class: 'hint', id: 'merge-methods-note' });
+    this.chartBox = el('div', { class: 'merge-chart-box', hidden: '' },
+      el('div', { class: 'map-title', text: 'Transform error of each method (this run)' }), this.chart, this.chartNote);
     this.tableBox = el('div', { class: 'merge-table-box', hidden: '' }, this.tableTitle, this.table, this.tableHint);
     this.host.replaceChildren(
       el('div', { class: 'merge-controls' }, select, this.button),
@@ -121,6 +127,7 @@ export class MergePanel {
       this.hint,
       this.tableBox,
       this.result,
+      this.chartBox,
     );
     this.refreshIdle();
   }
@@ -132,7 +139,10 @@ export class MergePanel {
   /** Called when the run changed: any merge of the old maps is gone. */
   invalidate() {
     this.active = false;
+    this.hold = false;
     this.view = null;
+    this.results = {};
+    this.drawChart();
     this.tableBox.hidden = true;
     this.result.hidden = true;
     this.progress.value = 0;
@@ -151,9 +161,28 @@ export class MergePanel {
     }
   }
 
+  /** Chooses `method` in the select and starts merging with it; `hold`
+   *  keeps the job from advancing until `release()`. */
+  startMethod(method, { hold = false } = {}) {
+    this.method = method;
+    this.select.value = method;
+    this.start();
+    this.hold = hold && this.active;
+    if (this.hold) {
+      this.stageText.textContent = 'waiting: press Next in the guide to match';
+      this.hooks.setStatus('The thesis method has selected its frames (marked on the map); the matching waits for Next.', 'info');
+    }
+  }
+
+  /** Lets a held merge advance. */
+  release() {
+    this.hold = false;
+  }
+
   start() {
     try {
       this.lab().mergeStart(this.method);
+      this.hold = false;
       this.active = true;
       this.view = null;
       this.result.hidden = true;
@@ -175,6 +204,7 @@ export class MergePanel {
       this.refreshIdle();
       return;
     }
+    if (this.hold) return;
     const lab = this.lab();
     let p;
     const t0 = performance.now();
@@ -374,7 +404,7 @@ export class MergePanel {
       close,
     );
     this.pairHost.hidden = false;
-    close.focus();
+    close.focus({ preventScroll: true });
   }
 
   closePair() {
@@ -389,9 +419,12 @@ export class MergePanel {
     if (!d) return;
     const p = r.pairs.find((q) => q.distance);
     const line = (text) => el('div', { text });
+    // Table positions counted from 1, as the thesis's Table 1 (and the guide) do.
+    const cell = ([row, col]) => `row ${row + 1}, column ${col + 1}`;
     this.distance.replaceChildren(
-      el('b', { text: `Distance between the robots (§6.2.4), pairs ${JSON.stringify(p.best)} and ${JSON.stringify(p.second)}` }),
-      line(`tan(θ/2) = (B'C'/2 − FJ/2)·K / AD      tan(θ/2) = (B'C'/2 − GH/2)·K / (AD + DE)`),
+      el('b', { text: `Distance between the robots (§6.2.4), from the pairs at ${cell(p.best)} and ${cell(p.second)} of the table` }),
+      line(`tan(θ/2) = (B'C'/2 − FJ/2)·K / AD`),
+      line(`tan(θ/2) = (B'C'/2 − GH/2)·K / (AD + DE)`),
       line(`θ = ${fmt(deg(d.hfov_rad), 1)}°, B'C' = ${fmt(d.bc_px, 0)} px, FJ = ${fmt(d.fj_px, 1)} px, ` +
         `GH = ${fmt(d.gh_px, 1)} px, DE = ${fmt(d.de_m, 3)} m (robot 2's odometry)`),
       line(`⇒ K = ${fmt(d.k_m_per_px * 1000, 3)} mm/px, AD = ${fmt(d.ad_m, 3)} m, AA' = ${fmt(d.aa_m, 3)} m; ` +
@@ -436,9 +469,88 @@ export class MergePanel {
         this.hooks.onError(e);
       }
     }
+    this.remember(r);
     this.hooks.setStatus(
       merged ? `Maps merged: ${r.transforms.length} robots joined.` : `No merge: ${r.reason}`,
       merged ? 'ok' : 'warn',
     );
+  }
+
+  /** Keeps this method's result for the comparison chart. With more than
+   *  two robots the worst joined robot's error stands for the method. */
+  remember(r) {
+    const first = this.view.robots[0]?.name;
+    let worst = null;
+    for (const e of r.errors) {
+      if (e.robot === first) continue;
+      if (!worst || e.error_m > worst.error_m) worst = e;
+    }
+    this.results[r.method] = r.status === 'merged' && worst
+      ? { status: 'merged', error_m: worst.error_m, error_deg: worst.error_deg, robot: worst.robot, reason: r.reason }
+      : { status: 'no_merge', reason: r.reason };
+    this.drawChart();
+  }
+
+  /**
+   * The transform error of each method on this run: one row per method,
+   * position error (m) on the left, heading error (degrees, absolute) on
+   * the right, each on its own linear scale; "no merge" or "not run yet"
+   * where there is no transform to score.
+   */
+  drawChart() {
+    const entries = METHODS.map(([m, text]) => [m, text.split(' (')[0].replace(' baseline', ''), this.results[m]]);
+    const any = entries.some(([, , r]) => r);
+    this.chartBox.hidden = !any;
+    if (!any) return;
+    const ctx = this.chart.getContext('2d');
+    const W = CHART_W;
+    ctx.fillStyle = '#fff';
+    ctx.fillRect(0, 0, W, CHART_H);
+    const merged = entries.filter(([, , r]) => r?.status === 'merged').map(([, , r]) => r);
+    const maxM = Math.max(0.05, ...merged.map((r) => r.error_m)) * 1.05;
+    const maxD = Math.max(0.5, ...merged.map((r) => Math.abs(r.error_deg))) * 1.05;
+    const x0 = 80;
+    const colW = (W - x0 - 6) / 2;
+    const rowH = 26;
+    const y0 = 18;
+    ctx.font = '10.5px system-ui, sans-serif';
+    ctx.textBaseline = 'middle';
+    ctx.fillStyle = '#333';
+    ctx.textAlign = 'left';
+    ctx.fillText('position error', x0, 8);
+    ctx.fillText('heading error', x0 + colW + 6, 8);
+    const spoken = [];
+    entries.forEach(([m, label, r], k) => {
+      const y = y0 + k * rowH;
+      ctx.fillStyle = k % 2 ? '#fafafa' : '#f1f3f6';
+      ctx.fillRect(0, y, W, rowH - 2);
+      ctx.fillStyle = '#1c1c1c';
+      ctx.textAlign = 'left';
+      ctx.font = `${m === this.view?.method ? '700 ' : ''}11px system-ui, sans-serif`;
+      ctx.fillText(label, 4, y + rowH / 2 - 1);
+      ctx.font = '10.5px system-ui, sans-serif';
+      if (!r || r.status !== 'merged') {
+        ctx.fillStyle = '#666';
+        ctx.fillText(r ? 'no merge' : 'not run yet', x0, y + rowH / 2 - 1);
+        spoken.push(`${label}: ${r ? 'no merge' : 'not run yet'}`);
+        return;
+      }
+      const bars = [
+        [x0, (colW - 44) * (r.error_m / maxM), `${fmt(r.error_m, 3)} m`, '#1f5fbf'],
+        [x0 + colW + 6, (colW - 44) * (Math.abs(r.error_deg) / maxD), `${fmt(Math.abs(r.error_deg), 2)}°`, '#0f7d6e'],
+      ];
+      for (const [bx, bw, text, colour] of bars) {
+        ctx.fillStyle = colour;
+        ctx.fillRect(bx, y + 5, Math.max(1.5, bw), rowH - 12);
+        ctx.fillStyle = '#1c1c1c';
+        ctx.fillText(text, bx + Math.max(1.5, bw) + 4, y + rowH / 2 - 1);
+      }
+      spoken.push(`${label}: ${fmt(r.error_m, 3)} m, ${fmt(Math.abs(r.error_deg), 2)} degrees`);
+    });
+    this.chart.setAttribute('aria-label', `Transform error of each method on this run. ${spoken.join('; ')}.`);
+    const several = this.view?.robots?.length > 2 ? ' With more than two robots, the worst joined robot counts.' : '';
+    this.chartNote.textContent =
+      'Error of the estimated map transform against the ground truth, for each method you merged with on this run; ' +
+      `pick another method above and merge to fill a row.${several}`;
   }
 }

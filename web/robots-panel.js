@@ -11,7 +11,7 @@
 // changes; live values are written in place, so typing in a field is never
 // interrupted by the running simulation.
 
-import { deg, fmt } from './geometry.js';
+import { deg, el, fmt } from './dom.js';
 
 /** Robot colours by index: the renderer's own list, set once the wasm is up. */
 export const ROBOT_COLOURS = [[80, 80, 80]];
@@ -26,18 +26,6 @@ export function robotColour(i, alpha = 1) {
 }
 
 const SONAR_COUNT = 8;
-
-function el(tag, attrs = {}, ...children) {
-  const e = document.createElement(tag);
-  for (const [k, v] of Object.entries(attrs)) {
-    if (k === 'class') e.className = v;
-    else if (k === 'style') e.style.cssText = v;
-    else if (k.startsWith('on')) e.addEventListener(k.slice(2), v);
-    else if (v !== false && v != null) e.setAttribute(k, v === true ? '' : v);
-  }
-  for (const c of children) if (c != null) e.append(c);
-  return e;
-}
 
 export class RobotsPanel {
   /**

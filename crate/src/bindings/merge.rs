@@ -8,6 +8,7 @@
 //! positions `mergeViewJson` lists.
 
 use super::Lab;
+use crate::merge::selection::{is_square, SONAR_4, SONAR_5};
 use crate::merge::MergeMethod;
 use wasm_bindgen::prelude::*;
 use wasm_bindgen::Clamped;
@@ -56,6 +57,61 @@ impl Lab {
     #[wasm_bindgen(js_name = mergeViewJson)]
     pub fn merge_view_json(&self) -> Result<String, JsError> {
         json(&self.inner.merge_view().map_err(err)?)
+    }
+
+    /// The current merge's image selection (thesis §6.2.2) with the numbers
+    /// behind it, as JSON: `{method, sonar_tolerance_m, min_front_range_m,
+    /// max_front_range_m, max_turn_per_step_rad, min_separation_m, robots:
+    /// [{name, captured, square, selected: [{frame, step, sonar4_m,
+    /// sonar5_m, pose}]}]}`. `square` counts the captured frames that pass
+    /// the squareness test (sonars 4 and 5 alike, not turning) before the
+    /// thinning; `selected` lists the frames that take part, in table
+    /// order, with the robot's own SLAM pose `[x, y, theta]` at capture
+    /// (its map frame, never the truth).
+    #[wasm_bindgen(js_name = mergeSelectionJson)]
+    pub fn merge_selection_json(&self) -> Result<String, JsError> {
+        let job = self
+            .inner
+            .merge
+            .as_ref()
+            .ok_or_else(|| JsError::new("no merge has been started"))?;
+        let cfg = &job.config.selection;
+        let mm = |x: f64| (x * 1000.0).round() / 1000.0;
+        let robots: Vec<serde_json::Value> = job
+            .robots
+            .iter()
+            .map(|r| {
+                let selected: Vec<serde_json::Value> = r
+                    .selected
+                    .iter()
+                    .map(|&k| {
+                        let f = &r.infos[k];
+                        serde_json::json!({
+                            "frame": f.index,
+                            "step": f.step,
+                            "sonar4_m": mm(f64::from(f.sonar_m[SONAR_4])),
+                            "sonar5_m": mm(f64::from(f.sonar_m[SONAR_5])),
+                            "pose": [f.pose.x, f.pose.y, f.pose.theta],
+                        })
+                    })
+                    .collect();
+                serde_json::json!({
+                    "name": r.name,
+                    "captured": r.infos.len(),
+                    "square": r.infos.iter().filter(|f| is_square(f, cfg)).count(),
+                    "selected": selected,
+                })
+            })
+            .collect();
+        json(&serde_json::json!({
+            "method": job.config.method.name(),
+            "sonar_tolerance_m": cfg.sonar_tolerance_m,
+            "min_front_range_m": cfg.min_front_range_m,
+            "max_front_range_m": cfg.max_front_range_m,
+            "max_turn_per_step_rad": cfg.max_turn_per_step_rad,
+            "min_separation_m": cfg.min_separation_m,
+            "robots": robots,
+        }))
     }
 
     /// One checked frame pair's matches, homography, quad and candidate

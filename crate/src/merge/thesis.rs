@@ -313,7 +313,9 @@ impl Default for ThesisConfig {
 #[derive(Clone, Debug, PartialEq)]
 pub struct ThesisOutcome {
     pub status: MergeStatus,
-    /// What was done, or why nothing could be.
+    /// What was done, or why nothing could be. Pairs in it are (row,
+    /// column) of the matched-pair table counted from 1, as the thesis's
+    /// Table 1 and the page count them.
     pub reason: String,
     /// The pair that gave the distance (positions in the selected frames,
     /// `(a, b)`), and the second pair: it shares robot 1's frame with the
@@ -546,7 +548,7 @@ fn solve_roles(
         if seconds.is_empty() {
             first_failure.get_or_insert(format!(
                 "best pair ({}, {}) with {} inliers: no other frame on the same line of approach matched frame {}",
-                best.one, best.two, best.inliers, best.one
+                best.one + 1, best.two + 1, best.inliers, best.one + 1
             ));
             continue;
         }
@@ -563,7 +565,10 @@ fn solve_roles(
                 Err(why) => {
                     first_failure.get_or_insert(format!(
                         "pairs ({}, {}) and ({}, {}): {why}",
-                        best.one, best.two, second.one, second.two
+                        best.one + 1,
+                        best.two + 1,
+                        second.one + 1,
+                        second.two + 1
                     ));
                     continue;
                 }
@@ -577,7 +582,7 @@ fn solve_roles(
                     if err > cfg.max_depth_error {
                         first_failure.get_or_insert(format!(
                             "pairs ({}, {}) and ({}, {}): the equations put robot 1 {:.2} m from the wall, its laser {:.2} m",
-                            best.one, best.two, second.one, second.two, sol.depth_a_m, l
+                            best.one + 1, best.two + 1, second.one + 1, second.two + 1, sol.depth_a_m, l
                         ));
                         continue;
                     }
@@ -713,7 +718,7 @@ pub fn thesis_merge_with(
     let (one, two) = if swapped { ("B", "A") } else { ("A", "B") };
     let reason = format!(
         "pairs ({}, {}) and ({}, {}): K = {:.4} m/px, AD = {:.2} m, AA' = {:.2} m (robot {one}'s frame, robot {two}'s two frames)",
-        best.0, best.1, second.0, second.1, distance.k_m_per_px, distance.ad_m, distance.aa_m
+        best.0 + 1, best.1 + 1, second.0 + 1, second.1 + 1, distance.k_m_per_px, distance.ad_m, distance.aa_m
     );
     ThesisOutcome {
         status: MergeStatus::Merged,

@@ -1,0 +1,121 @@
+// A printable summary of a run: what a teacher pins to the wall or a
+// student hands in.
+//
+// One page, built from what the lab shows: the scenario and seed (with the
+// link that restores them), the world with the robots' paths, each robot's
+// figures and position-error plot, the merge verdict with the transforms and
+// their errors against the ground truth, the thesis's §6.2.4 numbers when
+// that method ran, the matched-pair table, the merged map, and the transform
+// error of every method merged on this run. The page's print stylesheet
+// (web/style.css, `@media print`) prints only this view, so Ctrl+P anywhere
+// prints it too (app.js rebuilds it on `beforeprint`).
+//
+// Images are snapshots of the page's canvases (PNG data URLs) taken when the
+// summary is built; nothing here reads the Lab directly.
+import { deg, el, fmt } from './dom.js';
+
+const pct = (x) => (Number.isFinite(x) ? `${(100 * x).toFixed(0)} %` : '–');
+
+function table(caption, head, rows) {
+  return el('table', { class: 'summary-table' },
+    el('caption', { text: caption }),
+    el('tr', {}, ...head.map((h) => el('th', { text: h }))),
+    ...rows.map((r) => el('tr', {}, ...r.map((c) => el('td', { text: String(c) })))));
+}
+
+function figure(src, alt, caption, cls = '') {
+  if (!src) return '';
+  return el('figure', { class: cls }, el('img', { src, alt }), el('figcaption', { text: caption }));
+}
+
+const METHOD_NAMES = { auto: 'Automatic', thesis: 'Thesis §6.2', 'map-only': 'Map-only baseline' };
+
+/**
+ * Fills `host` with the summary of `data`:
+ * {scenario, link, when: Date, run: {time_s, finished, steps},
+ *  robots: [{name, follow, distance, frames, bumps, figures}],
+ *  worldImage, plots: [{name, src}],
+ *  merge: null | {report, view, tableImage, mergedImage, chartImage, results}}
+ */
+export function buildSummary(host, data, { onPrint, onClose }) {
+  const s = data.scenario;
+  const head = el('div', { class: 'summary-head' },
+    el('h1', { id: 'summary-title', text: `Run summary: “${s.name}”` }),
+    el('div', { class: 'summary-buttons no-print' },
+      (() => {
+        const b = el('button', { type: 'button', class: 'primary', id: 'summary-print', text: 'Print…' });
+        b.addEventListener('click', onPrint);
+        return b;
+      })(),
+      (() => {
+        const b = el('button', { type: 'button', id: 'summary-close', text: 'Close', 'aria-label': 'Close the summary (Esc)' });
+        b.addEventListener('click', onClose);
+        return b;
+      })()));
+  const run = data.run;
+  const meta = el('p', { class: 'summary-meta' },
+    `Seed ${s.seed} · ${fmt(run.time_s, 1)} s simulated of ${fmt(s.duration_s, 0)} s` +
+      `${run.finished ? '' : run.steps ? ' (run not finished)' : ' (not run yet)'} · ${s.walls.length} walls · ` +
+      `${s.robots.length} robots · ${data.when.toLocaleString('en-GB')}`,
+    el('br'), 'Link to this scenario and seed: ', el('a', { href: data.link, text: data.link, class: 'summary-link' }));
+
+  const parts = [head, meta];
+  parts.push(el('div', { class: 'summary-figures' },
+    figure(data.worldImage, 'The world with the robots\u2019 true and odometry paths',
+      'The world: walls, each robot\u2019s true path (solid) and odometry path (dashed).', 'wide')));
+
+  const robotRows = data.robots.map((r) => [
+    r.name, `${r.follow} wall, ${fmt(r.distance, 2)} m`, r.frames, r.bumps,
+    r.figures ? `${fmt(r.figures.ate_m)} m` : '–', r.figures ? `${fmt(r.figures.odometry_ate_m)} m` : '–',
+    r.figures ? pct(r.figures.occupied_precision) : '–',
+  ]);
+  parts.push(table('Robots: position error (ATE, RMS against the ground truth) of SLAM and of odometry alone',
+    ['robot', 'follows', 'pictures', 'bumps', 'ATE SLAM', 'ATE odometry', 'map cells on a wall'], robotRows));
+  if (data.plots.length) {
+    parts.push(el('div', { class: 'summary-figures' },
+      ...data.plots.map((p) => figure(p.src, `${p.name}'s position error over time`,
+        `${p.name}: position error over time (red: SLAM, dashed: odometry).`))));
+  }
+
+  const m = data.merge;
+  if (!m?.report) {
+    parts.push(el('p', { class: 'summary-note', text: 'The maps have not been merged on this run.' }));
+  } else {
+    const r = m.report;
+    const merged = r.status === 'merged';
+    parts.push(el('h2', { text: `Merge (${METHOD_NAMES[r.method] ?? r.method})` }));
+    parts.push(el('p', { class: `summary-verdict ${merged ? 'ok' : 'no'}`,
+      text: merged ? `Merged (confidence ${fmt(r.confidence)}): ${r.reason}.` : `No merge, because ${r.reason}.` }));
+    if (r.transforms.length) {
+      parts.push(table('Each robot\u2019s map frame in the merged frame, and its error against the ground truth',
+        ['robot', 'x (m)', 'y (m)', 'θ (°)', 'error (m)', 'error (°)'],
+        r.transforms.map((t) => {
+          const e = r.errors.find((x) => x.robot === t.robot);
+          return [t.robot, fmt(t.pose[0]), fmt(t.pose[1]), fmt(deg(t.pose[2]), 1), e ? fmt(e.error_m, 3) : '–', e ? fmt(e.error_deg, 2) : '–'];
+        })));
+    }
+    const d = r.pairs.find((p) => p.distance)?.distance;
+    if (d) {
+      parts.push(el('p', { class: 'summary-formula',
+        text: `§6.2.4: θ = ${fmt(deg(d.hfov_rad), 1)}°, B\u2032C\u2032 = ${fmt(d.bc_px, 0)} px, FJ = ${fmt(d.fj_px, 1)} px, ` +
+          `GH = ${fmt(d.gh_px, 1)} px, DE = ${fmt(d.de_m, 3)} m ⇒ K = ${fmt(d.k_m_per_px * 1000, 2)} mm/px, ` +
+          `AD = ${fmt(d.ad_m, 3)} m, AA\u2032 = ${fmt(d.aa_m, 3)} m.` }));
+    }
+    parts.push(el('div', { class: 'summary-figures' },
+      figure(m.tableImage, 'The matched-pair table', 'Matched-pair table: inliers per frame pair (orange: the best pair).'),
+      figure(m.mergedImage, 'The merged map', 'The merged map with every joined robot\u2019s path.')));
+  }
+  const results = m?.results ?? {};
+  const ran = Object.keys(METHOD_NAMES).filter((k) => results[k]);
+  if (ran.length) {
+    parts.push(table('Transform error of each method merged on this run (worst joined robot)',
+      ['method', 'verdict', 'position error', 'heading error'],
+      ran.map((k) => {
+        const x = results[k];
+        return x.status === 'merged'
+          ? [METHOD_NAMES[k], 'merged', `${fmt(x.error_m, 3)} m`, `${fmt(Math.abs(x.error_deg), 2)}°`]
+          : [METHOD_NAMES[k], 'no merge', '–', '–'];
+      })));
+  }
+  host.replaceChildren(...parts);
+}
