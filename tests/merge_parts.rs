@@ -719,6 +719,21 @@ fn fusion_adds_log_odds_and_resamples_rotated_maps_without_holes() {
     let alone = fuse(&[(&a, Pose2::IDENTITY)], cfg.clone());
     assert_eq!(units(&alone, on_wall), units(&a, on_wall));
     assert_eq!(alone.occupied_count(), a.occupied_count());
+    // The merge covers what the map knows, not the margin it grew by: a map
+    // whose only known cells sit in a 1 m box far from its origin fuses into
+    // one grow step (64 cells) or two across, not the whole span from 0.
+    let mut far = OccupancyGrid::new(cfg.clone());
+    far.ensure_contains(DVec2::ZERO, DVec2::new(20.0, 20.0));
+    far.integrate_beam(DVec2::new(18.0, 18.0), DVec2::new(19.0, 18.5), true);
+    let fused = fuse(&[(&far, Pose2::IDENTITY)], cfg.clone());
+    assert!(far.width() >= 400, "{}", far.width());
+    assert!(
+        fused.width() <= 128 && fused.height() <= 128,
+        "{} x {}",
+        fused.width(),
+        fused.height()
+    );
+    assert_eq!(fused.occupied_count(), far.occupied_count());
     assert_eq!(fuse(&[], cfg.clone()).width(), 0);
     let empty = OccupancyGrid::new(cfg.clone());
     assert_eq!(fuse(&[(&empty, Pose2::IDENTITY)], cfg).width(), 0);

@@ -20,16 +20,28 @@ use crate::geom::Pose2;
 use crate::slam::grid::{GridConfig, OccupancyGrid};
 use glam::DVec2;
 
-/// Corners of a grid's extent, in its own frame.
-fn corners(grid: &OccupancyGrid) -> [DVec2; 4] {
-    let lo = grid.origin_m();
-    let s = DVec2::new(grid.width() as f64, grid.height() as f64) * grid.resolution_m();
-    [
-        lo,
-        lo + DVec2::new(s.x, 0.0),
-        lo + s,
-        lo + DVec2::new(0.0, s.y),
-    ]
+/// Corners of the part of a grid that holds anything (known cells), in its
+/// own frame; `None` if every cell is unknown. A grid grows in whole blocks,
+/// so its allocated extent can be much larger than what was mapped, and the
+/// merged map (and its PGM) should not carry that margin.
+fn known_corners(grid: &OccupancyGrid) -> Option<[DVec2; 4]> {
+    let (w, units) = (grid.width(), grid.raw_units());
+    let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
+    for (iy, row) in units.chunks(w.max(1)).enumerate() {
+        let Some(first) = row.iter().position(|&u| u != 0) else {
+            continue;
+        };
+        let last = row.iter().rposition(|&u| u != 0).unwrap_or(first);
+        (x0, x1) = (x0.min(first), x1.max(last + 1));
+        (y0, y1) = (y0.min(iy), y1.max(iy + 1));
+    }
+    if x0 == usize::MAX {
+        return None;
+    }
+    let res = grid.resolution_m();
+    let lo = grid.origin_m() + DVec2::new(x0 as f64, y0 as f64) * res;
+    let hi = grid.origin_m() + DVec2::new(x1 as f64, y1 as f64) * res;
+    Some([lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)])
 }
 
 /// Writes log-odds `units` into the (empty) cell holding `p` of `grid`.
@@ -72,22 +84,23 @@ fn fuse_row(
 
 /// The merged grid: each map's frame at its pose in the merged frame,
 /// log-odds added and clamped to `config`'s range (see the module doc).
+/// The merged grid covers what the maps know (not their allocated margins).
 /// Maps that are empty or have a non-finite pose are skipped; with nothing
 /// to fuse the result is an empty grid.
 pub fn fuse(maps: &[(&OccupancyGrid, Pose2)], config: GridConfig) -> OccupancyGrid {
     let mut merged = OccupancyGrid::new(config.clone());
-    let usable: Vec<(&OccupancyGrid, Pose2)> = maps
+    let usable: Vec<(&OccupancyGrid, Pose2, [DVec2; 4])> = maps
         .iter()
-        .filter(|(g, pose)| g.width() > 0 && g.height() > 0 && pose.is_finite())
-        .map(|(g, pose)| (*g, *pose))
+        .filter(|(_, pose)| pose.is_finite())
+        .filter_map(|(g, pose)| known_corners(g).map(|c| (*g, *pose, c)))
         .collect();
     if usable.is_empty() || config.resolution_m.is_nan() || config.resolution_m <= 0.0 {
         return merged;
     }
     let mut lo = DVec2::splat(f64::INFINITY);
     let mut hi = DVec2::splat(f64::NEG_INFINITY);
-    for (g, pose) in &usable {
-        for c in corners(g) {
+    for (_, pose, corners) in &usable {
+        for &c in corners {
             let q = pose.transform_point(c);
             lo = lo.min(q);
             hi = hi.max(q);
@@ -95,8 +108,8 @@ pub fn fuse(maps: &[(&OccupancyGrid, Pose2)], config: GridConfig) -> OccupancyGr
     }
     if !merged.ensure_contains(lo, hi) {
         // Too large for the cell budget: fuse what fits around the first map.
-        let (g, pose) = usable[0];
-        let [a, b, c, d] = corners(g).map(|c| pose.transform_point(c));
+        let (_, pose, corners) = usable[0];
+        let [a, b, c, d] = corners.map(|c| pose.transform_point(c));
         let (l, h) = (a.min(b).min(c).min(d), a.max(b).max(c).max(d));
         if !merged.ensure_contains(l, h) {
             return merged;
@@ -105,13 +118,13 @@ pub fn fuse(maps: &[(&OccupancyGrid, Pose2)], config: GridConfig) -> OccupancyGr
     // Each map's inverse pose as a function, its sine and cosine taken once.
     let to_maps: Vec<_> = usable
         .iter()
-        .map(|(_, p)| {
+        .map(|(_, p, _)| {
             let inv = p.inverse();
             let (s, c) = inv.theta.sin_cos();
             move |q: DVec2| inv.position() + DVec2::new(c * q.x - s * q.y, s * q.x + c * q.y)
         })
         .collect();
-    let maps: Vec<&OccupancyGrid> = usable.iter().map(|(g, _)| *g).collect();
+    let maps: Vec<&OccupancyGrid> = usable.iter().map(|(g, _, _)| *g).collect();
     for iy in 0..merged.height() {
         fuse_row(&mut merged, iy, &maps, &to_maps);
     }
