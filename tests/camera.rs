@@ -458,7 +458,17 @@ fn a_frame_is_captured_every_simulated_second_with_its_senses() {
             let row = &r.log.sensors[f.step];
             assert_eq!(f.sonar_m, row.sonar_m);
             assert_eq!(f.laser_mm, row.laser_mm);
-            assert_eq!((f.width, f.height, f.gray.len()), (320, 240, 320 * 240));
+            let img = sim.frame_image(f);
+            assert_eq!(
+                (img.width, img.height, img.gray.len()),
+                (320, 240, 320 * 240)
+            );
+            // Rendering a stored frame again gives the same picture, and
+            // so does the other run's copy of it.
+            assert_eq!(sim.frame_image(f), img);
+            assert_eq!(sim2.frame_image(&r2.frames.frames[k]).gray, img.gray);
+            // The other robot is in the frame's list of bodies.
+            assert_eq!(f.others.len(), 1);
         }
         // Identical seeds give identical frames.
         assert_eq!(frames, &r2.frames.frames);
@@ -469,8 +479,8 @@ fn a_frame_is_captured_every_simulated_second_with_its_senses() {
     let mut sim3 = Simulation::new(&s3).unwrap();
     sim3.step();
     assert_ne!(
-        sim3.robots[0].frames.frames[0].gray,
-        sim.robots[0].frames.frames[0].gray
+        sim3.frame_image(&sim3.robots[0].frames.frames[0]).gray,
+        sim.frame_image(&sim.robots[0].frames.frames[0]).gray
     );
 }
 
@@ -488,7 +498,8 @@ fn frame_store_thins_evenly_at_its_cap() {
         laser_mm: [0; 181],
         width: 10,
         height: 10,
-        gray: vec![0; 100],
+        others: Vec::new(),
+        noise_seed: step as u64,
     };
     let mut step = 0;
     while store.frames.len() < 8 || step < 300 {

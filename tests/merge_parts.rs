@@ -485,8 +485,8 @@ fn features(sim: &Simulation, i: usize) -> Vec<Features> {
         .frames
         .iter()
         .map(|f| {
-            let img =
-                GrayImage::new(f.width as usize, f.height as usize, f.gray.clone()).expect("frame");
+            let f = sim.frame_image(f);
+            let img = GrayImage::new(f.width as usize, f.height as usize, f.gray).expect("frame");
             extract(&img, &upright())
         })
         .collect()

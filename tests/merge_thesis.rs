@@ -535,8 +535,8 @@ fn run_thesis(json: &str) -> ThesisRun {
         features.push(
             keep.iter()
                 .map(|&k| {
-                    let f = &frames[k];
-                    let img = GrayImage::new(f.width as usize, f.height as usize, f.gray.clone())
+                    let f = sim.frame_image(&frames[k]);
+                    let img = GrayImage::new(f.width as usize, f.height as usize, f.gray)
                         .expect("frame size");
                     extract(&img, &surf)
                 })

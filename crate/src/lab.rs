@@ -127,7 +127,7 @@ impl Lab {
     fn stop(&mut self) {
         self.merge = None;
         if let Some(sim) = self.sim.take() {
-            self.textures = Some(sim.textures);
+            self.textures = Some(sim.textures.into_inner());
         }
     }
 
@@ -314,7 +314,7 @@ impl Lab {
             .ok_or("nothing has run yet: run the scenario first")?;
         let mut timings = timings;
         if timings.camera == 0.0 && timings.slam == 0.0 {
-            timings.camera = sim.stage_times.camera_ms;
+            timings.camera = sim.stage_times.camera_ms + sim.render_ms();
             timings.slam = sim.stage_times.slam_ms;
         }
         if let Some(t) = self.merge.as_ref().map(|j| j.times_ms) {
@@ -341,7 +341,7 @@ impl Lab {
         }
         let img = ImageTexture::decode(bytes)?;
         match &mut self.sim {
-            Some(sim) => sim.textures.add_image(name, img.clone()),
+            Some(sim) => sim.textures.get_mut().add_image(name, img.clone()),
             None => {
                 let mut bank = self.take_textures();
                 bank.add_image(name, img.clone());
@@ -407,6 +407,13 @@ impl Lab {
             Some(sim) => &sim.robots[i].frames.frames,
             None => &[],
         })
+    }
+
+    /// The picture a captured frame shows (rendered on demand, see
+    /// [`crate::camera::capture`]).
+    pub fn frame_image(&self, f: &CapturedFrame) -> Result<crate::camera::CameraImage, String> {
+        let sim = self.sim.as_ref().ok_or("nothing has run yet")?;
+        Ok(sim.frame_image(f))
     }
 
     /// Robot `i`'s frame with capture index `index`.

@@ -59,9 +59,11 @@ pub struct RobotReport {
 #[derive(Clone, Debug, Serialize, Default, serde::Deserialize)]
 #[serde(default)]
 pub struct Timings {
-    /// The whole simulation (`camera` and `slam` are parts of it).
+    /// The whole simulation (`slam` is part of it).
     pub simulate: f64,
-    /// Rendering and capturing camera frames, inside `simulate`.
+    /// Capturing camera frames (inside `simulate`) and rendering the ones
+    /// looked at: a frame is stored as pose and noise seed and rendered
+    /// when first needed, mostly by the merge (inside `features`).
     pub camera: f64,
     /// Both mappers, inside `simulate`.
     pub slam: f64,

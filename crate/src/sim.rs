@@ -36,6 +36,8 @@ use crate::scenario::{RobotSpec, Scenario, ScenarioError};
 use crate::sensors::{Laser, LaserScan, RangeScene, Sonar, SonarReading, LASER_BEAMS, SONAR_COUNT};
 use crate::world::World;
 use std::collections::VecDeque;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Mutex, MutexGuard};
 
 /// The log keeps at most this many sensor rows per robot (20 simulated
 /// minutes at 10 Hz, about 4.5 MB). Older sensor rows are dropped first;
@@ -155,7 +157,9 @@ pub struct Simulation {
     pub robots: Vec<RobotSim>,
     steps: usize,
     pub camera: PinholeCamera,
-    pub textures: TextureBank,
+    /// Wall textures, generated on first use (hence a cell: rendering a
+    /// stored frame reads the simulation, it does not change it).
+    pub textures: TextureCache,
     /// Whether frames are captured (off only for experiments that need no
     /// images, e.g. controller tests; it changes nothing else in the run).
     capture: bool,
@@ -167,6 +171,57 @@ pub struct Simulation {
     clock: Option<fn() -> f64>,
     /// Time spent in the camera and in the mappers so far.
     pub stage_times: StageTimes,
+    /// Time spent rendering stored frames ([`Simulation::frame_image`]), ms.
+    render_ms: Millis,
+}
+
+/// The texture bank, which rendering a stored frame fills in as it reads
+/// the simulation: behind a lock, so that a `&Simulation` can render (and
+/// be shared, as tests do) while the textures are generated on first use.
+#[derive(Debug)]
+pub struct TextureCache(Mutex<TextureBank>);
+
+impl TextureCache {
+    /// The bank, for one rendering. A panic while rendering cannot leave
+    /// the bank half-written in a way that matters (a texture is inserted
+    /// whole), so a poisoned lock is simply taken over.
+    pub fn lock(&self) -> MutexGuard<'_, TextureBank> {
+        self.0.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    pub fn get_mut(&mut self) -> &mut TextureBank {
+        self.0.get_mut().unwrap_or_else(|e| e.into_inner())
+    }
+
+    pub fn into_inner(self) -> TextureBank {
+        self.0.into_inner().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+impl Clone for TextureCache {
+    fn clone(&self) -> Self {
+        TextureCache(Mutex::new(self.lock().clone()))
+    }
+}
+
+/// A millisecond total that a `&Simulation` can add to.
+#[derive(Debug, Default)]
+struct Millis(AtomicU64);
+
+impl Millis {
+    fn get(&self) -> f64 {
+        f64::from_bits(self.0.load(Ordering::Relaxed))
+    }
+
+    fn add(&self, ms: f64) {
+        self.0.store((self.get() + ms).to_bits(), Ordering::Relaxed);
+    }
+}
+
+impl Clone for Millis {
+    fn clone(&self) -> Self {
+        Millis(AtomicU64::new(self.0.load(Ordering::Relaxed)))
+    }
 }
 
 /// Milliseconds spent in the expensive stages of [`Simulation::step`],
@@ -174,6 +229,8 @@ pub struct Simulation {
 /// without one). Reading a clock changes nothing in the run.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StageTimes {
+    /// Capturing frames (pose, senses, noise seed); rendering them is timed
+    /// apart, when it happens ([`Simulation::render_ms`]).
     pub camera_ms: f64,
     pub slam_ms: f64,
 }
@@ -198,7 +255,7 @@ impl Simulation {
             return Err(p);
         }
         let camera = PinholeCamera::new(&scenario.camera);
-        let frame_bytes = (camera.width * camera.height) as usize;
+        let frame_bytes = crate::camera::capture::FRAME_BYTES;
         let period_steps = ((scenario.camera.period_s / CONTROL_DT_S).round() as usize).max(1);
         let n_robots = scenario.robots.len();
         let world = World::new(scenario.walls.iter().map(|w| w.segment()).collect());
@@ -251,11 +308,12 @@ impl Simulation {
             robots,
             steps: 0,
             camera,
-            textures,
+            textures: TextureCache(Mutex::new(textures)),
             capture: true,
             mapping: true,
             clock: None,
             stage_times: StageTimes::default(),
+            render_ms: Millis::default(),
         };
         sim.sense();
         for r in &mut sim.robots {
@@ -430,7 +488,7 @@ impl Simulation {
             &self.world,
             &self.scenario.walls,
             &boxes,
-            &mut self.textures,
+            &mut self.textures.lock(),
             colour,
             None,
         ))
@@ -456,23 +514,8 @@ impl Simulation {
             if !self.robots[i].frames.due(step) {
                 continue;
             }
-            let boxes = self.robot_boxes_except(i);
-            let spec = &self.scenario.camera;
+            let others = self.robot_boxes_except(i);
             let r = &mut self.robots[i];
-            let img = render_camera(
-                &self.camera,
-                &r.truth,
-                &self.world,
-                &self.scenario.walls,
-                &boxes,
-                &mut self.textures,
-                false,
-                Some(CameraNoise {
-                    rng: &mut r.camera_rng,
-                    pixel_std: spec.pixel_noise_std,
-                    exposure_std: spec.exposure_jitter,
-                }),
-            );
             let row = r.log.sensors.back().cloned();
             let frame = CapturedFrame {
                 index: 0,
@@ -484,12 +527,47 @@ impl Simulation {
                 laser_mm: row
                     .as_ref()
                     .map_or([LASER_LOG_NO_RETURN; LASER_BEAMS], |s| s.laser_mm),
-                width: img.width,
-                height: img.height,
-                gray: img.gray,
+                width: self.camera.width,
+                height: self.camera.height,
+                others,
+                noise_seed: r.camera_rng.next_u64(),
             };
             r.frames.push(frame);
         }
+    }
+
+    /// The picture stored frame `f` shows: rendered now from the static
+    /// world, the pose and other robots of its instant and its own noise
+    /// seed, so it is the same whenever (and however often) it is asked
+    /// for. About 2 ms at 320 × 240.
+    pub fn frame_image(&self, f: &CapturedFrame) -> CameraImage {
+        let spec = &self.scenario.camera;
+        let mut rng = Rng::new(f.noise_seed);
+        let t0 = self.clock.map_or(0.0, |now| now());
+        let img = render_camera(
+            &self.camera,
+            &f.truth,
+            &self.world,
+            &self.scenario.walls,
+            &f.others,
+            &mut self.textures.lock(),
+            false,
+            Some(CameraNoise {
+                rng: &mut rng,
+                pixel_std: spec.pixel_noise_std,
+                exposure_std: spec.exposure_jitter,
+            }),
+        );
+        if let Some(now) = self.clock {
+            self.render_ms.add(now() - t0);
+        }
+        img
+    }
+
+    /// Milliseconds spent rendering stored frames so far (zero without a
+    /// clock, see [`Simulation::set_clock`]).
+    pub fn render_ms(&self) -> f64 {
+        self.render_ms.get()
     }
 
     /// Runs to the end of the scenario's duration.

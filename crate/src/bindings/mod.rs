@@ -319,19 +319,19 @@ impl Lab {
             .inner
             .frame(robot as usize, index as usize)
             .map_err(js_err)?;
-        let rgba: Vec<u8> = f.gray.iter().flat_map(|&g| [g, g, g, 255]).collect();
-        put_rgba(ctx, &rgba, f.width, f.height)
+        let img = self.inner.frame_image(f).map_err(js_err)?;
+        let rgba: Vec<u8> = img.gray.iter().flat_map(|&g| [g, g, g, 255]).collect();
+        put_rgba(ctx, &rgba, img.width, img.height)
     }
 
     /// Captured frame `index` of robot `robot` as grey bytes.
     #[wasm_bindgen(js_name = frameGray)]
     pub fn frame_gray(&self, robot: u32, index: u32) -> Result<Vec<u8>, JsError> {
-        Ok(self
+        let f = self
             .inner
             .frame(robot as usize, index as usize)
-            .map_err(js_err)?
-            .gray
-            .clone())
+            .map_err(js_err)?;
+        Ok(self.inner.frame_image(f).map_err(js_err)?.gray)
     }
 
     /// Captured frame `index` of robot `robot` as a PNG file (8-bit grey).
@@ -341,9 +341,15 @@ impl Lab {
             .inner
             .frame(robot as usize, index as usize)
             .map_err(js_err)?;
+        let img = self.inner.frame_image(f).map_err(js_err)?;
         let mut out = Vec::new();
         image::codecs::png::PngEncoder::new(&mut out)
-            .write_image(&f.gray, f.width, f.height, image::ExtendedColorType::L8)
+            .write_image(
+                &img.gray,
+                img.width,
+                img.height,
+                image::ExtendedColorType::L8,
+            )
             .map_err(js_err)?;
         Ok(out)
     }

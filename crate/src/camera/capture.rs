@@ -7,19 +7,31 @@
 //! together with the odometry pose, sonar and laser of that instant, and the
 //! true pose beside it for scoring.
 //!
-//! Frames are stored raw (8-bit grey, `width × height` bytes) so that
-//! matching never pays for decoding. Memory is bounded by a budget shared by
-//! all robots ([`FRAME_BUDGET_BYTES`]). When a robot's share is full the
-//! store is **thinned**: every other frame is dropped and the capture period
-//! doubles, so the frames kept still span the whole run evenly (a 1-hour run
-//! at 320 × 240 keeps a frame every 4 s instead of every second). The
+//! A frame is stored as what it takes to *render* it — the true pose, the
+//! other robots' bodies in view, and the seed of its pixel noise — not as
+//! pixels. The world is static, so rendering it later gives exactly the
+//! picture the camera took, while a run keeps a few hundred bytes per frame
+//! instead of 75 kB, and pays for rendering only the frames that are looked
+//! at: the merge describes perhaps half of them (the automatic method's
+//! motion thinning) or a tenth (the thesis's squareness test), and the page
+//! shows one at a time. [`crate::sim::Simulation::frame_image`] renders one.
+//!
+//! Memory is still bounded by a budget shared by all robots
+//! ([`FRAME_BUDGET_BYTES`]), for runs of days. When a robot's share is full
+//! the store is **thinned**: every other frame is dropped and the capture
+//! period doubles, so the frames kept still span the whole run evenly. The
 //! number of frames dropped is reported.
 
+use crate::camera::RobotBox;
 use crate::geom::Pose2;
 use crate::sensors::{LASER_BEAMS, SONAR_COUNT};
 
-/// Frames of all robots together use at most this much memory (96 MiB).
-pub const FRAME_BUDGET_BYTES: usize = 96 << 20;
+/// Frames of all robots together use at most this much memory (16 MiB:
+/// about 20 hours of frames at one a second for two robots).
+pub const FRAME_BUDGET_BYTES: usize = 16 << 20;
+
+/// What one stored frame costs, roughly: its senses plus two robot bodies.
+pub const FRAME_BYTES: usize = std::mem::size_of::<CapturedFrame>() + 2 * (4 * 16 + 32);
 
 /// One captured frame and the robot's senses at that instant.
 #[derive(Clone, Debug, PartialEq)]
@@ -36,9 +48,14 @@ pub struct CapturedFrame {
     pub sonar_m: [f32; SONAR_COUNT],
     /// Laser ranges in mm; `u16::MAX` for no return.
     pub laser_mm: [u16; LASER_BEAMS],
+    /// Image size (px).
     pub width: u32,
     pub height: u32,
-    pub gray: Vec<u8>,
+    /// The other robots' bodies at that instant, as the camera sees them.
+    pub others: Vec<RobotBox>,
+    /// Seed of the frame's pixel noise and exposure jitter, drawn from the
+    /// robot's camera stream at capture.
+    pub noise_seed: u64,
 }
 
 /// One robot's frames, within its share of the budget.
@@ -54,8 +71,9 @@ pub struct FrameStore {
 }
 
 impl FrameStore {
-    /// A store for frames of `frame_bytes` each, with `robots` robots sharing
-    /// the budget, capturing every `period_steps` steps.
+    /// A store for frames of `frame_bytes` each (see [`FRAME_BYTES`]), with
+    /// `robots` robots sharing the budget, capturing every `period_steps`
+    /// steps.
     pub fn new(frame_bytes: usize, robots: usize, period_steps: usize) -> Self {
         let share = FRAME_BUDGET_BYTES / robots.max(1);
         FrameStore {
@@ -94,7 +112,17 @@ impl FrameStore {
         self.frames.push(frame);
     }
 
+    /// Memory the stored frames take (bytes, roughly).
     pub fn bytes(&self) -> usize {
-        self.frames.iter().map(|f| f.gray.len()).sum()
+        self.frames
+            .iter()
+            .map(|f| {
+                std::mem::size_of::<CapturedFrame>()
+                    + f.others
+                        .iter()
+                        .map(|b| std::mem::size_of::<RobotBox>() + 16 * b.corners.len())
+                        .sum::<usize>()
+            })
+            .sum()
     }
 }

@@ -120,6 +120,7 @@ pub struct CameraNoise<'a> {
 }
 
 /// Another robot as the camera sees it: its body polygon and colour.
+#[derive(Clone, Debug, PartialEq)]
 pub struct RobotBox {
     pub corners: Vec<DVec2>,
     pub rgb: [u8; 3],
@@ -148,6 +149,16 @@ pub fn wall_texture_key(walls: &[WallSpec], i: usize, back: bool) -> TextureKey 
             .unwrap_or_else(|| format!("wall#{i}")),
         back,
     }
+}
+
+/// A grey value rounded to the nearest byte (halves up), clamped to
+/// 0..=255. `(v + 0.5).floor()` rather than `v.round()`: wasm has a
+/// floor instruction but no round-half-away-from-zero, which becomes a
+/// library call per pixel; the two agree on every value that survives the
+/// clamp.
+#[inline]
+fn to_byte(v: f64) -> u8 {
+    (v + 0.5).floor().clamp(0.0, 255.0) as u8
 }
 
 /// Rows whose pixel centres lie between the continuous rows `top` and
@@ -328,12 +339,12 @@ pub fn render(
             Some(n) if n.pixel_std > 0.0 => {
                 for (r, v) in column.iter().enumerate() {
                     let noisy = v * gain + n.pixel_std * n.rng.approx_gaussian();
-                    gray[r * w as usize + c as usize] = noisy.round().clamp(0.0, 255.0) as u8;
+                    gray[r * w as usize + c as usize] = to_byte(noisy);
                 }
             }
             _ => {
                 for (r, v) in column.iter().enumerate() {
-                    gray[r * w as usize + c as usize] = (v * gain).round().clamp(0.0, 255.0) as u8;
+                    gray[r * w as usize + c as usize] = to_byte(v * gain);
                 }
             }
         }

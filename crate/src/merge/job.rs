@@ -470,7 +470,8 @@ impl MergeJob {
                 .find(|f| f.index == info.index);
             let features = frame
                 .and_then(|f| {
-                    GrayImage::new(f.width as usize, f.height as usize, f.gray.clone()).ok()
+                    let img = sim.frame_image(f);
+                    GrayImage::new(img.width as usize, img.height as usize, img.gray).ok()
                 })
                 .map(|img| strongest_features(&img, &self.config.surf, self.config.max_keypoints))
                 .unwrap_or_default();
