@@ -527,6 +527,18 @@ impl MergeJob {
 
     /// Checks one frame pair (positions in the robots' selected lists).
     pub fn check(&self, a: usize, row: usize, b: usize, col: usize) -> Option<PairCheck> {
+        self.check_with(a, row, b, col, &self.config.verify)
+    }
+
+    /// [`MergeJob::check`] with other verification settings.
+    fn check_with(
+        &self,
+        a: usize,
+        row: usize,
+        b: usize,
+        col: usize,
+        verify: &VerifyConfig,
+    ) -> Option<PairCheck> {
         let (ra, rb) = (self.robots.get(a)?, self.robots.get(b)?);
         let (fa, fb) = (ra.features.get(row)?, rb.features.get(col)?);
         let (ia, ib) = (&ra.infos[ra.selected[row]], &rb.infos[rb.selected[col]]);
@@ -534,15 +546,7 @@ impl MergeJob {
             ^ ((ia.index as u64) << 20)
             ^ ((ib.index as u64) << 40)
             ^ ((a * 16 + b) as u64);
-        Some(verify_pair(
-            &self.camera,
-            ia,
-            fa,
-            ib,
-            fb,
-            &self.config.verify,
-            seed,
-        ))
+        Some(verify_pair(&self.camera, ia, fa, ib, fb, verify, seed))
     }
 
     fn advance_matching(&mut self, units: usize) -> usize {
@@ -558,7 +562,15 @@ impl MergeJob {
             }
             let (row, col) = p.todo[p.cells.len()];
             let (a, b) = (p.a, p.b);
-            let cell = match self.check(a, row, b, col) {
+            // The automatic method decides on the rigid fit alone: the
+            // homography (the thesis's table figure) is fitted again only
+            // for a pair the user opens (`check`).
+            let verify = VerifyConfig {
+                homography: self.config.verify.homography
+                    && self.config.method == MergeMethod::Thesis,
+                ..self.config.verify
+            };
+            let cell = match self.check_with(a, row, b, col, &verify) {
                 Some(check) => {
                     let inliers = match self.config.method {
                         MergeMethod::Thesis => check.homography_inliers,
