@@ -4,7 +4,7 @@
 //! simulated runs; the truth is used only to score.
 //!
 //! ```text
-//! cargo run --release -p slamlab --example bench_merge -- [--runs 20] [--others 5] [--multi 5] [--duration 300] [--methods auto,thesis,map-only] [--verbose]
+//! cargo run --release -p slamlab --example bench_merge -- [--runs 20] [--first-seed 1] [--others 5] [--multi 5] [--duration 300] [--methods auto,thesis,map-only] [--verbose]
 //! ```
 //!
 //! `--multi N` adds N mazes with three robots each, scored robot by robot:
@@ -104,8 +104,14 @@ fn main() {
     let only = arg(&args, "--only");
     // `--min-places N`: the verdict's independent places (an experiment).
     let min_places: Option<usize> = arg(&args, "--min-places").and_then(|s| s.parse().ok());
+    // `--min-inliers N`: rigid inliers a frame pair needs (an experiment).
+    let min_inliers: Option<usize> = arg(&args, "--min-inliers").and_then(|s| s.parse().ok());
+    // `--first-seed S`: mazes S..S+runs (default 1), e.g. for a held-out set.
+    let first_seed: u64 = arg(&args, "--first-seed")
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1);
     let mut cases: Vec<(String, String)> = Vec::new();
-    for seed in 1..=runs {
+    for seed in first_seed..first_seed + runs {
         let spec = MazeSpec {
             seed,
             duration_s: duration,
@@ -168,6 +174,9 @@ fn main() {
             let mut cfg = MergeConfig::new(method, scenario.seed);
             if let Some(n) = min_places {
                 cfg.verdict.min_places = n;
+            }
+            if let Some(n) = min_inliers {
+                cfg.verify.min_inliers = n;
             }
             let mut job = MergeJob::new(&sim, cfg).expect("job");
             let mut stage_ms: Vec<(&'static str, f64)> = Vec::new();

@@ -232,6 +232,7 @@ pub fn render(
             }
         })
         .collect();
+    let mut memo: Option<(usize, bool, i64, std::sync::Arc<texture::Chunk>)> = None;
     let mut column = vec![0f64; h as usize];
     let mut column_rgb = vec![[0u8; 3]; if colour { h as usize } else { 0 }];
     for c in 0..w {
@@ -268,7 +269,16 @@ pub fn render(
             };
             let k = along.floor() as i64;
             let lx = (along - k as f64) * ppm;
-            let chunk = bank.chunk(&wall_texture_key(walls, wi, back), k);
+            // Neighbouring columns mostly draw from the same chunk: look it
+            // up (a string key and a hash) only when it changes.
+            let chunk = match &memo {
+                Some((w, b, c, chunk)) if (*w, *b, *c) == (wi, back, k) => chunk.clone(),
+                _ => {
+                    let chunk = bank.chunk(&wall_texture_key(walls, wi, back), k);
+                    memo = Some((wi, back, k, chunk.clone()));
+                    chunk
+                }
+            };
             let (top, bottom) = (cam.row_of(cam.wall_height_m, depth), cam.row_of(0.0, depth));
             let (r0, r1) = row_span(top, bottom, h);
             // On the wall, texel row = (h_w - z) * ppm with z linear in the

@@ -27,6 +27,7 @@
 
 use crate::rng::Rng;
 use std::collections::HashMap;
+use std::sync::Arc;
 use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Rect, Stroke, Transform};
 
 /// Texture resolution (texels per metre).
@@ -158,7 +159,7 @@ impl ImageTexture {
 pub struct TextureBank {
     seed: u64,
     wall_height_m: f64,
-    chunks: HashMap<(TextureKey, i64), Chunk>,
+    chunks: HashMap<(TextureKey, i64), Arc<Chunk>>,
     /// Insertion order, for evicting the oldest chunk at the cap.
     order: std::collections::VecDeque<(TextureKey, i64)>,
     images: HashMap<String, ImageTexture>,
@@ -252,20 +253,23 @@ impl TextureBank {
         self.chunks.len()
     }
 
-    /// The chunk `k` of a texture, generating it on first use.
-    pub fn chunk(&mut self, key: &TextureKey, k: i64) -> &Chunk {
+    /// The chunk `k` of a texture, generating it on first use. Shared, so a
+    /// renderer can hold on to the chunk it is drawing from column after
+    /// column without looking it up again.
+    pub fn chunk(&mut self, key: &TextureKey, k: i64) -> Arc<Chunk> {
         let id = (key.clone(), k);
-        if !self.chunks.contains_key(&id) {
-            if self.chunks.len() >= CHUNK_CACHE_CAP {
-                if let Some(old) = self.order.pop_front() {
-                    self.chunks.remove(&old);
-                }
-            }
-            let chunk = self.paint_chunk(key, k);
-            self.order.push_back(id.clone());
-            self.chunks.insert(id.clone(), chunk);
+        if let Some(c) = self.chunks.get(&id) {
+            return c.clone();
         }
-        &self.chunks[&id]
+        if self.chunks.len() >= CHUNK_CACHE_CAP {
+            if let Some(old) = self.order.pop_front() {
+                self.chunks.remove(&old);
+            }
+        }
+        let chunk = Arc::new(self.paint_chunk(key, k));
+        self.order.push_back(id.clone());
+        self.chunks.insert(id, chunk.clone());
+        chunk
     }
 
     fn paint_chunk(&self, key: &TextureKey, k: i64) -> Chunk {

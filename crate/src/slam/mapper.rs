@@ -92,6 +92,10 @@ pub struct SlamConfig {
     pub insert_distance_m: f64,
     /// ...or turned this much (rad). Default 5°.
     pub insert_turn_rad: f64,
+    /// ...or when fewer than this share of the scan's points lie on
+    /// surfaces already mapped: the scan shows new walls, and the map must
+    /// have them before the next scans are matched to it. Default 0.9.
+    pub insert_below_score: f64,
 }
 
 impl Default for SlamConfig {
@@ -108,6 +112,7 @@ impl Default for SlamConfig {
             odometry_noise: OdometryNoise::default(),
             insert_distance_m: 0.1,
             insert_turn_rad: 5f64.to_radians(),
+            insert_below_score: 0.9,
         }
     }
 }
@@ -374,7 +379,9 @@ impl RobotMapping {
             MatchStatus::Degenerate => self.counts.degenerate += 1,
             MatchStatus::OdometryOnly => self.counts.odometry_only += 1,
         }
-        if self.due_for_insert(1, &outcome.pose) {
+        let novel = outcome.score < self.config.insert_below_score;
+        if self.due_for_insert(1, &outcome.pose) || novel {
+            self.last_inserted[1] = Some(outcome.pose);
             self.slam_map.integrate_scan(&outcome.pose, scan);
         }
         self.estimates.push(outcome.pose);
