@@ -59,7 +59,7 @@ use super::gauss_newton;
 use super::grid::{beam_directions, GridConfig, OccupancyGrid};
 use super::likelihood::LikelihoodField;
 use super::surface::{information_at, refine_to_surface, RefineConfig, Refinement};
-use crate::geom::{wrap_angle, Pose2};
+use crate::geom::Pose2;
 use crate::sensors::LaserScan;
 use glam::DVec2;
 
@@ -84,18 +84,6 @@ pub struct SlamConfig {
     /// match's information is `JᵀJ / σ²`.
     pub match_noise_m: f64,
     pub odometry_noise: OdometryNoise,
-    /// A scan is added to a map only once the pose it is placed at has
-    /// moved this far (m)... Default 0.1. Every scan is still *matched*;
-    /// what is skipped is re-painting the same walls from nearly the same
-    /// place, which is most of the mapper's time (each beam walks up to 80
-    /// cells), the way Hector SLAM and GMapping gate their map updates.
-    pub insert_distance_m: f64,
-    /// ...or turned this much (rad). Default 5°.
-    pub insert_turn_rad: f64,
-    /// ...or when fewer than this share of the scan's points lie on
-    /// surfaces already mapped: the scan shows new walls, and the map must
-    /// have them before the next scans are matched to it. Default 0.9.
-    pub insert_below_score: f64,
 }
 
 impl Default for SlamConfig {
@@ -110,9 +98,6 @@ impl Default for SlamConfig {
             search_below: 0.5,
             match_noise_m: 0.01,
             odometry_noise: OdometryNoise::default(),
-            insert_distance_m: 0.1,
-            insert_turn_rad: 5f64.to_radians(),
-            insert_below_score: 0.9,
         }
     }
 }
@@ -297,9 +282,6 @@ pub struct RobotMapping {
     /// The current pose and odometry's calibration (odometry frame).
     filter: PoseFilter,
     last_odometry: Pose2,
-    /// Where each map last took a scan (odometry map, SLAM map); `None`
-    /// before the first.
-    last_inserted: [Option<Pose2>; 2],
     pub counts: MatchCounts,
     pub last_outcome: Option<MatchOutcome>,
 }
@@ -327,7 +309,6 @@ impl RobotMapping {
             // The start pose is the frame's origin: known exactly.
             filter: PoseFilter::new(Pose2::IDENTITY, &noise),
             last_odometry: Pose2::IDENTITY,
-            last_inserted: [None, None],
             counts: MatchCounts::default(),
             last_outcome: None,
         }
@@ -363,9 +344,7 @@ impl RobotMapping {
 
     /// One step: the new odometry pose and the scan taken there.
     pub fn observe(&mut self, odometry: &Pose2, scan: &LaserScan) {
-        if self.due_for_insert(0, odometry) {
-            self.odometry_map.integrate_scan(odometry, scan);
-        }
+        self.odometry_map.integrate_scan(odometry, scan);
         let step = self.last_odometry.between(odometry);
         self.filter.predict(&step, &self.config.odometry_noise);
         let prior = self.filter.pose;
@@ -379,28 +358,10 @@ impl RobotMapping {
             MatchStatus::Degenerate => self.counts.degenerate += 1,
             MatchStatus::OdometryOnly => self.counts.odometry_only += 1,
         }
-        let novel = outcome.score < self.config.insert_below_score;
-        if self.due_for_insert(1, &outcome.pose) || novel {
-            self.last_inserted[1] = Some(outcome.pose);
-            self.slam_map.integrate_scan(&outcome.pose, scan);
-        }
+        self.slam_map.integrate_scan(&outcome.pose, scan);
         self.estimates.push(outcome.pose);
         self.last_odometry = *odometry;
         self.last_outcome = Some(outcome);
-    }
-
-    /// Whether map `which` (0 odometry, 1 SLAM) takes a scan placed at
-    /// `pose`: the first one, then one whenever the pose has moved or
-    /// turned enough since the last it took (and if so, remembers it).
-    fn due_for_insert(&mut self, which: usize, pose: &Pose2) -> bool {
-        let due = self.last_inserted[which].is_none_or(|last| {
-            (pose.position() - last.position()).length() >= self.config.insert_distance_m
-                || wrap_angle(pose.theta - last.theta).abs() >= self.config.insert_turn_rad
-        });
-        if due {
-            self.last_inserted[which] = Some(*pose);
-        }
-        due
     }
 
     /// The map of one mapper.
