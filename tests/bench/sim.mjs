@@ -65,4 +65,20 @@ for (const [w, h] of [[320, 240], [640, 480]]) {
   lab.runToEnd();
   const ms = performance.now() - t0;
   console.log(`wasm (${build}) thesis run, 300 s with cameras: ${ms.toFixed(0)} ms (${(ms / 3000).toFixed(3)} ms per step)`);
+
+  // Captured frames are stored as pose and noise seed and rendered when
+  // looked at: ms per stored frame (with its pixel noise), over robot1's
+  // frames, once with the wall textures still to generate and once with
+  // them cached.
+  const n = lab.frameCount(0);
+  for (const pass of ['textures generated', 'textures cached']) {
+    const t = [];
+    for (let k = 0; k < n; k++) {
+      const t0 = performance.now();
+      lab.frameGray(0, k);
+      t.push(performance.now() - t0);
+    }
+    console.log(`wasm (${build}) stored frame 320x240 (${pass}): ${median(t).toFixed(2)} ms/frame median over ${n}`);
+  }
+  lab.free();
 }
