@@ -131,6 +131,7 @@ use super::selection::front_wall;
 use super::{FrameInfo, MergeStatus};
 use crate::camera::PinholeCamera;
 use crate::geom::{wrap_angle, Pose2};
+use crate::surf::msac::homography_from_4;
 use crate::surf::Homography;
 use glam::DVec2;
 use serde::Serialize;
@@ -406,37 +407,6 @@ fn view_in_one(h: &Homography, cam: &PinholeCamera) -> Option<ViewInOne> {
     .then_some(view)
 }
 
-/// The homography through four point pairs (`h₃₃ = 1`), by Gaussian
-/// elimination on the 8 × 8 direct linear transform; `None` if degenerate.
-fn homography_through(p: &[[f64; 2]; 4], q: &[[f64; 2]; 4]) -> Option<Homography> {
-    let mut a = [[0.0f64; 9]; 8];
-    for k in 0..4 {
-        let ([x, y], [u, v]) = (p[k], q[k]);
-        a[2 * k] = [x, y, 1.0, 0.0, 0.0, 0.0, -u * x, -u * y, u];
-        a[2 * k + 1] = [0.0, 0.0, 0.0, x, y, 1.0, -v * x, -v * y, v];
-    }
-    for col in 0..8 {
-        let pivot = (col..8).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
-        if a[pivot][col].abs() < 1e-9 {
-            return None;
-        }
-        a.swap(col, pivot);
-        let pivot_row = a[col];
-        for (r, row) in a.iter_mut().enumerate() {
-            if r != col {
-                let f = row[col] / pivot_row[col];
-                for (v, p) in row.iter_mut().zip(pivot_row).skip(col) {
-                    *v -= f * p;
-                }
-            }
-        }
-    }
-    let h: Vec<f64> = (0..8).map(|i| a[i][8] / a[i][i]).collect();
-    h.iter()
-        .all(|v| v.is_finite())
-        .then(|| Homography([[h[0], h[1], h[2]], [h[3], h[4], h[5]], [h[6], h[7], 1.0]]))
-}
-
 /// A's pixels to B's pixels for one table row: the homography, or the one
 /// through the matched region's corners.
 fn a_to_b(pm: &PairMatch, cam: &PinholeCamera) -> Option<Homography> {
@@ -451,7 +421,7 @@ fn a_to_b(pm: &PairMatch, cam: &PinholeCamera) -> Option<Homography> {
         [w - 0.5, h - 0.5],
         [-0.5, h - 0.5],
     ];
-    homography_through(&corners, &quad)
+    homography_from_4(&corners, &quad)
 }
 
 /// One usable table row seen from the robot that gives one frame ("one")

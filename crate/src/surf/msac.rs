@@ -283,8 +283,9 @@ fn good_sample(p: &[[f64; 2]; 4], q: &[[f64; 2]; 4]) -> bool {
 }
 
 /// The homography through four correspondences (h₃₃ = 1), by Gaussian
-/// elimination with partial pivoting on the 8 × 8 DLT system.
-fn homography_from_4(p: &[[f64; 2]; 4], q: &[[f64; 2]; 4]) -> Option<Homography> {
+/// elimination with partial pivoting on the 8 × 8 DLT system; `None` when
+/// degenerate (three points on a line).
+pub fn homography_from_4(p: &[[f64; 2]; 4], q: &[[f64; 2]; 4]) -> Option<Homography> {
     let mut a = [[0.0f64; 9]; 8];
     for k in 0..4 {
         let ([x, y], [u, v]) = (p[k], q[k]);
