@@ -4,7 +4,9 @@
 //! matching-precision measures.
 #![allow(dead_code)]
 
-use slamlab::surf::{Features, GrayImage, Homography, Match};
+use slamlab::surf::{
+    fit_homography, match_features, Features, GrayImage, Homography, Match, MatchConfig, MsacConfig,
+};
 
 pub const ASTRONAUT: &[u8] = include_bytes!("../data/astronaut.png");
 pub const COFFEE: &[u8] = include_bytes!("../data/coffee.png");
@@ -26,6 +28,36 @@ pub fn rot_scale(deg: f64, s: f64, cx: f64, cy: f64, tx: f64, ty: f64) -> Homogr
         [b, a, cy - (b * cx + a * cy) + ty],
         [0.0, 0.0, 1.0],
     ])
+}
+
+/// The warps the quality tests use: the 12°/0.85 view first, then
+/// harder ones. Each with the largest overlap error (px) `surf_quality`
+/// accepts for it.
+pub fn views() -> [(&'static str, Homography, f64); 6] {
+    [
+        (
+            "rot12 s0.85",
+            rot_scale(12.0, 0.85, 319.5, 239.5, 0.0, 0.0),
+            1.0,
+        ),
+        ("rot30", rot_scale(30.0, 1.0, 319.5, 239.5, 0.0, 0.0), 1.0),
+        ("scale0.5", rot_scale(0.0, 0.5, 319.5, 239.5, 0.0, 0.0), 1.0),
+        ("scale2", rot_scale(0.0, 2.0, 319.5, 239.5, 0.0, 0.0), 2.0),
+        (
+            "rot-20 s1.4",
+            rot_scale(-20.0, 1.4, 319.5, 239.5, 10.0, -5.0),
+            2.0,
+        ),
+        (
+            "perspective",
+            Homography([
+                [0.9, 0.05, 30.0],
+                [-0.03, 0.95, 20.0],
+                [0.0002, -0.0001, 1.0],
+            ]),
+            1.0,
+        ),
+    ]
 }
 
 /// `src` seen through `h` (src pixels → dst pixels) in a `w × h` image,
@@ -187,4 +219,108 @@ pub fn noise_image(w: usize, h: usize, seed: u64) -> GrayImage {
         (0..w * h).map(|_| (rng.next_u64() >> 56) as u8).collect(),
     )
     .expect("valid")
+}
+
+/// Table header matching [`Outcome::row`].
+pub const HEADER: &str = "| view | keypoints | repeatability | matches | precision@3px | precision@σ | inliers | inlier precision | overlap error px | corner error px |";
+
+/// Every quality figure of one pair of feature sets (see `surf_quality`'s
+/// module doc for the definitions).
+pub struct Outcome {
+    pub keypoints: (usize, usize),
+    pub repeatability: f64,
+    pub matches: usize,
+    pub precision_3px: f64,
+    pub precision_scale: f64,
+    pub inliers: usize,
+    pub inlier_precision: f64,
+    pub overlap_error_px: f64,
+    pub corner_error_px: f64,
+}
+
+impl Outcome {
+    /// One Markdown table row, as in BENCHMARKS.md.
+    pub fn row(&self, name: &str) -> String {
+        format!(
+            "| {name} | {} / {} | {:.3} | {} | {:.3} | {:.3} | {} | {:.3} | {:.2} | {:.2} |",
+            self.keypoints.0,
+            self.keypoints.1,
+            self.repeatability,
+            self.matches,
+            self.precision_3px,
+            self.precision_scale,
+            self.inliers,
+            self.inlier_precision,
+            self.overlap_error_px,
+            self.corner_error_px
+        )
+    }
+}
+
+/// Largest distance, over a grid of image-1 points that land inside image 2
+/// (`w × h`), between where `fit` and `truth` send them.
+pub fn overlap_error(fit: &Homography, truth: &Homography, w: usize, h: usize) -> f64 {
+    let mut worst: f64 = 0.0;
+    for gy in 0..=24 {
+        for gx in 0..=32 {
+            let p = [
+                gx as f64 * (w as f64 - 1.0) / 32.0,
+                gy as f64 * (h as f64 - 1.0) / 24.0,
+            ];
+            let (Some(a), Some(b)) = (fit.apply(p), truth.apply(p)) else {
+                return f64::INFINITY;
+            };
+            if b[0] >= 0.0 && b[1] >= 0.0 && b[0] <= w as f64 - 1.0 && b[1] <= h as f64 - 1.0 {
+                worst = worst.max((a[0] - b[0]).hypot(a[1] - b[1]));
+            }
+        }
+    }
+    worst
+}
+
+/// Scores features `f1` of an image and `f2` of the same image warped by
+/// `hm` (both `size`): default ratio matching with Laplacian gating, then
+/// the default MSAC homography.
+pub fn score(f1: &Features, f2: &Features, hm: &Homography, size: (usize, usize)) -> Outcome {
+    let (w, h) = size;
+    let repeatability = repeatability(f1, f2, hm, size, size, 2.5);
+    let matches = match_features(f1, f2, &MatchConfig::default());
+    let precision_3px = precision(f1, f2, &matches, hm, 3.0);
+    let scale_ok = matches
+        .iter()
+        .filter(|m| {
+            let tol = (f2.keypoints[m.train].scale as f64).max(3.0);
+            correct(f1, f2, m, hm, tol)
+        })
+        .count();
+    let precision_scale = scale_ok as f64 / matches.len().max(1) as f64;
+    let (p1, p2) = pairs(f1, f2, &matches);
+    let fit = fit_homography(&p1, &p2, &MsacConfig::default());
+    let (inliers, inlier_precision, overlap_error_px, corner_error_px) = match &fit {
+        Some(f) => {
+            let good = f
+                .inliers
+                .iter()
+                .filter(|&&i| correct(f1, f2, &matches[i], hm, 3.0))
+                .count();
+            (
+                f.inliers.len(),
+                good as f64 / f.inliers.len() as f64,
+                overlap_error(&f.model, hm, w, h),
+                corner_error(&f.model, hm, w, h),
+            )
+        }
+        None => (0, 0.0, f64::INFINITY, f64::INFINITY),
+    };
+    Outcome {
+        keypoints: (f1.len(), f2.len()),
+        repeatability,
+        matches: matches.len(),
+        precision_3px,
+        precision_scale,
+        inliers,
+        inlier_precision,
+        overlap_error_px,
+        corner_error_px,
+    }
 }
