@@ -106,6 +106,11 @@ fn main() {
     let min_places: Option<usize> = arg(&args, "--min-places").and_then(|s| s.parse().ok());
     // `--min-inliers N`: rigid inliers a frame pair needs (an experiment).
     let min_inliers: Option<usize> = arg(&args, "--min-inliers").and_then(|s| s.parse().ok());
+    // `--max-keypoints N`, `--min-motion M`: frame features and thinning (experiments).
+    let max_keypoints: Option<usize> = arg(&args, "--max-keypoints").and_then(|s| s.parse().ok());
+    let min_motion: Option<f64> = arg(&args, "--min-motion").and_then(|s| s.parse().ok());
+    let proposals: Option<usize> = arg(&args, "--proposals").and_then(|s| s.parse().ok());
+    let max_pairs: Option<usize> = arg(&args, "--max-pairs").and_then(|s| s.parse().ok());
     // `--first-seed S`: mazes S..S+runs (default 1), e.g. for a held-out set.
     let first_seed: u64 = arg(&args, "--first-seed")
         .and_then(|s| s.parse().ok())
@@ -177,6 +182,18 @@ fn main() {
             }
             if let Some(n) = min_inliers {
                 cfg.verify.min_inliers = n;
+            }
+            if let Some(n) = max_keypoints {
+                cfg.max_keypoints = n;
+            }
+            if let Some(m) = min_motion {
+                cfg.min_motion_m = m;
+            }
+            if let Some(n) = proposals {
+                cfg.proposals_per_frame = n;
+            }
+            if let Some(n) = max_pairs {
+                cfg.max_pairs = n;
             }
             let mut job = MergeJob::new(&sim, cfg).expect("job");
             let mut stage_ms: Vec<(&'static str, f64)> = Vec::new();

@@ -422,9 +422,8 @@ impl OccupancyGrid {
     /// frame) crosses by `miss`, the cell holding `b` only if `include_last`.
     fn clear(&mut self, a: DVec2, b: DVec2, include_last: bool) {
         let miss = self.config.miss;
-        let last = [b.x.floor() as i64, b.y.floor() as i64];
-        let first = [a.x.floor() as i64, a.y.floor() as i64];
-        let (Some(start), Some(_)) = (self.local(first), self.local(last)) else {
+        let last = cell_of(b);
+        let (Some(start), Some(_)) = (self.local(cell_of(a)), self.local(last)) else {
             // Partly outside a grid at its cap: the careful path, which
             // counts what it drops.
             traverse(a, b, |c| {
@@ -436,42 +435,10 @@ impl OccupancyGrid {
         };
         // Both ends inside the (rectangular) grid, so is every cell between:
         // the same walk as `traverse`, stepping the cells' index directly.
+        let walk = Walk::new(a, b);
         let w = self.width as i64;
         let mut index = start.1 as i64 * w + start.0 as i64;
-        let d = b - a;
-        let step = [
-            if d.x > 0.0 { 1 } else { -1 },
-            if d.y > 0.0 { 1 } else { -1 },
-        ];
-        let index_step = [step[0], step[1] * w];
-        let t_delta = [1.0 / d.x.abs(), 1.0 / d.y.abs()];
-        let boundary = |p: f64, c: i64, s: i64| {
-            if s > 0 {
-                (c + 1) as f64 - p
-            } else {
-                p - c as f64
-            }
-        };
-        let mut t_max = [
-            if d.x != 0.0 {
-                boundary(a.x, first[0], step[0]) * t_delta[0]
-            } else {
-                f64::INFINITY
-            },
-            if d.y != 0.0 {
-                boundary(a.y, first[1], step[1]) * t_delta[1]
-            } else {
-                f64::INFINITY
-            },
-        ];
-        let left = [(last[0] - first[0]).abs(), (last[1] - first[1]).abs()];
-        // An axis with no steps left is never chosen again: rounding cannot
-        // carry the walk past the end cell.
-        for axis in 0..2 {
-            if left[axis] == 0 {
-                t_max[axis] = f64::INFINITY;
-            }
-        }
+        let index_step = [walk.step[0], walk.step[1] * w];
         let (min, max) = (self.config.min as i16, self.config.max);
         let (cells, surface) = (&mut self.cells, &mut self.surface);
         let mut lower = |index: i64| {
@@ -490,8 +457,8 @@ impl OccupancyGrid {
                 }
             }
         };
-        let ([mut tx, mut ty], [dtx, dty]) = (t_max, t_delta);
-        let ([mut nx, mut ny], [sx, sy]) = (left, index_step);
+        let ([mut tx, mut ty], [dtx, dty]) = (walk.t_max, walk.t_delta);
+        let ([mut nx, mut ny], [sx, sy]) = (walk.left, index_step);
         for _ in 0..nx + ny {
             lower(index);
             // Plain scalars, not arrays indexed by the axis: this loop is
@@ -556,40 +523,68 @@ pub fn state_of(units: i8) -> CellState {
     }
 }
 
+/// The cell (unit-sized, in cell coordinates) holding `p`.
+fn cell_of(p: DVec2) -> [i64; 2] {
+    [p.x.floor() as i64, p.y.floor() as i64]
+}
+
+/// The set-up of an Amanatides–Woo walk (Amanatides and Woo 1987) along
+/// the segment `a → b` in cell coordinates: the direction of each axis's
+/// steps, the segment parameter t at which the walk first crosses a cell
+/// boundary on each axis (`t_max`) and between two crossings (`t_delta`),
+/// and how many steps each axis takes to reach `b`'s cell. An axis with no
+/// steps to take has `t_max` infinite, so it is never chosen: rounding
+/// cannot carry the walk past the end cell.
+struct Walk {
+    step: [i64; 2],
+    t_max: [f64; 2],
+    t_delta: [f64; 2],
+    left: [i64; 2],
+}
+
+impl Walk {
+    fn new(a: DVec2, b: DVec2) -> Walk {
+        let (first, last) = (cell_of(a), cell_of(b));
+        let d = b - a;
+        let step = [
+            if d.x > 0.0 { 1 } else { -1 },
+            if d.y > 0.0 { 1 } else { -1 },
+        ];
+        let t_delta = [1.0 / d.x.abs(), 1.0 / d.y.abs()];
+        let left = [(last[0] - first[0]).abs(), (last[1] - first[1]).abs()];
+        let mut t_max = [f64::INFINITY; 2];
+        for (axis, (p, dp)) in [(a.x, d.x), (a.y, d.y)].into_iter().enumerate() {
+            if dp != 0.0 && left[axis] != 0 {
+                // Distance to the first boundary crossed, in units of t.
+                let c = first[axis];
+                let to_boundary = if step[axis] > 0 {
+                    (c + 1) as f64 - p
+                } else {
+                    p - c as f64
+                };
+                t_max[axis] = to_boundary * t_delta[axis];
+            }
+        }
+        Walk {
+            step,
+            t_max,
+            t_delta,
+            left,
+        }
+    }
+}
+
 /// Amanatides–Woo traversal of the cells (unit-sized, in cell coordinates)
 /// the segment `a → b` passes through, from `a`'s cell to `b`'s cell
 /// inclusive, each once.
 pub fn traverse(a: DVec2, b: DVec2, mut visit: impl FnMut([i64; 2])) {
-    let mut cell = [a.x.floor() as i64, a.y.floor() as i64];
-    let end = [b.x.floor() as i64, b.y.floor() as i64];
-    let d = b - a;
-    let step = [
-        if d.x > 0.0 { 1 } else { -1 },
-        if d.y > 0.0 { 1 } else { -1 },
-    ];
-    let t_delta = [1.0 / d.x.abs(), 1.0 / d.y.abs()];
-    let boundary = |p: f64, c: i64, s: i64| {
-        if s > 0 {
-            (c + 1) as f64 - p
-        } else {
-            p - c as f64
-        }
-    };
-    let mut t_max = [
-        if d.x != 0.0 {
-            boundary(a.x, cell[0], step[0]) * t_delta[0]
-        } else {
-            f64::INFINITY
-        },
-        if d.y != 0.0 {
-            boundary(a.y, cell[1], step[1]) * t_delta[1]
-        } else {
-            f64::INFINITY
-        },
-    ];
-    // |Δx| + |Δy| steps, each axis stepping exactly as far as the end cell
-    // (rounding cannot carry the walk past it on one axis).
-    let mut left = [(end[0] - cell[0]).abs(), (end[1] - cell[1]).abs()];
+    let mut cell = cell_of(a);
+    let Walk {
+        step,
+        mut t_max,
+        t_delta,
+        mut left,
+    } = Walk::new(a, b);
     visit(cell);
     while left != [0, 0] {
         let axis = usize::from(!(left[1] == 0 || (left[0] > 0 && t_max[0] < t_max[1])));
