@@ -22,7 +22,7 @@ use slamlab::merge::lift::{
 use slamlab::merge::rigid::{fit_rigid_least_squares, fit_rigid_msac, RigidConfig};
 use slamlab::merge::verdict::{decide_pair, map_agreement, VerdictConfig};
 use slamlab::merge::verify::{verify_pair, VerifyConfig};
-use slamlab::merge::vocabulary::{propose_pairs, similarity, Vocabulary, VocabularyConfig};
+use slamlab::merge::vocabulary::{propose_pairs, similarity, Bag, Vocabulary, VocabularyConfig};
 use slamlab::merge::{Candidate, FrameInfo, MergeStatus};
 use slamlab::rng::Rng;
 use slamlab::scenario::{CameraSpec, Scenario, WallSpec};
@@ -492,6 +492,31 @@ fn features(sim: &Simulation, i: usize) -> Vec<Features> {
         .collect()
 }
 
+/// For each frame of both robots, in order, the keypoints whose bearing
+/// the laser reaches (the ones place recognition uses).
+fn liftable(
+    cam: &PinholeCamera,
+    infos: &[Vec<FrameInfo>; 2],
+    feats: &[Vec<Features>; 2],
+) -> Vec<Vec<usize>> {
+    (0..2)
+        .flat_map(|r| {
+            feats[r]
+                .iter()
+                .zip(&infos[r])
+                .map(|(f, info)| liftable_keypoints(cam, info, f))
+                .collect::<Vec<_>>()
+        })
+        .collect()
+}
+
+/// A vocabulary trained on both robots' frames (`keep`: their liftable
+/// keypoints) and each frame's bag of words.
+fn bags(feats: &[Vec<Features>; 2], keep: &[Vec<usize>]) -> Vec<Bag> {
+    let sets: Vec<&Features> = feats.iter().flatten().collect();
+    Vocabulary::train_with_bags_on(&sets, keep, &VocabularyConfig::default(), 1).1
+}
+
 /// The automatic chain on a finished run: features, place recognition on
 /// the keypoints that lift, verification, verdict.
 fn merge_auto(sim: &Simulation) -> (Vec<Candidate>, slamlab::merge::verdict::PairDecision) {
@@ -504,17 +529,8 @@ fn merge_auto(sim: &Simulation) -> (Vec<Candidate>, slamlab::merge::verdict::Pai
         (80.0..500.0).contains(&mean_kp),
         "keypoints per 320 × 240 frame: {mean_kp}"
     );
-    let sets: Vec<&Features> = feats.iter().flatten().collect();
-    let keep: Vec<Vec<usize>> = (0..2)
-        .flat_map(|r| {
-            feats[r]
-                .iter()
-                .zip(&infos[r])
-                .map(|(f, info)| liftable_keypoints(&cam, info, f))
-                .collect::<Vec<_>>()
-        })
-        .collect();
-    let (_, bags) = Vocabulary::train_with_bags_on(&sets, &keep, &VocabularyConfig::default(), 1);
+    let keep = liftable(&cam, &infos, &feats);
+    let bags = bags(&feats, &keep);
     let n0 = feats[0].len();
     let proposals = propose_pairs(&bags[..n0], &bags[n0..], 3, 300);
     let cands: Vec<Candidate> = proposals
@@ -823,19 +839,10 @@ fn bench_automatic_merge_stages() {
     let feats = [features(&sim, 0), features(&sim, 1)];
     let t_features = now_ms() - t;
     let t = now_ms();
-    let keep: Vec<Vec<usize>> = (0..2)
-        .flat_map(|r| {
-            feats[r]
-                .iter()
-                .zip(&infos[r])
-                .map(|(f, info)| liftable_keypoints(&cam, info, f))
-                .collect::<Vec<_>>()
-        })
-        .collect();
+    let keep = liftable(&cam, &infos, &feats);
     let t_lift = now_ms() - t;
     let t = now_ms();
-    let sets: Vec<&Features> = feats.iter().flatten().collect();
-    let (_, bags) = Vocabulary::train_with_bags_on(&sets, &keep, &VocabularyConfig::default(), 1);
+    let bags = bags(&feats, &keep);
     let t_vocabulary = now_ms() - t;
     let t = now_ms();
     let n0 = feats[0].len();
