@@ -93,6 +93,9 @@ export class MergePanel {
       id: 'merge-map', class: 'map-view', width: String(MAP_W), height: String(MAP_H),
       role: 'img', 'aria-label': 'Merged map',
     });
+    // Robots do not know the world frame, so neither does the merge: say
+    // why the merged map can look turned against the maze view.
+    this.mapNote = el('p', { class: 'hint merge-map-note' });
     this.downloads = el('div', { class: 'merge-downloads' });
     for (const [label, fn] of [
       ['Merged map PNG', () => this.hooks.download('merged.png', this.lab().mergedPng(), 'image/png')],
@@ -112,7 +115,7 @@ export class MergePanel {
       });
       this.downloads.append(b);
     }
-    this.result = el('div', { class: 'merge-result', hidden: '' }, this.verdict, this.distance, this.transforms, this.map, this.downloads);
+    this.result = el('div', { class: 'merge-result', hidden: '' }, this.verdict, this.distance, this.transforms, this.map, this.mapNote, this.downloads);
     this.chart = el('canvas', {
       id: 'merge-methods-chart', class: 'merge-chart', width: String(CHART_W), height: String(CHART_H),
       role: 'img', 'aria-label': 'Transform error of each method: no method has merged this run yet',
@@ -459,6 +462,11 @@ export class MergePanel {
     this.transforms.hidden = !merged;
     this.showDistance(r);
     this.map.hidden = !merged;
+    this.mapNote.hidden = !merged;
+    const first = r.transforms[0]?.robot ?? 'the first robot';
+    this.mapNote.textContent = `Drawn in ${first}\u2019s map frame (its start is the origin, its start heading ` +
+      'points right), not the world\u2019s: robots never learn the world frame, so the map may look turned ' +
+      'against the maze view.';
     this.downloads.querySelectorAll('button').forEach((b, k) => {
       b.hidden = !merged && k < 2;
     });
