@@ -278,10 +278,7 @@ fn nearer_walls_and_robots_occlude_farther_ones() {
 
 #[wasm_bindgen_test(unsupported = test)]
 fn textures_are_deterministic_and_names_look_different() {
-    let key = |n: &str| TextureKey {
-        name: n.into(),
-        back: false,
-    };
+    let key = |n: &str| TextureKey::new(n, false);
     let mean_diff = |a: &[u8], b: &[u8]| {
         a.iter()
             .zip(b)
@@ -317,10 +314,7 @@ fn textures_are_deterministic_and_names_look_different() {
     let mut b3 = TextureBank::new(8, 2.5);
     assert!(mean_diff(&a, &b3.chunk(&key("brick"), 3).gray[0]) > 10.0);
     // The back of a wall differs from its front.
-    let back = TextureKey {
-        name: "brick".into(),
-        back: true,
-    };
+    let back = TextureKey::new("brick", true);
     assert!(mean_diff(&a, &b1.chunk(&back, 3).gray[0]) > 10.0);
     // Plain is featureless.
     let p = b1.chunk(&key("plain"), 0).gray[0].clone();
@@ -334,10 +328,7 @@ fn texture_chunks_join_without_seams() {
     // to the same picture: they differ no more than neighbouring columns
     // inside a chunk do.
     let mut bank = TextureBank::new(3, 2.5);
-    let key = TextureKey {
-        name: "brick".into(),
-        back: false,
-    };
+    let key = TextureKey::new("brick", false);
     let a = bank.chunk(&key, 4).gray[0].clone();
     let b = bank.chunk(&key, 5).gray[0].clone();
     let w = 160usize;
@@ -354,6 +345,43 @@ fn texture_chunks_join_without_seams() {
         seam < 4.0 * inside + 5.0,
         "seam {seam:.1} vs inside {inside:.1}"
     );
+}
+
+/// A short unnamed wall's chunk is painted only as wide as the wall: the
+/// texels it has are the whole chunk's, at every mip level (up to
+/// anti-aliasing at a few shape edges).
+#[wasm_bindgen_test(unsupported = test)]
+fn narrow_chunks_hold_the_whole_chunks_texels() {
+    let mut bank = TextureBank::new(3, 2.5);
+    let whole = TextureKey::new("wall#7", false);
+    let narrow = TextureKey::new("wall#7", false).for_length(0.024);
+    // 0.024 m = 3.84 texels, + 8 of bilinear footprint, to a multiple of 4.
+    assert_eq!(narrow.width, 12);
+    assert_eq!(TextureKey::new("x", true).for_length(0.99).width, 160);
+    assert_eq!(TextureKey::new("x", true).for_length(3.0).width, 160);
+    let a = bank.chunk(&whole, 0);
+    let b = bank.chunk(&narrow, 0);
+    for level in 0..3 {
+        let (wa, wb) = (a.width[level] as usize, b.width[level] as usize);
+        assert_eq!(wb, 12 >> level);
+        assert_eq!(a.height[level], b.height[level]);
+        let (mut differ, mut most, mut sum) = (0, 0, 0.0);
+        for r in 0..a.height[level] as usize {
+            for x in 0..wb {
+                let d = a.gray[level][r * wa + x].abs_diff(b.gray[level][r * wb + x]);
+                differ += usize::from(d != 0);
+                most = most.max(d);
+                sum += f64::from(d);
+            }
+        }
+        // tiny-skia anti-aliases a path cut by the pixmap's edge a little
+        // differently: a few shape edges move by a fraction of a texel.
+        let all = wb * a.height[level] as usize;
+        assert!(
+            sum / (all as f64) < 0.25 && most <= 16,
+            "level {level}: {differ} of {all} texels differ, by {sum} in all, most by {most}"
+        );
+    }
 }
 
 #[wasm_bindgen_test(unsupported = test)]

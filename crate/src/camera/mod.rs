@@ -140,14 +140,13 @@ pub fn robot_boxes(poses: &[Pose2], skip: usize) -> Vec<RobotBox> {
         .collect()
 }
 
-/// The texture a wall face shows.
+/// The texture a wall face shows. A named texture may be shared by walls
+/// of any length, so its chunks are whole; an unnamed wall's texture is its
+/// own, so its chunks are painted only as far as the wall reaches.
 pub fn wall_texture_key(walls: &[WallSpec], i: usize, back: bool) -> TextureKey {
-    TextureKey {
-        name: walls[i]
-            .texture
-            .clone()
-            .unwrap_or_else(|| format!("wall#{i}")),
-        back,
+    match &walls[i].texture {
+        Some(name) => TextureKey::new(name.clone(), back),
+        None => TextureKey::new(format!("wall#{i}"), back).for_length(walls[i].segment().length()),
     }
 }
 

@@ -28,7 +28,7 @@
 use crate::rng::Rng;
 use std::collections::HashMap;
 use std::sync::Arc;
-use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Rect, Stroke, Transform};
+use tiny_skia::{Color, FillRule, Paint, Path, PathBuilder, Pixmap, Rect, Stroke, Transform};
 
 /// Texture resolution (texels per metre).
 pub const TEXELS_PER_M: u32 = 160;
@@ -37,6 +37,37 @@ pub const CHUNK_CACHE_CAP: usize = 600;
 /// Largest picture a user may load (pixels on a side, and in all).
 pub const MAX_IMAGE_SIDE: u32 = 4096;
 pub const MAX_IMAGE_PIXELS: u64 = 16_000_000;
+
+/// Whether a shape with bounds `b`, drawn translated by `t` and padded by
+/// `pad` texels, reaches into `pm` at all. A chunk paints its neighbours'
+/// shapes too, and most of those lie wholly outside it; tiny-skia would
+/// draw nothing for them but only after setting up a blitter, which costs
+/// more than most shapes' pixels. Culled here instead, after the shape's
+/// random draws (its colour is an argument), so no texture changes.
+fn reaches(pm: &Pixmap, b: Rect, t: Transform, pad: f32) -> bool {
+    let (x0, x1) = (b.left() + t.tx - pad, b.right() + t.tx + pad);
+    let (y0, y1) = (b.top() + t.ty - pad, b.bottom() + t.ty + pad);
+    x1 >= 0.0 && y1 >= 0.0 && x0 <= pm.width() as f32 && y0 <= pm.height() as f32
+}
+
+fn fill_path(pm: &mut Pixmap, path: &Path, paint: &Paint, rule: FillRule, t: Transform) {
+    if reaches(pm, path.bounds(), t, 1.0) {
+        pm.fill_path(path, paint, rule, t, None);
+    }
+}
+
+fn fill_rect(pm: &mut Pixmap, rect: Rect, paint: &Paint, t: Transform) {
+    if reaches(pm, rect, t, 1.0) {
+        pm.fill_rect(rect, paint, t, None);
+    }
+}
+
+fn stroke_path(pm: &mut Pixmap, path: &Path, paint: &Paint, stroke: &Stroke, t: Transform) {
+    // Joins and caps reach beyond the path by up to a few widths.
+    if reaches(pm, path.bounds(), t, 4.0 * stroke.width + 1.0) {
+        pm.stroke_path(path, paint, stroke, t, None);
+    }
+}
 
 /// FNV-1a hash of a string.
 pub fn name_hash(s: &str) -> u64 {
@@ -95,6 +126,36 @@ impl Style {
 pub struct TextureKey {
     pub name: String,
     pub back: bool,
+    /// Texels of each chunk actually painted, from its left edge:
+    /// [`TEXELS_PER_M`] for whole chunks. A wall shorter than a chunk that
+    /// alone shows its texture (an unnamed wall) needs only its own length:
+    /// a floor plan traced as thousands of short segments would otherwise
+    /// paint a whole metre of texture for each centimetre of wall. The
+    /// texels painted are the same either way, up to anti-aliasing at a few
+    /// shape edges that the narrower pixmap cuts (`tests/camera.rs`).
+    pub width: u32,
+}
+
+impl TextureKey {
+    /// A texture's key, with whole chunks.
+    pub fn new(name: impl Into<String>, back: bool) -> TextureKey {
+        TextureKey {
+            name: name.into(),
+            back,
+            width: TEXELS_PER_M,
+        }
+    }
+
+    /// Chunks painted only as wide as a wall of `length_m` needs, with room
+    /// for the renderer's bilinear footprint at the coarsest mip level, and
+    /// a multiple of 4 so the mips halve evenly.
+    pub fn for_length(mut self, length_m: f64) -> TextureKey {
+        let needed = (length_m.max(0.0) * TEXELS_PER_M as f64).ceil() + 8.0;
+        if needed < TEXELS_PER_M as f64 {
+            self.width = ((needed as u32).div_ceil(4) * 4).min(TEXELS_PER_M);
+        }
+        self
+    }
 }
 
 /// One rasterised chunk: grayscale at three mip levels, and colour at full
@@ -159,9 +220,12 @@ impl ImageTexture {
 pub struct TextureBank {
     seed: u64,
     wall_height_m: f64,
-    chunks: HashMap<(TextureKey, i64), Arc<Chunk>>,
-    /// Insertion order, for evicting the oldest chunk at the cap.
-    order: std::collections::VecDeque<(TextureKey, i64)>,
+    /// Each chunk with the tick of its last use: at the cap the least
+    /// recently used goes. (Evicting the oldest instead thrashes when one
+    /// frame needs hundreds of chunks, as a wall traced as many short
+    /// segments does: each frame would repaint what the last one evicted.)
+    chunks: HashMap<(TextureKey, i64), (Arc<Chunk>, u64)>,
+    tick: u64,
     images: HashMap<String, ImageTexture>,
 }
 
@@ -192,7 +256,7 @@ impl Clone for TextureBank {
             seed: self.seed,
             wall_height_m: self.wall_height_m,
             chunks: HashMap::new(),
-            order: std::collections::VecDeque::new(),
+            tick: 0,
             images: self.images.clone(),
         }
     }
@@ -214,7 +278,7 @@ impl TextureBank {
             seed,
             wall_height_m,
             chunks: HashMap::new(),
-            order: std::collections::VecDeque::new(),
+            tick: 0,
             images: HashMap::new(),
         }
     }
@@ -240,8 +304,6 @@ impl TextureBank {
         self.images.insert(name.to_string(), image);
         self.chunks
             .retain(|(k, _), _| k.name != format!("image:{name}"));
-        self.order
-            .retain(|(k, _)| k.name != format!("image:{name}"));
     }
 
     pub fn has_image(&self, name: &str) -> bool {
@@ -257,27 +319,36 @@ impl TextureBank {
     /// renderer can hold on to the chunk it is drawing from column after
     /// column without looking it up again.
     pub fn chunk(&mut self, key: &TextureKey, k: i64) -> Arc<Chunk> {
+        self.tick += 1;
         let id = (key.clone(), k);
-        if let Some(c) = self.chunks.get(&id) {
+        if let Some((c, used)) = self.chunks.get_mut(&id) {
+            *used = self.tick;
             return c.clone();
         }
         if self.chunks.len() >= CHUNK_CACHE_CAP {
-            if let Some(old) = self.order.pop_front() {
+            // A scan of the cap's entries, against painting a chunk (~1 ms).
+            let oldest = self
+                .chunks
+                .iter()
+                .min_by_key(|(_, (_, used))| *used)
+                .map(|(id, _)| id.clone());
+            if let Some(old) = oldest {
                 self.chunks.remove(&old);
             }
         }
         let chunk = Arc::new(self.paint_chunk(key, k));
-        self.order.push_back(id.clone());
-        self.chunks.insert(id, chunk.clone());
+        self.chunks.insert(id, (chunk.clone(), self.tick));
         chunk
     }
 
     fn paint_chunk(&self, key: &TextureKey, k: i64) -> Chunk {
+        // Shapes are laid out on whole chunks; the pixmap may be narrower.
         let w = TEXELS_PER_M;
         let h = ((self.wall_height_m * TEXELS_PER_M as f64).round() as u32).max(4);
-        let mut pm = match Pixmap::new(w, h) {
+        let painted = key.width.clamp(4, TEXELS_PER_M);
+        let mut pm = match Pixmap::new(painted, h) {
             Some(p) => p,
-            None => return Self::flat_chunk(w, h, 128),
+            None => return Self::flat_chunk(painted, h, 128),
         };
         if let Some(img) = key
             .name
@@ -388,7 +459,7 @@ impl TextureBank {
         for y in 0..h {
             let sy = ((y as f64 + 0.5) * img.height as f64 / h as f64) as u32;
             for x in 0..w {
-                let u = (k as f64 * w as f64 + x as f64 + 0.5).rem_euclid(img_w_texels);
+                let u = (k as f64 * TEXELS_PER_M as f64 + x as f64 + 0.5).rem_euclid(img_w_texels);
                 let sx = ((u / img_w_texels) * img.width as f64) as u32;
                 let s = ((sy.min(img.height - 1) * img.width + sx.min(img.width - 1)) * 4) as usize;
                 let d = ((y * w + x) * 4) as usize;
@@ -433,7 +504,7 @@ impl TextureBank {
                 );
             }
             if let Some(p) = pb.finish() {
-                pm.fill_path(&p, &rgb(c, a), FillRule::Winding, t, None);
+                fill_path(pm, &p, &rgb(c, a), FillRule::Winding, t);
             }
         }
     }
@@ -503,7 +574,7 @@ impl TextureBank {
                         }
                         let c = colour(rng, hue, 25.0);
                         if let Some(rc) = rect(x + 1.5, r as f32 * bh + 1.5, bw - 3.0, bh - 3.0) {
-                            pm.fill_rect(rc, &rgb(c, 255), t, None);
+                            fill_rect(pm, rc, &rgb(c, 255), t);
                         }
                         j += 1;
                     }
@@ -519,7 +590,7 @@ impl TextureBank {
                         blob(rng, cx, cy, radius)
                     } {
                         let c = colour(rng, hue + 90.0, 120.0);
-                        pm.fill_path(&p, &rgb(c, 200), FillRule::Winding, t, None);
+                        fill_path(pm, &p, &rgb(c, 200), FillRule::Winding, t);
                     }
                 }
                 if rng.uniform() < 0.5 {
@@ -578,12 +649,12 @@ impl TextureBank {
                         }
                     }
                     if let Some(p) = pb.finish() {
-                        pm.fill_path(&p, &rgb(c, 255), FillRule::Winding, t, None);
+                        fill_path(pm, &p, &rgb(c, 255), FillRule::Winding, t);
                         let inner = colour(rng, hue + 180.0, 60.0);
                         let mut pb2 = PathBuilder::new();
                         disc(&mut pb2, cx, cy, r * rng.range(0.2, 0.45) as f32);
                         if let Some(p2) = pb2.finish() {
-                            pm.fill_path(&p2, &rgb(inner, 255), FillRule::Winding, t, None);
+                            fill_path(pm, &p2, &rgb(inner, 255), FillRule::Winding, t);
                         }
                     }
                 }
@@ -602,7 +673,7 @@ impl TextureBank {
                         let radius = rng.range(5.0, 40.0) as f32;
                         blob(rng, cx, cy, radius)
                     } {
-                        pm.fill_path(&p, &rgb(c, 230), FillRule::Winding, t, None);
+                        fill_path(pm, &p, &rgb(c, 230), FillRule::Winding, t);
                     }
                 }
                 for _ in 0..rng.range(1.0, 3.0) as usize {
@@ -622,12 +693,12 @@ impl TextureBank {
                             width: rng.range(2.0, 7.0) as f32,
                             ..Stroke::default()
                         };
-                        pm.stroke_path(
+                        stroke_path(
+                            pm,
                             &p,
                             &rgb(colour(rng, hue + 180.0, 60.0), 255),
                             &stroke,
                             t,
-                            None,
                         );
                     }
                 }
@@ -643,7 +714,7 @@ impl TextureBank {
                     for cy in 0..(h / s) as i32 + 1 {
                         let c = colour(rng, hue, 60.0);
                         if let Some(rc) = rect(tx + 1.0, cy as f32 * s + 1.0, s - 2.0, s - 2.0) {
-                            pm.fill_rect(rc, &rgb(c, 255), t, None);
+                            fill_rect(pm, rc, &rgb(c, 255), t);
                         }
                         if rng.uniform() < 0.35 {
                             let mut pb = PathBuilder::new();
@@ -654,12 +725,12 @@ impl TextureBank {
                                 s * rng.range(0.15, 0.4) as f32,
                             );
                             if let Some(p) = pb.finish() {
-                                pm.fill_path(
+                                fill_path(
+                                    pm,
                                     &p,
                                     &rgb(colour(rng, hue + 180.0, 90.0), 255),
                                     FillRule::Winding,
                                     t,
-                                    None,
                                 );
                             }
                         }
@@ -673,7 +744,7 @@ impl TextureBank {
                 while x < w {
                     let c = colour(rng, hue, 15.0);
                     if let Some(rc) = rect(x + 1.0, 0.0, plank - 2.0, h) {
-                        pm.fill_rect(rc, &rgb(c, 255), t, None);
+                        fill_rect(pm, rc, &rgb(c, 255), t);
                     }
                     for _ in 0..rng.range(1.0, 4.0) as usize {
                         let (kx, ky) = (
@@ -684,12 +755,12 @@ impl TextureBank {
                             let radius = rng.range(3.0, 9.0) as f32;
                             blob(rng, kx, ky, radius)
                         } {
-                            pm.fill_path(
+                            fill_path(
+                                pm,
                                 &p,
                                 &rgb(colour(rng, hue + 20.0, 20.0), 255),
                                 FillRule::Winding,
                                 t,
-                                None,
                             );
                         }
                     }
@@ -706,12 +777,12 @@ impl TextureBank {
                         let radius = rng.range(4.0, 22.0) as f32;
                         blob(rng, cx, cy, radius)
                     } {
-                        pm.fill_path(
+                        fill_path(
+                            pm,
                             &p,
                             &rgb(colour(rng, hue, 50.0), 255),
                             FillRule::Winding,
                             t,
-                            None,
                         );
                     }
                 }
@@ -728,12 +799,12 @@ impl TextureBank {
                         width: 2.5,
                         ..Stroke::default()
                     };
-                    pm.stroke_path(
+                    stroke_path(
+                        pm,
                         &p,
                         &rgb(colour(rng, hue + 180.0, 40.0), 255),
                         &stroke,
                         t,
-                        None,
                     );
                 }
             }
@@ -756,10 +827,10 @@ impl TextureBank {
         let frame = colour(rng, hue, 30.0);
         let paper = colour(rng, hue + 180.0, 30.0);
         if let Some(r) = Rect::from_xywh(x, y, w, h) {
-            pm.fill_rect(r, &rgb(frame, 255), t, None);
+            fill_rect(pm, r, &rgb(frame, 255), t);
         }
         if let Some(r) = Rect::from_xywh(x + 3.0, y + 3.0, w - 6.0, h - 6.0) {
-            pm.fill_rect(r, &rgb(paper, 255), t, None);
+            fill_rect(pm, r, &rgb(paper, 255), t);
         }
         for _ in 0..rng.range(2.0, 5.0) as usize {
             let mut pb = PathBuilder::new();
@@ -770,12 +841,12 @@ impl TextureBank {
                 r.max(1.0),
             );
             if let Some(p) = pb.finish() {
-                pm.fill_path(
+                fill_path(
+                    pm,
                     &p,
                     &rgb(colour(rng, hue + 90.0, 150.0), 255),
                     FillRule::Winding,
                     t,
-                    None,
                 );
             }
         }
@@ -792,7 +863,7 @@ impl TextureBank {
                     word.min(x + 0.9 * w - lx).max(1.0),
                     (0.035 * h).max(1.5),
                 ) {
-                    pm.fill_rect(r, &rgb(ink, 255), t, None);
+                    fill_rect(pm, r, &rgb(ink, 255), t);
                 }
                 lx += word + 0.04 * w;
             }
