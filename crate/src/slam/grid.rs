@@ -435,14 +435,16 @@ impl OccupancyGrid {
         };
         // Both ends inside the (rectangular) grid, so is every cell between:
         // the same walk as `traverse`, stepping the cells' index directly.
+        // Indices are `usize` (32-bit in wasm, where 64-bit index arithmetic
+        // and a conversion per cell cost a fifth of this loop).
         let walk = Walk::new(a, b);
-        let w = self.width as i64;
-        let mut index = start.1 as i64 * w + start.0 as i64;
-        let index_step = [walk.step[0], walk.step[1] * w];
+        let w = self.width as isize;
+        let mut index = start.1 * self.width + start.0;
+        let (sx, sy) = (walk.step[0] as isize, walk.step[1] as isize * w);
         let (min, max) = (self.config.min as i16, self.config.max);
         let (cells, surface) = (&mut self.cells, &mut self.surface);
-        let mut lower = |index: i64| {
-            let Some(v) = usize::try_from(index).ok().and_then(|i| cells.get_mut(i)) else {
+        let mut lower = |index: usize| {
+            let Some(v) = cells.get_mut(index) else {
                 return;
             };
             let was = *v;
@@ -452,23 +454,23 @@ impl OccupancyGrid {
             }
             *v = (was as i16 + miss as i16).max(min) as i8;
             if was > 0 && *v <= 0 {
-                if let Some(s) = surface.get_mut(index as usize) {
+                if let Some(s) = surface.get_mut(index) {
                     s.hits = 0;
                 }
             }
         };
         let ([mut tx, mut ty], [dtx, dty]) = (walk.t_max, walk.t_delta);
-        let ([mut nx, mut ny], [sx, sy]) = (walk.left, index_step);
+        let [mut nx, mut ny] = walk.left.map(|n| n as usize);
         for _ in 0..nx + ny {
             lower(index);
             // Plain scalars, not arrays indexed by the axis: this loop is
             // the mapper's hottest.
             if tx < ty {
-                index += sx;
+                index = index.wrapping_add_signed(sx);
                 nx -= 1;
                 tx = if nx == 0 { f64::INFINITY } else { tx + dtx };
             } else {
-                index += sy;
+                index = index.wrapping_add_signed(sy);
                 ny -= 1;
                 ty = if ny == 0 { f64::INFINITY } else { ty + dty };
             }
