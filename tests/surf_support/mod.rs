@@ -171,6 +171,88 @@ pub fn correct(f1: &Features, f2: &Features, m: &Match, hm: &Homography, tol_px:
         .is_some_and(|p| (p[0] - b.x as f64).hypot(p[1] - b.y as f64) <= tol_px)
 }
 
+/// The region-overlap criterion of the standard descriptor evaluation
+/// (Mikolajczyk and Schmid, PAMI 2005, §4.1; Mikolajczyk et al., IJCV 2005,
+/// the protocol Bay et al. 2008 evaluate SURF with): a match is correct
+/// when the overlap error `1 − |A ∩ B| / |A ∪ B|` of the two keypoints'
+/// regions, compared in image 2, is below `max_error` (0.5 there). Region
+/// A is image 1's circle of radius proportional to its scale, carried into
+/// image 2 by the homography's local affine map at its centre (an
+/// ellipse); B is image 2's circle. As in that protocol, the sizes (not the
+/// positions) are normalised so that A's equivalent radius is 30 px: the
+/// criterion then allows a fixed fraction of a 30 px region in position
+/// (about 12 px for equal scales) and about 1.4× in scale, at every scale.
+/// The overlap is integrated on a 120 × 120 grid over the two regions.
+pub fn overlap_correct(
+    f1: &Features,
+    f2: &Features,
+    m: &Match,
+    hm: &Homography,
+    max_error: f64,
+) -> bool {
+    let (a, b) = (&f1.keypoints[m.query], &f2.keypoints[m.train]);
+    let pa = [a.x as f64, a.y as f64];
+    let (Some(ca), Some(px), Some(py)) = (
+        hm.apply(pa),
+        hm.apply([pa[0] + 1.0, pa[1]]),
+        hm.apply([pa[0], pa[1] + 1.0]),
+    ) else {
+        return false;
+    };
+    // Local affine map J (columns: images of the unit steps).
+    let j = [
+        [px[0] - ca[0], py[0] - ca[0]],
+        [px[1] - ca[1], py[1] - ca[1]],
+    ];
+    let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+    if det.abs() < 1e-12 {
+        return false;
+    }
+    // A = { ca + J u : |u| ≤ ra }, equivalent radius ra·sqrt|det J| → 30.
+    let ra_img2 = a.scale as f64 * det.abs().sqrt();
+    let f = 30.0 / ra_img2;
+    let ra = a.scale as f64 * f;
+    let rb = b.scale as f64 * f;
+    let cb = [b.x as f64, b.y as f64];
+    let inv = [
+        [j[1][1] / det, -j[0][1] / det],
+        [-j[1][0] / det, j[0][0] / det],
+    ];
+    let in_a = |p: [f64; 2]| {
+        let d = [p[0] - ca[0], p[1] - ca[1]];
+        let u = [
+            inv[0][0] * d[0] + inv[0][1] * d[1],
+            inv[1][0] * d[0] + inv[1][1] * d[1],
+        ];
+        u[0] * u[0] + u[1] * u[1] <= ra * ra
+    };
+    let in_b = |p: [f64; 2]| (p[0] - cb[0]).powi(2) + (p[1] - cb[1]).powi(2) <= rb * rb;
+    // Bounding box of both: A's extent along each axis is ra·|row of J|.
+    let ex = [ra * j[0][0].hypot(j[0][1]), ra * j[1][0].hypot(j[1][1])];
+    let lo = [
+        (ca[0] - ex[0]).min(cb[0] - rb),
+        (ca[1] - ex[1]).min(cb[1] - rb),
+    ];
+    let hi = [
+        (ca[0] + ex[0]).max(cb[0] + rb),
+        (ca[1] + ex[1]).max(cb[1] + rb),
+    ];
+    const N: usize = 120;
+    let (mut both, mut either) = (0usize, 0usize);
+    for iy in 0..N {
+        for ix in 0..N {
+            let p = [
+                lo[0] + (ix as f64 + 0.5) * (hi[0] - lo[0]) / N as f64,
+                lo[1] + (iy as f64 + 0.5) * (hi[1] - lo[1]) / N as f64,
+            ];
+            let (ia, ib) = (in_a(p), in_b(p));
+            both += usize::from(ia && ib);
+            either += usize::from(ia || ib);
+        }
+    }
+    either > 0 && 1.0 - (both as f64) / (either as f64) < max_error
+}
+
 /// Largest distance between the images of image 1's corners under two homographies.
 pub fn corner_error(a: &Homography, b: &Homography, w: usize, h: usize) -> f64 {
     let (w, h) = (w as f64, h as f64);
@@ -222,7 +304,7 @@ pub fn noise_image(w: usize, h: usize, seed: u64) -> GrayImage {
 }
 
 /// Table header matching [`Outcome::row`].
-pub const HEADER: &str = "| view | keypoints | repeatability | matches | precision@3px | precision@σ | inliers | inlier precision | overlap error px | corner error px |";
+pub const HEADER: &str = "| view | keypoints | repeatability | matches | precision@3px | precision@σ | precision (overlap) | inliers | inlier precision | overlap error px | corner error px |";
 
 /// Every quality figure of one pair of feature sets (see `surf_quality`'s
 /// module doc for the definitions).
@@ -232,6 +314,8 @@ pub struct Outcome {
     pub matches: usize,
     pub precision_3px: f64,
     pub precision_scale: f64,
+    /// Share of matches correct by [`overlap_correct`] (error < 50 %).
+    pub precision_overlap: f64,
     pub inliers: usize,
     pub inlier_precision: f64,
     pub overlap_error_px: f64,
@@ -242,13 +326,14 @@ impl Outcome {
     /// One Markdown table row, as in BENCHMARKS.md.
     pub fn row(&self, name: &str) -> String {
         format!(
-            "| {name} | {} / {} | {:.3} | {} | {:.3} | {:.3} | {} | {:.3} | {:.2} | {:.2} |",
+            "| {name} | {} / {} | {:.3} | {} | {:.3} | {:.3} | {:.3} | {} | {:.3} | {:.2} | {:.2} |",
             self.keypoints.0,
             self.keypoints.1,
             self.repeatability,
             self.matches,
             self.precision_3px,
             self.precision_scale,
+            self.precision_overlap,
             self.inliers,
             self.inlier_precision,
             self.overlap_error_px,
@@ -294,6 +379,11 @@ pub fn score(f1: &Features, f2: &Features, hm: &Homography, size: (usize, usize)
         })
         .count();
     let precision_scale = scale_ok as f64 / matches.len().max(1) as f64;
+    let overlap_ok = matches
+        .iter()
+        .filter(|m| overlap_correct(f1, f2, m, hm, 0.5))
+        .count();
+    let precision_overlap = overlap_ok as f64 / matches.len().max(1) as f64;
     let (p1, p2) = pairs(f1, f2, &matches);
     let fit = fit_homography(&p1, &p2, &MsacConfig::default());
     let (inliers, inlier_precision, overlap_error_px, corner_error_px) = match &fit {
@@ -318,6 +408,7 @@ pub fn score(f1: &Features, f2: &Features, hm: &Homography, size: (usize, usize)
         matches: matches.len(),
         precision_3px,
         precision_scale,
+        precision_overlap,
         inliers,
         inlier_precision,
         overlap_error_px,
