@@ -7,7 +7,7 @@
 use glam::DVec2;
 use slamlab::camera::texture::TextureBank;
 use slamlab::camera::{render, PinholeCamera};
-use slamlab::geom::{wrap_angle, Pose2};
+use slamlab::geom::{wrap_angle, Pose2, Segment};
 use slamlab::merge::align::{refine_alignment, AlignConfig};
 use slamlab::merge::consistency::{
     independent_places, max_consistent_places, max_consistent_set, pairwise_consistent,
@@ -19,6 +19,7 @@ use slamlab::merge::lift::{
     column_bearing_rad, laser_range_at, lift_keypoint, lift_keypoint_3d, liftable_features,
     liftable_keypoints,
 };
+use slamlab::merge::mapsearch::{dominant_rotation, search_maps, MapSearchConfig};
 use slamlab::merge::rigid::{fit_rigid_least_squares, fit_rigid_msac, RigidConfig};
 use slamlab::merge::verdict::{decide_pair, map_agreement, VerdictConfig};
 use slamlab::merge::verify::{verify_pair, VerifyConfig};
@@ -661,6 +662,154 @@ fn grid_alignment_recovers_a_perturbed_transform_and_the_verdict_refuses_wrong_o
     assert!(d.reason.starts_with("too little evidence"), "{}", d.reason);
     let d = decide_pair(&[], map_a, map_b, &cfg);
     assert!(d.reason.starts_with("no common place seen"), "{}", d.reason);
+}
+
+// ----- the map search -------------------------------------------------------
+
+/// A building of axis-aligned walls (metres): an outline `w` × `h` and the
+/// interior walls given, as segments.
+fn building(w: f64, h: f64, inner: &[[f64; 4]]) -> Vec<Segment> {
+    let c = |x: f64, y: f64| DVec2::new(x, y);
+    let mut walls = vec![
+        Segment::new(c(0.0, 0.0), c(w, 0.0)),
+        Segment::new(c(w, 0.0), c(w, h)),
+        Segment::new(c(w, h), c(0.0, h)),
+        Segment::new(c(0.0, h), c(0.0, 0.0)),
+    ];
+    walls.extend(
+        inner
+            .iter()
+            .map(|s| Segment::new(c(s[0], s[1]), c(s[2], s[3]))),
+    );
+    walls
+}
+
+/// The map a robot whose map frame sits at `frame` (in the building's
+/// coordinates) makes from 360-beam scans (8 m range) at `stops`, three
+/// scans each, every beam ray-cast against `walls`.
+fn scanned_map(walls: &[Segment], frame: &Pose2, stops: &[DVec2]) -> OccupancyGrid {
+    let mut g = OccupancyGrid::new(GridConfig::default());
+    let local: Vec<DVec2> = stops
+        .iter()
+        .map(|&p| frame.inverse_transform_point(p))
+        .collect();
+    let lo = local
+        .iter()
+        .fold(DVec2::splat(f64::INFINITY), |m, &p| m.min(p));
+    let hi = local
+        .iter()
+        .fold(DVec2::splat(f64::NEG_INFINITY), |m, &p| m.max(p));
+    assert!(g.ensure_contains(lo - 9.0, hi + 9.0));
+    for &stop in stops {
+        for k in 0..360 {
+            let dir = DVec2::from_angle((k as f64).to_radians());
+            let hit = walls
+                .iter()
+                .filter_map(|s| s.ray_hit(stop, dir))
+                .fold(f64::INFINITY, f64::min);
+            let (range, is_hit) = if hit <= 8.0 {
+                (hit, true)
+            } else {
+                (8.0, false)
+            };
+            let from = frame.inverse_transform_point(stop);
+            let to = frame.inverse_transform_point(stop + dir * range);
+            for _ in 0..3 {
+                g.integrate_beam(from, to, is_hit);
+            }
+        }
+    }
+    g
+}
+
+/// Points every metre in `x0..x1` × `y0..y1` (half-metre offsets, so none
+/// lies on a wall of the buildings below).
+fn stops(x0: f64, x1: f64, y0: f64, y1: f64) -> Vec<DVec2> {
+    let mut out = Vec::new();
+    let mut y = y0 + 0.5;
+    while y < y1 {
+        let mut x = x0 + 0.5;
+        while x < x1 {
+            out.push(DVec2::new(x, y));
+            x += 1.0;
+        }
+        y += 1.0;
+    }
+    out
+}
+
+const HOUSE: [[f64; 4]; 6] = [
+    [4.0, 0.0, 4.0, 7.0],
+    [8.0, 4.0, 8.0, 12.0],
+    [12.0, 0.0, 12.0, 5.0],
+    [10.0, 5.0, 14.0, 5.0],
+    [12.0, 8.0, 16.0, 8.0],
+    [4.0, 9.0, 8.0, 9.0],
+];
+
+#[wasm_bindgen_test(unsupported = test)]
+fn map_search_finds_a_turned_and_shifted_map_within_0_1_m_and_1_degree() {
+    let walls = building(16.0, 12.0, &HOUSE);
+    // A's frame is turned 17° in the building, B's 110° the other way and
+    // shifted; each robot tours two thirds of the floor.
+    let frame_a = Pose2::new(1.3, 0.7, 17f64.to_radians());
+    let frame_b = Pose2::new(9.2, 4.1, -110f64.to_radians());
+    let a = scanned_map(&walls, &frame_a, &stops(0.0, 11.0, 0.0, 12.0));
+    let b = scanned_map(&walls, &frame_b, &stops(5.0, 16.0, 0.0, 12.0));
+    let truth = frame_a.inverse().compose(&frame_b);
+    // The wall directions give the rotation modulo 90°.
+    let delta = dominant_rotation(&a, &b).expect("walls have directions");
+    let off = wrap_angle(4.0 * (delta - truth.theta)) / 4.0;
+    assert!(off.abs() < 0.5f64.to_radians(), "rotation off by {off}");
+    let found = search_maps(
+        &a,
+        &b,
+        &MapSearchConfig::default(),
+        &VerdictConfig::default(),
+    );
+    assert_eq!(found.status, MergeStatus::Merged, "{}", found.reason);
+    assert!(
+        found.reason.starts_with("maps alone agree"),
+        "{}",
+        found.reason
+    );
+    let pose = found.pose.expect("pose");
+    let (m, deg) = pose_error(&pose, &truth);
+    assert!(m < 0.1 && deg < 1.0, "off by {m:.3} m, {deg:.2}°");
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn map_search_refuses_two_different_buildings_and_a_symmetric_one() {
+    let house = building(16.0, 12.0, &HOUSE);
+    let other = building(
+        14.0,
+        10.0,
+        &[
+            [3.0, 3.0, 3.0, 10.0],
+            [6.0, 0.0, 6.0, 6.0],
+            [6.0, 6.0, 10.0, 6.0],
+            [10.0, 3.0, 14.0, 3.0],
+        ],
+    );
+    let frame = Pose2::new(0.0, 0.0, 0.0);
+    let a = scanned_map(&house, &frame, &stops(0.0, 16.0, 0.0, 12.0));
+    let b = scanned_map(&other, &frame, &stops(0.0, 14.0, 0.0, 10.0));
+    let cfg = MapSearchConfig::default();
+    let found = search_maps(&a, &b, &cfg, &VerdictConfig::default());
+    assert_eq!(found.status, MergeStatus::NoMerge, "{}", found.reason);
+    assert!(found.pose.is_none());
+    // An empty hall is symmetric: turned by 180° it lies on itself as
+    // well as it does unturned, so the maps alone cannot choose.
+    let hall = building(12.0, 8.0, &[]);
+    let a = scanned_map(&hall, &frame, &stops(0.0, 12.0, 0.0, 8.0));
+    let b = scanned_map(
+        &hall,
+        &Pose2::new(2.0, 1.0, 0.3),
+        &stops(0.0, 12.0, 0.0, 8.0),
+    );
+    let found = search_maps(&a, &b, &cfg, &VerdictConfig::default());
+    assert_eq!(found.status, MergeStatus::NoMerge, "{}", found.reason);
+    assert!(found.reason.contains("ambiguous"), "{}", found.reason);
 }
 
 // ----- fusion and the spanning tree -----------------------------------------

@@ -5,6 +5,7 @@
 //!
 //! ```text
 //! cargo run --release -p slamlab --example bench_merge -- [--runs 20] [--first-seed 1] [--others 5] [--multi 5] [--duration 300] [--methods auto,thesis,map-only] [--verbose]
+//! cargo run --release -p slamlab --example bench_merge -- --dump-search   # the map search alone, every hypothesis against the truth
 //! ```
 //!
 //! `--multi N` adds N mazes with three robots each, scored robot by robot:
@@ -115,6 +116,10 @@ fn main() {
     let first_seed: u64 = arg(&args, "--first-seed")
         .and_then(|s| s.parse().ok())
         .unwrap_or(1);
+    let dump_search = args.iter().any(|a| a == "--dump-search");
+    // `--no-map-search`: the automatic method on vision alone (as before
+    // the map search existed).
+    let no_map_search = args.iter().any(|a| a == "--no-map-search");
     let mut cases: Vec<(String, String)> = Vec::new();
     for seed in first_seed..first_seed + runs {
         let spec = MazeSpec {
@@ -124,7 +129,12 @@ fn main() {
         };
         cases.push((format!("maze-{seed}"), random_maze(&spec)));
     }
-    for seed in 1..=others {
+    // `--first-other S`: the no-overlap and repeated-texture cases use seeds
+    // S..S+others (default 1: disjoint-101…, repeated-201…).
+    let first_other: u64 = arg(&args, "--first-other")
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1);
+    for seed in first_other..first_other + others {
         let spec = MazeSpec {
             seed: 100 + seed,
             duration_s: duration,
@@ -174,6 +184,12 @@ fn main() {
         );
         let kind = name.split('-').next().unwrap_or("maze");
         let has_common = kind != "disjoint" && common >= COMMON_CELLS;
+        if dump_search {
+            // `--dump-search`: the map-only search on robots 1 and 2 alone,
+            // every hypothesis scored against the truth (an experiment).
+            dump_map_search(name, common, &sim, &truth);
+            continue;
+        }
         for &method in &methods {
             let t0 = Instant::now();
             let mut cfg = MergeConfig::new(method, scenario.seed);
@@ -194,6 +210,9 @@ fn main() {
             }
             if let Some(n) = max_pairs {
                 cfg.max_pairs = n;
+            }
+            if no_map_search {
+                cfg.map_search = None;
             }
             let mut job = MergeJob::new(&sim, cfg).expect("job");
             let mut stage_ms: Vec<(&'static str, f64)> = Vec::new();
@@ -373,4 +392,49 @@ fn score_robots(
         method.name(),
         parts.join(", ")
     );
+}
+
+fn dump_map_search(name: &str, common: usize, sim: &Simulation, truth: &Pose2) {
+    use slamlab::merge::mapsearch::{search_maps, MapSearchConfig};
+    use slamlab::merge::verdict::VerdictConfig;
+    let a = sim.robots[0].mapping.map(MapperKind::Slam);
+    let b = sim.robots[1].mapping.map(MapperKind::Slam);
+    let t = Instant::now();
+    let s = search_maps(a, b, &MapSearchConfig::default(), &VerdictConfig::default());
+    let ms = t.elapsed().as_secs_f64() * 1e3;
+    let err = |p: &Pose2| {
+        (
+            (p.position() - truth.position()).length(),
+            wrap_angle(p.theta - truth.theta).to_degrees().abs(),
+        )
+    };
+    let verdict_err = s.pose.as_ref().map(err);
+    println!(
+        "{name:<15} common {common:>5} {:?} {ms:.0} ms rot {:.2}° (truth {:.2}°) err {:?} :: {}",
+        s.status,
+        s.rotation_rad.unwrap_or(f64::NAN).to_degrees(),
+        truth.theta.to_degrees(),
+        verdict_err,
+        s.reason
+    );
+    for (i, h) in s.hypotheses.iter().enumerate() {
+        let p = h.pose.unwrap_or(h.coarse);
+        let (m, d) = err(&p);
+        let (cm, cd) = err(&h.coarse);
+        let ag = h.agreement.unwrap_or_default();
+        println!(
+            "   {}{} #{i:<2} coarse {:>6} ({cm:.2} m {cd:.1}°) -> {m:.2} m {d:.1}°  agree {:>5} min {:>5} contra {:>4} run {:>4} weak {:>6.0} free {:>6} net {:>7.0}  {}",
+            if Some(i) == s.winner { "W" } else { " " },
+            if Some(i) == s.runner_up { "R" } else { " " },
+            h.coarse_score,
+            ag.occupied_agree,
+            ag.min_direction_agree,
+            ag.occupied_contradict,
+            ag.largest_contradiction,
+            ag.weak_constraint,
+            ag.free_agree,
+            h.net,
+            h.failure.clone().unwrap_or_else(|| "PASS".into())
+        );
+    }
 }

@@ -21,7 +21,9 @@
 //!    table. One unit of work per pair.
 //! 5. **Decision.** Per pair of robots: the thesis's distance computation
 //!    (§6.2.4, [`super::thesis`]), the automatic verdict (consistency, grid
-//!    alignment and map agreement, [`super::verdict`]), or the baseline's
+//!    alignment and map agreement, [`super::verdict`]; when vision finds no
+//!    transform the maps confirm, a search of the maps alone,
+//!    [`super::mapsearch`], judged as strictly), or the baseline's
 //!    grid-image fit ([`super::baseline`]). The pairwise results are joined
 //!    along the most confident spanning tree ([`super::graph`]).
 //! 6. **Fusion.** The joined maps are fused into one grid in the first
@@ -33,6 +35,7 @@
 use super::baseline::{map_only_merge, BaselineConfig};
 use super::fuse::fuse;
 use super::graph::{spanning_tree, PairEdge};
+use super::mapsearch::{search_maps, MapSearchConfig};
 use super::selection::{select_frames, SelectionConfig};
 use super::thesis::{thesis_merge, DistanceSolution, PairMatch};
 use super::verdict::{decide_pair_after_search, SearchSummary, VerdictConfig};
@@ -71,6 +74,9 @@ pub struct MergeConfig {
     /// Automatic method: at most this many pairs verified per robot pair.
     pub max_pairs: usize,
     pub verdict: VerdictConfig,
+    /// Automatic method: when vision finds no transform the maps confirm,
+    /// search the maps alone ([`super::mapsearch`]); `None` turns that off.
+    pub map_search: Option<MapSearchConfig>,
     pub baseline: BaselineConfig,
     /// Which map each robot contributes (SLAM by default).
     pub mapper: MapperKind,
@@ -98,6 +104,7 @@ impl MergeConfig {
             proposals_per_frame: 3,
             max_pairs: 600,
             verdict: VerdictConfig::default(),
+            map_search: Some(MapSearchConfig::default()),
             baseline: BaselineConfig::default(),
             mapper: MapperKind::Slam,
             seed,
@@ -630,13 +637,32 @@ impl MergeJob {
                             .unwrap_or(0),
                         min_inliers: self.config.verify.min_inliers,
                     };
-                    let d = decide_pair_after_search(
+                    let mut d = decide_pair_after_search(
                         &cands,
                         &summary,
                         map_a,
                         map_b,
                         &self.config.verdict,
                     );
+                    // Vision found nothing the maps confirm (and was not
+                    // torn between two transforms): ask the maps alone.
+                    if let Some(ms) = self
+                        .config
+                        .map_search
+                        .as_ref()
+                        .filter(|_| d.status != MergeStatus::Merged && !d.ambiguous)
+                    {
+                        let m = search_maps(map_a, map_b, ms, &self.config.verdict);
+                        if m.status == MergeStatus::Merged {
+                            d.status = MergeStatus::Merged;
+                            d.pose = m.pose;
+                            d.confidence = m.confidence;
+                            d.support.clear();
+                            d.reason = format!("merged: {} (vision: {})", m.reason, d.reason);
+                        } else {
+                            d.reason = format!("{}; {}", d.reason, m.reason);
+                        }
+                    }
                     PairOutcome {
                         a: name_a,
                         b: name_b,

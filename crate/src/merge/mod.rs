@@ -18,8 +18,11 @@
 //!   ([`lift`]) and fitting a rigid transform with MSAC ([`rigid`]). The
 //!   candidates that agree with each other ([`consistency`], after PCM) are
 //!   refined by aligning the two occupancy grids ([`align`]), and the
-//!   overlaid maps must not contradict each other ([`verdict`]). Otherwise
-//!   the answer is "no merge", with the reason;
+//!   overlaid maps must not contradict each other ([`verdict`]). When the
+//!   cameras never saw a common place from close enough viewpoints, the
+//!   maps alone are searched for the overlay ([`mapsearch`], after Carpin
+//!   2008), judged by the same contradiction test with stricter demands.
+//!   Otherwise the answer is "no merge", with the reasons;
 //! * **a map-only baseline** ([`baseline`]), as existing tools do: features
 //!   on the grid images and a robust similarity fit, shown beside the
 //!   others so users see what vision adds.
@@ -39,6 +42,7 @@ pub mod graph;
 pub mod job;
 pub mod lab;
 pub mod lift;
+pub mod mapsearch;
 pub mod rigid;
 pub mod selection;
 pub mod thesis;

@@ -351,6 +351,9 @@ pub struct PairDecision {
     /// Independent places among `support`.
     pub places: usize,
     pub agreement: Option<Agreement>,
+    /// Refused because two different transforms fit both the frames and
+    /// the maps: no other evidence may then pick one.
+    pub ambiguous: bool,
 }
 
 /// What the search for candidates saw, for the "no candidate" reasons.
@@ -373,6 +376,7 @@ fn refuse(reason: String) -> PairDecision {
         support: Vec::new(),
         places: 0,
         agreement: None,
+        ambiguous: false,
     }
 }
 
@@ -515,6 +519,7 @@ pub fn decide_pair_after_search(
                 ));
                 d.support = first.support.clone();
                 d.places = first.places;
+                d.ambiguous = true;
                 d
             }
         }
@@ -523,7 +528,7 @@ pub fn decide_pair_after_search(
 
 /// "maps contradict: …" when the overlay puts a long piece of wall, or too
 /// large a share of the wall cells, in the other map's free space.
-fn contradiction_reason(
+pub(crate) fn contradiction_reason(
     agreement: &Agreement,
     cfg: &VerdictConfig,
     resolution_m: f64,
