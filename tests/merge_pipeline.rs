@@ -198,3 +198,33 @@ fn three_robots_join_and_a_fourth_that_shares_nothing_is_listed() {
     assert_eq!(report.errors.len(), 3);
     assert_eq!(report.robot_poses.len(), 3);
 }
+
+/// A lone robot: the verdict says there is nothing to merge, at once,
+/// without describing a single frame (the merge goes straight to the
+/// decision).
+#[wasm_bindgen_test(unsupported = test)]
+fn a_lone_robot_is_told_so_without_describing_frames() {
+    use slamlab::lab::Lab;
+    use slamlab::merge::{MergeMethod, MergeStatus};
+    let json = r#"{"duration_s": 30, "walls": [
+        {"from": [0, 0], "to": [6, 0]}, {"from": [6, 0], "to": [6, 4]},
+        {"from": [6, 4], "to": [0, 4]}, {"from": [0, 4], "to": [0, 0]}],
+        "robots": [{"name": "solo", "start": [1.5, 2, 0], "follow": "left"}]}"#;
+    let mut lab = Lab::new(json).expect("lab");
+    lab.run_to_end().expect("runs");
+    assert!(lab.frames(0).expect("frames").len() >= 30);
+    for method in [MergeMethod::Auto, MergeMethod::Thesis, MergeMethod::MapOnly] {
+        let p = lab.merge_start(method).expect("starts");
+        assert_eq!(p.stage, "decision", "{method:?}");
+        let p = lab.merge_finish().expect("finishes");
+        assert!(p.finished);
+        let report = lab.merge_report().expect("report");
+        assert_eq!(report.status, MergeStatus::NoMerge);
+        assert!(
+            report.reason.contains("only robot"),
+            "{method:?}: {}",
+            report.reason
+        );
+        assert_eq!(report.transforms.len(), 1);
+    }
+}

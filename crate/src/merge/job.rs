@@ -368,8 +368,11 @@ impl MergeJob {
                 });
             }
         }
+        // A lone robot has nothing to match: straight to the verdict (which
+        // says so) without describing a single frame.
         let stage = match method {
             MergeMethod::MapOnly => Stage::Decision,
+            _ if pairs.is_empty() => Stage::Decision,
             _ => Stage::Features,
         };
         Ok(MergeJob {
