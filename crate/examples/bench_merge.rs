@@ -4,7 +4,7 @@
 //! simulated runs; the truth is used only to score.
 //!
 //! ```text
-//! cargo run --release -p slamlab --example bench_merge -- [--runs 20] [--first-seed 1] [--others 5] [--multi 5] [--duration 300] [--methods auto,thesis,map-only] [--verbose]
+//! cargo run --release -p slamlab --example bench_merge -- [--runs 20] [--first-seed 1] [--others 5] [--multi 5] [--duration 300] [--methods auto,thesis,map-only] [--verbose] [--only maze-10] [--scenario-out DIR]
 //! cargo run --release -p slamlab --example bench_merge -- --dump-search   # the map search alone, every hypothesis against the truth
 //! ```
 //!
@@ -103,6 +103,8 @@ fn main() {
     let verbose = args.iter().any(|a| a == "--verbose");
     // `--only maze-14`: just that case, with the whole reason.
     let only = arg(&args, "--only");
+    // `--scenario-out DIR`: write the cases' scenario files instead of running them.
+    let scenario_out = arg(&args, "--scenario-out");
     // `--min-places N`: the verdict's independent places (an experiment).
     let min_places: Option<usize> = arg(&args, "--min-places").and_then(|s| s.parse().ok());
     // `--min-inliers N`: rigid inliers a frame pair needs (an experiment).
@@ -170,6 +172,14 @@ fn main() {
     println!("case            method    common  status    error_m  error_deg  ms     reason");
     for (name, json) in &cases {
         if only.as_ref().is_some_and(|o| o != name) {
+            continue;
+        }
+        if let Some(dir) = &scenario_out {
+            // `--scenario-out DIR`: each case as a scenario file, to open in
+            // the page or run with `node web/cli.mjs run`.
+            let path = std::path::Path::new(dir).join(format!("{name}.json"));
+            std::fs::write(&path, json).expect("write the scenario");
+            println!("wrote {}", path.display());
             continue;
         }
         let scenario = Scenario::parse(json).expect("scenario parses");
