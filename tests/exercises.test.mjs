@@ -217,13 +217,15 @@ const checks = {
   ],
   '04-featureless-walls.md': [
     {
-      what: 'plain walls: SLAM is as good as ever, the automatic merge refuses',
+      what: 'plain walls: SLAM is as good as ever, vision finds nothing, the maps alone merge',
       check(report) {
         for (const robot of report.robots) assert.ok(robot.slam.ate_m < 0.1, `${robot.name} ATE ${robot.slam.ate_m}`);
-        assert.equal(report.merge.status, 'no_merge');
-        assert.match(report.merge.reason, /no common place|too few inliers/);
-        assert.deepEqual(report.merge.unjoined, ['robot2']);
-        assert.equal(report.merge.transforms.length, 1);
+        assert.equal(report.merge.status, 'merged', report.merge.reason);
+        assert.match(report.merge.reason, /maps alone agree/);
+        assert.match(report.merge.reason, /vision: (no common place|too few inliers)/);
+        assert.ok(report.merge.confidence <= 0.5, `map-only confidence ${report.merge.confidence}`);
+        assert.deepEqual(report.merge.unjoined, []);
+        assert.ok(mergeError(report, 'robot2') < 0.1);
       },
     },
     {
