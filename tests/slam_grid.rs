@@ -256,3 +256,63 @@ fn grid_picture_fits_the_grid_y_up_and_draws_in_map_coordinates() {
     assert_eq!(&after[i..i + 4], &[255, 0, 0, 255]);
     assert!(GridPicture::new(&g, 0, 10).is_err());
 }
+
+/// A scan of `LASER_BEAMS` beams, all `range` long, all hits or all
+/// max-range.
+fn ring_scan(range: f64, hit: bool) -> slamlab::sensors::LaserScan {
+    let n = slamlab::sensors::LASER_BEAMS;
+    slamlab::sensors::LaserScan {
+        ranges_m: vec![range; n],
+        max_range: vec![!hit; n],
+        reflective: vec![false; n],
+        range_max_m: 4.0,
+    }
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn a_scan_lowers_each_cell_of_its_fan_once() {
+    // From the origin facing +x, 181 max-range beams 1 m long over ±90°:
+    // the fan is the right half-disc of radius 1 m. Walked beam by beam,
+    // cell (1, 0) would lie under some thirty beams; once per scan, it is
+    // lowered by one `miss`, like every cell whose centre is in the fan.
+    let mut g = OccupancyGrid::new(GridConfig::default());
+    g.integrate_scan(&Pose2::new(0.0, 0.0, 0.0), &ring_scan(1.0, false));
+    let miss = g.config.miss as f32 * LOG_ODDS_UNIT;
+    for k in 0..=19 {
+        assert_eq!(g.log_odds_global([k, 0]), miss, "cell ({k}, 0)");
+        assert_eq!(g.log_odds_global([0, k]), miss, "cell (0, {k})");
+        assert_eq!(g.log_odds_global([0, -k - 1]), miss, "cell (0, {})", -k - 1);
+    }
+    // Centres at x = 1.025 m, y = 1.025 m: outside the disc.
+    assert_eq!(g.log_odds_global([20, 0]), 0.0);
+    assert_eq!(g.log_odds_global([0, 20]), 0.0);
+    // (0.725, 0.725) lies 1.025 m out; (0.675, 0.675) 0.955 m.
+    assert_eq!(g.log_odds_global([14, 14]), 0.0);
+    assert_eq!(g.log_odds_global([13, 13]), miss);
+    // Behind the robot (centre x = −0.025 m): not in the fan.
+    assert_eq!(g.log_odds_global([-1, 0]), 0.0);
+    assert_eq!(g.occupied_count(), 0);
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn a_scan_of_hits_clears_to_the_margin_and_marks_the_ends() {
+    // Every beam ends on a surface 1 m out: cells are cleared only to
+    // 0.9 m (the hit margin), and the cells the beams end in are marked.
+    let mut g = OccupancyGrid::new(GridConfig::default());
+    g.integrate_scan(&Pose2::new(0.0, 0.0, 0.0), &ring_scan(1.0, true));
+    let (miss, hit) = (
+        g.config.miss as f32 * LOG_ODDS_UNIT,
+        g.config.hit as f32 * LOG_ODDS_UNIT,
+    );
+    assert_eq!(g.log_odds_global([17, 0]), miss, "centre 0.875 m");
+    assert_eq!(
+        g.log_odds_global([18, 0]),
+        0.0,
+        "centre 0.925 m: in the margin"
+    );
+    // The 0° beam ends at (1.0, 0) in cell (20, 0); the +1° and +2° beams
+    // at (0.99985, 0.01745) and (0.99939, 0.03490), both in cell (19, 0).
+    assert_eq!(g.log_odds_global([20, 0]), hit);
+    assert_eq!(g.log_odds_global([19, 0]), 2.0 * hit);
+    assert_eq!(g.log_odds_global([21, 0]), 0.0);
+}

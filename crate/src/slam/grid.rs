@@ -26,16 +26,33 @@
 //! * a *reflective* return came off another robot, which moves: the beam
 //!   still clears the space before it, but its end is never marked as wall.
 //!
-//! Cells along a beam are visited with the traversal of Amanatides and Woo
-//! (1987), the same walk [`crate::world`] uses for ray casting, so every cell
-//! the segment touches is visited exactly once. It is the mapper's hottest
-//! loop (≈ 11,000 cells per scan and map), so when both ends of a beam lie
-//! in the grid, as they do once it has grown to the scan's reach, the walk
-//! steps the cells' index directly instead of converting coordinates. Log-odds are clamped to
-//! `[l_min, l_max]`, so a cell that was wrong (a robot that stood there) can
-//! be cleared again after a few scans, and stored quantised in steps of
-//! [`LOG_ODDS_UNIT`] as one byte per cell: integer sums are exact, so the
-//! map is the same on every machine.
+//! Log-odds are clamped to `[l_min, l_max]`, so a cell that was wrong (a
+//! robot that stood there) can be cleared again after a few scans, and
+//! stored quantised in steps of [`LOG_ODDS_UNIT`] as one byte per cell:
+//! integer sums are exact, so the map is the same on every machine.
+//!
+//! ## A scan at once
+//! Table 9.1 of *Probabilistic Robotics* updates each cell in the sensor's
+//! field once per scan. A beam-by-beam walk does not: near the robot a
+//! cell lies under many of the 181 beams (under ≈ 3 / r of them at r
+//! metres), so it was lowered many times by one scan, while far out, where
+//! neighbouring beams are 7 cm apart at 4 m, cells between them were never
+//! lowered at all. [`OccupancyGrid::integrate_scan`] therefore treats the
+//! scan's free space as one polygon, the fan from the robot through the
+//! point where each beam stops clearing (its hit-margin point, or its end
+//! for a max-range or reflective beam), and lowers every cell whose centre
+//! lies inside it once, by a scanline fill; then it marks each beam's end
+//! cell. That is the textbook update, and about four times faster than
+//! walking the beams (≈ 12,000 cell visits a scan in the thesis preset,
+//! against a few thousand cells in the fan, filled in contiguous runs).
+//! Measured on the presets (`examples/slam_trace.rs all`), trajectories
+//! come out slightly better than with the beam walk: mean ATE 0.014 m
+//! against 0.018 m.
+//!
+//! A single beam ([`OccupancyGrid::integrate_beam`], used where a map is
+//! built from points rather than scans) is still walked with the traversal
+//! of Amanatides and Woo (1987), the same walk [`crate::world`] uses for ray
+//! casting, so every cell the segment touches is visited exactly once.
 //!
 //! ## Where in the cell: the surface layer
 //! A cell is 5 cm wide; a wall is a line. A grid that keeps only log-odds
@@ -481,19 +498,168 @@ impl OccupancyGrid {
     }
 
     /// Integrates a whole scan taken at `pose` (odometry frame), growing the
-    /// grid to cover the scan's reach first.
+    /// grid to cover the scan's reach first: the free region the beams
+    /// sweep is lowered once (see the module doc, "A scan at once"), then
+    /// every beam that ended on a surface marks its end cell.
     pub fn integrate_scan(&mut self, pose: &Pose2, scan: &LaserScan) {
         let reach = scan.range_max_m + 2.0 * self.config.resolution_m;
         let c = pose.position();
         self.ensure_contains(c - reach, c + reach);
+        let (r, margin) = (self.config.resolution_m, self.config.hit_margin_m);
+        let mut outline = Vec::with_capacity(scan.ranges_m.len());
+        let mut hits = Vec::with_capacity(scan.ranges_m.len());
         for (i, dir) in beam_directions(pose.theta, scan.ranges_m.len()).enumerate() {
-            let end = c + dir * scan.ranges_m[i];
+            let range = scan.ranges_m[i];
             // A beam without its flags counts as max-range: clear, mark nothing.
             let hit =
                 scan.max_range.get(i) == Some(&false) && scan.reflective.get(i) == Some(&false);
-            self.integrate_beam(c, end, hit);
+            // Where this beam stops saying "free": short of a surface by the
+            // hit margin, at the end of a beam that marks nothing.
+            let free = if hit {
+                (range - margin).max(0.0)
+            } else {
+                range
+            };
+            outline.push((c + dir * free) / r);
+            if hit {
+                hits.push(c + dir * range);
+            }
+        }
+        self.clear_fan(c / r, &outline);
+        let occ = self.config.hit;
+        for p in hits {
+            self.add(self.global_cell(p), occ);
+            self.add_surface_hit(p);
         }
         self.scans += 1;
+    }
+
+    /// Lowers by `miss`, once, every cell whose centre lies inside the fan
+    /// polygon `origin, outline[0], outline[1], …, origin` (cell units of
+    /// the odometry frame; the outline in beam order, so the polygon is
+    /// simple), and the cell holding `origin`.
+    ///
+    /// A scanline fill: each edge adds, for every cell row whose centre
+    /// line it crosses (half-open in y, so a vertex on a centre line is
+    /// counted once), the x of the crossing; sorted, each row's crossings
+    /// pair up into runs of cells, lowered left to right.
+    fn clear_fan(&mut self, origin: DVec2, outline: &[DVec2]) {
+        let n = outline.len();
+        let vertex = |k: usize| {
+            if k == 0 || k > n {
+                origin
+            } else {
+                outline[k - 1]
+            }
+        };
+        // The rows the fan spans, and each edge's crossings bucketed by row
+        // (a counting sort: rows are few, and most hold two crossings).
+        let (mut lo_y, mut hi_y) = (origin.y, origin.y);
+        for p in outline {
+            lo_y = lo_y.min(p.y);
+            hi_y = hi_y.max(p.y);
+        }
+        let first_row = (lo_y - 0.5).ceil() as i64;
+        let rows = ((hi_y - 0.5).ceil() as i64 - first_row).max(0) as usize;
+        let edge_rows = |k: usize| {
+            let (a, b) = (vertex(k), vertex(k + 1));
+            let (lo, hi) = if a.y < b.y { (a.y, b.y) } else { (b.y, a.y) };
+            // Rows whose centre line y = row + ½ lies in [lo, hi): a vertex
+            // on a centre line is counted once.
+            let (r0, r1) = ((lo - 0.5).ceil() as i64, (hi - 0.5).ceil() as i64);
+            (a, b, r0, r1)
+        };
+        let mut start = vec![0usize; rows + 1];
+        for k in 0..=n {
+            let (_, _, r0, r1) = edge_rows(k);
+            for row in r0..r1 {
+                start[(row - first_row) as usize + 1] += 1;
+            }
+        }
+        for i in 0..rows {
+            start[i + 1] += start[i];
+        }
+        let mut fill = start.clone();
+        let mut xs = vec![0f64; start[rows]];
+        for k in 0..=n {
+            let (a, b, r0, r1) = edge_rows(k);
+            if r0 >= r1 {
+                continue;
+            }
+            let slope = (b.x - a.x) / (b.y - a.y);
+            for row in r0..r1 {
+                let slot = &mut fill[(row - first_row) as usize];
+                xs[*slot] = a.x + (row as f64 + 0.5 - a.y) * slope;
+                *slot += 1;
+            }
+        }
+        let home = cell_of(origin);
+        let mut home_cleared = false;
+        for i in 0..rows {
+            let row = first_row + i as i64;
+            let row_xs = &mut xs[start[i]..start[i + 1]];
+            row_xs.sort_unstable_by(f64::total_cmp);
+            debug_assert!(
+                row_xs.len().is_multiple_of(2),
+                "a closed outline crosses a row an even number of times"
+            );
+            for pair in row_xs.chunks_exact(2) {
+                // Cells whose centre x = col + ½ lies in [x0, x1).
+                let (c0, c1) = ((pair[0] - 0.5).ceil() as i64, (pair[1] - 0.5).ceil() as i64);
+                home_cleared |= row == home[1] && (c0..c1).contains(&home[0]);
+                self.lower_run(row, c0, c1);
+            }
+        }
+        if !home_cleared && outline.iter().any(|&p| p != origin) {
+            self.lower_run(home[1], home[0], home[0] + 1);
+        }
+    }
+
+    /// Lowers cells `c0..c1` of global row `row` by `miss` (a wall at the
+    /// upper clamp excepted; a cell cleared to free loses its surface).
+    fn lower_run(&mut self, row: i64, c0: i64, c1: i64) {
+        if c0 >= c1 {
+            return;
+        }
+        let miss = self.config.miss;
+        let (Some((x0, y)), Some(_)) = (self.local([c0, row]), self.local([c1 - 1, row])) else {
+            // Partly outside a grid at its cap: cell by cell, counting
+            // what is dropped.
+            for c in c0..c1 {
+                self.add([c, row], miss);
+            }
+            return;
+        };
+        let start = y * self.width + x0;
+        let run = &mut self.cells[start..start + (c1 - c0) as usize];
+        let (min, max) = (self.config.min, self.config.max);
+        let lowered = |was: i8| {
+            if was >= max {
+                was
+            } else {
+                was.saturating_add(miss).max(min)
+            }
+        };
+        // Does any wall cell of the run turn free (and so lose its surface)?
+        // Rarely: then cell by cell; else one branch-free pass the compiler
+        // vectorises.
+        let clears_surface = !self.surface.is_empty()
+            && run
+                .iter()
+                .fold(false, |any, &was| any | ((was > 0) & (lowered(was) <= 0)));
+        if clears_surface {
+            for (k, v) in run.iter_mut().enumerate() {
+                let was = *v;
+                *v = lowered(was);
+                if was > 0 && *v <= 0 {
+                    self.surface[start + k].hits = 0;
+                }
+            }
+        } else {
+            for v in run.iter_mut() {
+                *v = lowered(*v);
+            }
+        }
     }
 }
 
