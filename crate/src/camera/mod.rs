@@ -151,13 +151,14 @@ pub fn wall_texture_key(walls: &[WallSpec], i: usize, back: bool) -> TextureKey 
 }
 
 /// A grey value rounded to the nearest byte (halves up), clamped to
-/// 0..=255. `(v + 0.5).floor()` rather than `v.round()`: wasm has a
-/// floor instruction but no round-half-away-from-zero, which becomes a
-/// library call per pixel; the two agree on every value that survives the
-/// clamp.
+/// 0..=255: `(v + 0.5).floor().clamp(0.0, 255.0)`, written as a cast.
+/// Rust's float-to-int `as` truncates toward zero and saturates (NaN gives
+/// 0); for `v + 0.5 ≥ 0` truncation is `floor`, and anything below 0 goes
+/// to 0 either way. No library `round` (wasm has none) and no separate
+/// clamp, per pixel.
 #[inline]
 fn to_byte(v: f64) -> u8 {
-    (v + 0.5).floor().clamp(0.0, 255.0) as u8
+    (v + 0.5) as u8
 }
 
 /// Rows whose pixel centres lie between the continuous rows `top` and
@@ -195,7 +196,9 @@ pub fn render(
     noise: Option<CameraNoise>,
 ) -> CameraImage {
     let (w, h) = (cam.width, cam.height);
-    let mut gray = vec![0u8; (w * h) as usize];
+    // Columns are drawn one after another, so the grey values are written
+    // column-major (each column contiguous) and transposed once at the end.
+    let mut by_column = vec![0u8; (w * h) as usize];
     let mut rgba = colour.then(|| vec![255u8; (w * h * 4) as usize]);
     let mut noise = noise;
     let gain = match &mut noise {
@@ -344,16 +347,16 @@ pub fn render(
             }
         }
         // Exposure and sensor noise, then out.
+        let out = &mut by_column[(c * h) as usize..((c + 1) * h) as usize];
         match &mut noise {
             Some(n) if n.pixel_std > 0.0 => {
-                for (r, v) in column.iter().enumerate() {
-                    let noisy = v * gain + n.pixel_std * n.rng.approx_gaussian();
-                    gray[r * w as usize + c as usize] = to_byte(noisy);
+                for (o, v) in out.iter_mut().zip(&column) {
+                    *o = to_byte(v * gain + n.pixel_std * n.rng.approx_gaussian());
                 }
             }
             _ => {
-                for (r, v) in column.iter().enumerate() {
-                    gray[r * w as usize + c as usize] = to_byte(v * gain);
+                for (o, v) in out.iter_mut().zip(&column) {
+                    *o = to_byte(v * gain);
                 }
             }
         }
@@ -364,6 +367,12 @@ pub fn render(
                     out[i + ch] = (px[ch] as f64 * gain).clamp(0.0, 255.0) as u8;
                 }
             }
+        }
+    }
+    let mut gray = vec![0u8; (w * h) as usize];
+    for (c, col) in by_column.chunks_exact(h as usize).enumerate() {
+        for (r, &v) in col.iter().enumerate() {
+            gray[r * w as usize + c] = v;
         }
     }
     CameraImage {
