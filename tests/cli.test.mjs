@@ -116,6 +116,8 @@ test('bad command lines exit 2 with a message', () => {
     [['run', 'scenarios/thesis.json', '--duration'], /--duration needs a value/],
     [['run', 'scenarios/thesis.json', '--frobnicate'], /unknown option --frobnicate/],
     [['run', 'scenarios/thesis.json', '--method', 'magic'], /--method: 'magic' is not one of auto, thesis, map-only/],
+    [['run', 'scenarios/thesis.json', '--workers', '-1'], /--workers: '-1' is not a whole number from 0 to 64/],
+    [['run', 'scenarios/thesis.json', '--workers', '65'], /--workers: '65'/],
     [['merge', 'scenarios/thesis.json'], /--out FILE.yaml is required/],
     [['fly'], /unknown command 'fly'/],
     [[], /usage:/],
@@ -239,6 +241,26 @@ test('features and match keep the interface JSON', () => {
   const bad = run('match', 'tests/data/coffee.png', 'tests/data/README.md', '--json');
   assert.equal(bad.code, 2);
   assert.match(bad.stderr, /not a PNG or JPEG/);
+});
+
+test('worker threads describing frames during the run change nothing in the report', () => {
+  const strip = (s) => {
+    const j = JSON.parse(s);
+    delete j.timings_ms;
+    if (j.merge) delete j.merge.timings_ms;
+    return j;
+  };
+  for (const method of ['auto', 'thesis']) {
+    const args = ['run', 'scenarios/thesis.json', '--json', '--method', method];
+    const [none, one, three] = ['0', '1', '3'].map((w) => run(...args, '--workers', w));
+    for (const r of [none, one, three]) assert.equal(r.code, 0, r.stderr);
+    const alone = strip(none.stdout);
+    assert.ok(alone.match_tables[0].rows.length > 0, `${method}: frames took part`);
+    assert.ok(alone.match_tables[0].inliers.flat().some((n) => n > 0), `${method}: some pair matched`);
+    assert.deepEqual(strip(one.stdout), alone, `${method}: one worker`);
+    assert.deepEqual(strip(three.stdout), alone, `${method}: three workers`);
+    assert.doesNotMatch(three.stderr, /describing frames/, 'no worker failed');
+  }
 });
 
 test('run merges with the automatic method: the report carries the table, the verdict and the transform', () => {

@@ -2,7 +2,11 @@
 // The lab's command line: the same wasm build as the page, run headless in node.
 //
 //   node web/cli.mjs run SCENARIO.json [--seed N] [--duration S] [--method auto|thesis|map-only] [--json]
+//                                     [--workers N]
 //
+// While the robots run, worker threads (--workers, default one per core up to
+// 4, 0 for none) describe the camera frames the merge will use; the report is
+// the same with any number of them.
 // Progress goes to stderr; with --json the report is the only thing on stdout.
 // Exit status: 0 when the run completed, 2 on bad input (message on stderr),
 // 1 on an internal error (a bug: please report it).
@@ -11,41 +15,30 @@ import { performance } from 'node:perf_hooks';
 import { loadWasm } from './cli/wasm.mjs';
 import { UsageError, parseArgs, wasmCall, openScenario } from './cli/args.mjs';
 import { methodOf, mergeLab, describeMerge } from './cli/merge.mjs';
+import { simulate, workersOf } from './cli/describe-pool.mjs';
 
 export { UsageError, parseArgs };
 
 const USAGE = `usage:
   node web/cli.mjs run SCENARIO.json [--seed N] [--duration S] [--method auto|thesis|map-only] [--json]
+      [--workers N]
       run the scenario headless, merge the robots' maps (default method: auto)
-      and print a report (JSON with --json)`;
+      and print a report (JSON with --json); N worker threads (default: one
+      per core, at most 4) describe camera frames while the robots run`;
 
 async function run(argv, wasm) {
   const { positional, options } = parseArgs(argv, {
-    seed: 'value', duration: 'value', json: 'flag', method: 'value',
+    seed: 'value', duration: 'value', json: 'flag', method: 'value', workers: 'value',
   });
   if (positional.length !== 1) throw new UsageError('run: expected exactly one SCENARIO.json');
   const method = methodOf(options);
+  const workers = method === 'map-only' ? 0 : workersOf(options);
   const t0 = performance.now();
   const lab = await openScenario(positional[0], options, wasm);
-  const state0 = JSON.parse(lab.stateJson());
-  const total = state0.total_steps;
-  const tSim = performance.now();
-  let done = 0;
-  let lastReport = tSim;
-  while (done < total) {
-    const n = wasmCall(() => lab.step(Math.min(500, total - done)));
-    if (n === 0) break;
-    done += n;
-    const now = performance.now();
-    if (now - lastReport > 1000 || done === total) {
-      process.stderr.write(`simulated ${(done / 10).toFixed(1)} / ${(total / 10).toFixed(1)} s\n`);
-      lastReport = now;
-    }
-  }
-  const simulateMs = performance.now() - tSim;
+  const { simulateMs, waitMs } = await simulate(lab, method, workers, true);
   mergeLab(lab, method);
   const totalMs = performance.now() - t0;
-  const report = wasmCall(() => lab.reportJson(JSON.stringify({ simulate: simulateMs, total: totalMs })));
+  const report = wasmCall(() => lab.reportJson(JSON.stringify({ simulate: simulateMs, features: waitMs, total: totalMs })));
   if (options.json) {
     process.stdout.write(report + '\n');
   } else {

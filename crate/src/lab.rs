@@ -34,6 +34,9 @@ pub struct Lab {
     /// The map merge of the current run, once asked for (see
     /// [`crate::merge::lab`]); dropped when the run changes.
     pub(crate) merge: Option<crate::merge::job::MergeJob>,
+    /// Features of this run's frames described ahead of a merge by other
+    /// threads ([`crate::merge::described`]); dropped when the run changes.
+    pub(crate) described: crate::merge::described::DescribedFrames,
     /// The host's millisecond clock, for stage timings.
     pub(crate) clock: Option<fn() -> f64>,
 }
@@ -85,6 +88,7 @@ impl Lab {
             textures: None,
             preview_world: None,
             merge: None,
+            described: Default::default(),
             clock: None,
         })
     }
@@ -126,6 +130,7 @@ impl Lab {
     /// Drops the simulation, keeping its texture bank for the next run.
     fn stop(&mut self) {
         self.merge = None;
+        self.described = Default::default();
         if let Some(sim) = self.sim.take() {
             self.textures = Some(sim.textures.into_inner());
         }
@@ -318,8 +323,10 @@ impl Lab {
             timings.slam = sim.stage_times.slam_ms;
         }
         if let Some(t) = self.merge.as_ref().map(|j| j.times_ms) {
-            if timings.features == 0.0 && timings.matching == 0.0 && timings.merge == 0.0 {
-                timings.features = t.features;
+            if timings.matching == 0.0 && timings.merge == 0.0 {
+                // The caller's `features` is its wait for frames other
+                // threads described (`crate::merge::described`), if any.
+                timings.features += t.features;
                 timings.matching = t.matching;
                 timings.merge = t.merge;
             }

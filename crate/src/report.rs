@@ -67,7 +67,9 @@ pub struct Timings {
     pub camera: f64,
     /// Both mappers, inside `simulate`.
     pub slam: f64,
-    /// SURF on the frames that take part in the merge.
+    /// SURF on the frames that take part in the merge: the merge's
+    /// features stage, plus the wait after the run for frames that worker
+    /// threads were describing meanwhile (the command line's `--workers`).
     pub features: f64,
     /// Proposals and frame-pair verification (the matched-pair table).
     pub matching: f64,

@@ -541,15 +541,29 @@ impl Simulation {
     /// seed, so it is the same whenever (and however often) it is asked
     /// for. About 2 ms at 320 × 240.
     pub fn frame_image(&self, f: &CapturedFrame) -> CameraImage {
+        self.render_stored(&f.truth, &f.others, f.noise_seed)
+    }
+
+    /// What a stored frame with this pose, these other robots' bodies and
+    /// this noise seed shows ([`Simulation::frame_image`] of its parts): a
+    /// second simulation of the same scenario renders the same picture, which
+    /// is what lets another thread describe the frames of this one
+    /// ([`crate::merge::described`]).
+    pub fn render_stored(
+        &self,
+        truth: &Pose2,
+        others: &[RobotBox],
+        noise_seed: u64,
+    ) -> CameraImage {
         let spec = &self.scenario.camera;
-        let mut rng = Rng::new(f.noise_seed);
+        let mut rng = Rng::new(noise_seed);
         let t0 = self.clock.map_or(0.0, |now| now());
         let img = render_camera(
             &self.camera,
-            &f.truth,
+            truth,
             &self.world,
             &self.scenario.walls,
-            &f.others,
+            others,
             &mut self.textures.lock(),
             false,
             Some(CameraNoise {

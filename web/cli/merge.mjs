@@ -3,11 +3,12 @@
 import { writeFile } from 'node:fs/promises';
 import path from 'node:path';
 import { parseArgs, UsageError, wasmCall, openScenario } from './args.mjs';
+import { simulate, workersOf } from './describe-pool.mjs';
 
 export const METHODS = ['auto', 'thesis', 'map-only'];
 
-export const usage = `  node web/cli.mjs merge SCENARIO.json --out FILE.yaml [--method auto|thesis|map-only] [--seed N] [--duration S]
-      run the scenario, merge the robots' maps, and write the merged map as ROS map_server PGM + YAML (and a PNG)`;
+export const usage = `  node web/cli.mjs merge SCENARIO.json --out FILE.yaml [--method auto|thesis|map-only] [--seed N] [--duration S] [--workers N]
+      run the scenario (N worker threads describing frames meanwhile, as for run), merge the robots' maps, and write the merged map as ROS map_server PGM + YAML (and a PNG)`;
 
 /** Checks a --method value (undefined means the default, auto). */
 export function methodOf(options) {
@@ -57,14 +58,15 @@ export function describeMerge(merge) {
 
 async function merge(argv, wasm) {
   const { positional, options } = parseArgs(argv, {
-    out: 'value', method: 'value', seed: 'value', duration: 'value',
+    out: 'value', method: 'value', seed: 'value', duration: 'value', workers: 'value',
   });
   if (positional.length !== 1) throw new UsageError('merge: expected exactly one SCENARIO.json');
   if (options.out === undefined) throw new UsageError('merge: --out FILE.yaml is required');
   if (!/\.ya?ml$/i.test(options.out)) throw new UsageError(`--out: '${options.out}' should end in .yaml`);
   const method = methodOf(options);
+  const workers = method === 'map-only' ? 0 : workersOf(options);
   const lab = await openScenario(positional[0], options, wasm);
-  wasmCall(() => lab.runToEnd());
+  await simulate(lab, method, workers, false);
   const view = mergeLab(lab, method);
   const report = view.report;
   console.log(describeMerge(report));

@@ -10,18 +10,33 @@ import path from 'node:path';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 
-export async function loadWasm() {
-  const pkgDir = process.env.SLAMLAB_PKG
+/** Where the wasm build is: web/pkg, or $SLAMLAB_PKG. */
+export function pkgDir() {
+  return process.env.SLAMLAB_PKG
     ? path.resolve(process.env.SLAMLAB_PKG)
     : path.join(here, '..', 'pkg');
-  const js = path.join(pkgDir, 'slamlab.js');
+}
+
+// The compiled module, kept so worker threads can instantiate it without
+// compiling it again (a WebAssembly.Module can be posted to a worker).
+let compiled = null;
+
+/** The WebAssembly.Module loadWasm() compiled (null before). */
+export function compiledModule() {
+  return compiled;
+}
+
+export async function loadWasm() {
+  const dir = pkgDir();
+  const js = path.join(dir, 'slamlab.js');
   try {
     await access(js);
   } catch {
-    throw new Error(`wasm build not found at ${pkgDir}: run ./build.sh build first`);
+    throw new Error(`wasm build not found at ${dir}: run ./build.sh build first`);
   }
   const mod = await import(pathToFileURL(js).href);
-  const bytes = await readFile(path.join(pkgDir, 'slamlab_bg.wasm'));
-  mod.initSync({ module: bytes });
+  const bytes = await readFile(path.join(dir, 'slamlab_bg.wasm'));
+  compiled = new WebAssembly.Module(bytes);
+  mod.initSync({ module: compiled });
   return mod;
 }

@@ -31,6 +31,66 @@ impl Lab {
         json(&self.inner.merge_start(method).map_err(err)?)
     }
 
+    /// The frames a merge with `method` would describe now that no other
+    /// thread has described yet, flat: `[robot, frame, robot, frame, …]`
+    /// (see `describeFrameSpec`). Empty before a run.
+    #[wasm_bindgen(js_name = framesToDescribe)]
+    pub fn frames_to_describe(&self, method: &str) -> Result<Vec<u32>, JsError> {
+        let method = MergeMethod::parse(method).map_err(err)?;
+        Ok(self
+            .inner
+            .frames_to_describe(method)
+            .into_iter()
+            .flat_map(|(r, i)| [r as u32, i as u32])
+            .collect())
+    }
+
+    /// Frame `index` of robot `robot` of this run as JSON, for a lab of the
+    /// same scenario in another thread to describe (`describeFrameSpec`).
+    #[wasm_bindgen(js_name = frameSpecJson)]
+    pub fn frame_spec_json(&self, robot: u32, index: u32) -> Result<String, JsError> {
+        json(
+            &self
+                .inner
+                .frame_spec(robot as usize, index as usize)
+                .map_err(err)?,
+        )
+    }
+
+    /// In a lab of the same scenario (a worker's): the SURF features of
+    /// the frame `spec_json` (from `frameSpecJson`) as a merge with `method`
+    /// describes them, packed as `[count, then 70 numbers per keypoint]`.
+    #[wasm_bindgen(js_name = describeFrameSpec)]
+    pub fn describe_frame_spec(
+        &mut self,
+        spec_json: &str,
+        method: &str,
+    ) -> Result<Vec<f32>, JsError> {
+        let method = MergeMethod::parse(method).map_err(err)?;
+        let spec: crate::merge::described::FrameSpec =
+            serde_json::from_str(spec_json).map_err(|e| err(format!("frame spec: {e}")))?;
+        let f = self.inner.describe_frame_spec(&spec, method).map_err(err)?;
+        Ok(crate::merge::described::encode(&f))
+    }
+
+    /// Keeps the packed features (from `describeFrameSpec`) of frame `index`
+    /// of robot `robot` of this run for the next merge with `method`, which
+    /// takes them instead of describing the frame itself.
+    #[wasm_bindgen(js_name = storeDescribed)]
+    pub fn store_described(
+        &mut self,
+        robot: u32,
+        index: u32,
+        method: &str,
+        packed: &[f32],
+    ) -> Result<(), JsError> {
+        let method = MergeMethod::parse(method).map_err(err)?;
+        let f = crate::merge::described::decode(packed).map_err(err)?;
+        self.inner
+            .store_described(robot as usize, index as usize, method, f)
+            .map_err(err)
+    }
+
     /// Whether a merge of the current run exists (started, running or
     /// done); stepping, resetting or editing drops it.
     #[wasm_bindgen(js_name = hasMerge)]

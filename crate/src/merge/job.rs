@@ -33,6 +33,7 @@
 //! and their maps. It never looks at the truth; [`crate::lab`] scores it.
 
 use super::baseline::{map_only_merge, BaselineConfig};
+use super::described::DescribedFrames;
 use super::fuse::fuse;
 use super::graph::{spanning_tree, PairEdge};
 use super::mapsearch::{search_maps, MapSearchConfig};
@@ -255,6 +256,9 @@ pub struct MergeJob {
     merged: Option<OccupancyGrid>,
     /// Time per stage, measured by the caller's clock ([`crate::merge::lab`]).
     pub times_ms: super::lab::MergeTimes,
+    /// Frames described ahead, elsewhere ([`super::described`]): taken
+    /// instead of describing them again.
+    described: DescribedFrames,
 }
 
 fn pose3(p: &Pose2) -> [f64; 3] {
@@ -311,6 +315,17 @@ pub fn thin_by_motion(infos: &[FrameInfo], min_m: f64, min_rad: f64) -> Vec<usiz
     kept
 }
 
+/// Positions in `infos` of the frames a merge with `config` describes: all
+/// of them thinned by motion for the automatic method, the thesis's
+/// selection for its method, none for the map-only one.
+pub fn frames_taking_part(infos: &[FrameInfo], config: &MergeConfig) -> Vec<usize> {
+    match config.method {
+        MergeMethod::Auto => thin_by_motion(infos, config.min_motion_m, config.min_turn_rad),
+        MergeMethod::Thesis => select_frames(infos, &config.selection),
+        MergeMethod::MapOnly => Vec::new(),
+    }
+}
+
 /// SURF on one frame, keeping the `max` strongest keypoints (ties broken
 /// by position, so the result is deterministic) before describing them.
 pub fn strongest_features(image: &GrayImage, config: &SurfConfig, max: usize) -> Features {
@@ -341,13 +356,7 @@ impl MergeJob {
         let robots: Vec<RobotFrames> = (0..sim.robots.len())
             .map(|i| {
                 let infos = frame_infos(sim, i);
-                let selected = match method {
-                    MergeMethod::Auto => {
-                        thin_by_motion(&infos, config.min_motion_m, config.min_turn_rad)
-                    }
-                    MergeMethod::Thesis => select_frames(&infos, &config.selection),
-                    MergeMethod::MapOnly => Vec::new(),
-                };
+                let selected = frames_taking_part(&infos, &config);
                 RobotFrames {
                     name: sim.robots[i].spec.name.clone(),
                     infos,
@@ -387,7 +396,16 @@ impl MergeJob {
             outcome: None,
             merged: None,
             times_ms: Default::default(),
+            described: DescribedFrames::default(),
         })
+    }
+
+    /// Hands the job features described ahead of it (by another thread);
+    /// the features stage takes those it needs instead of computing them.
+    /// They are what it would compute (same frames, same settings), so the
+    /// merge comes out the same.
+    pub fn adopt_described(&mut self, described: DescribedFrames) {
+        self.described = described;
     }
 
     pub fn stage(&self) -> Stage {
@@ -473,18 +491,22 @@ impl MergeJob {
                 continue;
             }
             let info = &robot.infos[robot.selected[k]];
-            let frame = sim.robots[ri]
-                .frames
-                .frames
-                .iter()
-                .find(|f| f.index == info.index);
-            let features = frame
-                .and_then(|f| {
-                    let img = sim.frame_image(f);
-                    GrayImage::new(img.width as usize, img.height as usize, img.gray).ok()
-                })
-                .map(|img| strongest_features(&img, &self.config.surf, self.config.max_keypoints))
-                .unwrap_or_default();
+            let features = match self.described.take(&self.config, ri, info.index) {
+                Some(ready) => ready,
+                None => sim.robots[ri]
+                    .frames
+                    .frames
+                    .iter()
+                    .find(|f| f.index == info.index)
+                    .and_then(|f| {
+                        let img = sim.frame_image(f);
+                        GrayImage::new(img.width as usize, img.height as usize, img.gray).ok()
+                    })
+                    .map(|img| {
+                        strongest_features(&img, &self.config.surf, self.config.max_keypoints)
+                    })
+                    .unwrap_or_default(),
+            };
             robot.features.push(features);
             self.cursor = (ri, k + 1);
             done += 1;

@@ -11,6 +11,7 @@
 //! frames are the robots' odometry frames, whose origins are their start
 //! poses).
 
+use super::described::{describe_spec, frames_to_describe, FrameSpec};
 use super::job::{MergeConfig, MergeJob, MergeOutcome, PairOutcome, RobotTransform, Stage};
 use super::{MergeMethod, MergeStatus};
 use crate::geom::{wrap_angle, Pose2};
@@ -170,9 +171,60 @@ impl Lab {
             return Err("the robots have not moved yet: run them before merging".into());
         }
         let config = MergeConfig::new(method, sim.scenario.seed);
-        let job = MergeJob::new(sim, config)?;
+        let mut job = MergeJob::new(sim, config)?;
+        job.adopt_described(std::mem::take(&mut self.described));
         self.merge = Some(job);
         self.merge_progress()
+    }
+
+    /// The frames (robot, frame index) a merge with `method` would describe
+    /// now and that no other thread has described yet
+    /// ([`crate::merge::described`]); empty before a run.
+    pub fn frames_to_describe(&self, method: MergeMethod) -> Vec<(usize, usize)> {
+        let Some(sim) = self.simulation() else {
+            return Vec::new();
+        };
+        let config = MergeConfig::new(method, sim.scenario.seed);
+        frames_to_describe(sim, &config)
+            .into_iter()
+            .filter(|&(r, i)| !self.described.contains(&config, r, i))
+            .collect()
+    }
+
+    /// Frame `index` of robot `robot` of this run, for another lab of the
+    /// same scenario to describe.
+    pub fn frame_spec(&self, robot: usize, index: usize) -> Result<FrameSpec, String> {
+        let sim = self.simulation().ok_or("nothing has run yet")?;
+        FrameSpec::of(sim, robot, index)
+    }
+
+    /// Describes a frame of *another* lab's run of this same scenario, as a
+    /// merge with `method` would (this lab's own run is not touched; one is
+    /// started, at time 0, if there is none, for its world and textures).
+    pub fn describe_frame_spec(
+        &mut self,
+        spec: &FrameSpec,
+        method: MergeMethod,
+    ) -> Result<crate::surf::Features, String> {
+        let sim = self.start().map_err(|e| e.to_string())?;
+        let config = MergeConfig::new(method, sim.scenario.seed);
+        Ok(describe_spec(sim, spec, &config))
+    }
+
+    /// Keeps features another lab described for frame `index` of robot
+    /// `robot` of this run, for the next merge with `method` to take.
+    pub fn store_described(
+        &mut self,
+        robot: usize,
+        index: usize,
+        method: MergeMethod,
+        features: crate::surf::Features,
+    ) -> Result<(), String> {
+        let sim = self.simulation().ok_or("nothing has run yet")?;
+        FrameSpec::of(sim, robot, index)?;
+        let config = MergeConfig::new(method, sim.scenario.seed);
+        self.described.insert(&config, robot, index, features);
+        Ok(())
     }
 
     /// Where the merge stands.

@@ -30,13 +30,15 @@
 //! With three or more robots the pairwise results form a graph and the maps
 //! are joined along its most confident spanning tree ([`graph`]); the grids
 //! are fused by adding log-odds ([`fuse`]). [`job`] runs all of this in
-//! small increments so the page can show the matched-pair table filling in.
+//! small increments so the page can show the matched-pair table filling in;
+//! [`described`] lets other threads describe the frames ahead of it.
 //!
 //! Ground truth is never read here; [`crate::lab`] scores the result.
 
 pub mod align;
 pub mod baseline;
 pub mod consistency;
+pub mod described;
 pub mod fuse;
 pub mod graph;
 pub mod job;
