@@ -143,3 +143,48 @@ fn body_rectangle_touches_only_walls_it_reaches() {
     let world = World::new(vec![seg(0.2, -0.5, 0.2, 0.5)]);
     assert!(world.body_hits_wall(&body));
 }
+
+#[wasm_bindgen_test(unsupported = test)]
+fn casting_among_the_walls_within_range_answers_as_casting_among_all() {
+    // Hand case: a wall square on at exactly the range is kept and hit at
+    // the range; one 1 cm further is left out.
+    let world = World::new(vec![seg(4.0, -1.0, 4.0, 1.0), seg(-4.01, -1.0, -4.01, 1.0)]);
+    let near = world.walls_within(DVec2::ZERO, 4.0).expect("brute force");
+    assert_eq!(near, vec![0]);
+    let hit = world
+        .cast_among(&near, DVec2::ZERO, DVec2::X, 4.0)
+        .expect("hit at the range");
+    assert_eq!((hit.range_m, hit.wall), (4.0, Some(0)));
+
+    // Random walls, random scan origins, 181 rays each out to 4 m.
+    let mut rng = Rng::new(11);
+    let walls: Vec<Segment> = (0..40)
+        .map(|_| {
+            let a = DVec2::new(rng.range(0.0, 20.0), rng.range(0.0, 15.0));
+            let b = a + DVec2::from_angle(rng.range(0.0, 2.0 * PI)) * rng.range(0.2, 5.0);
+            Segment::new(a, b)
+        })
+        .collect();
+    let world = World::new(walls);
+    let (mut culled, mut hits) = (0, 0);
+    for _ in 0..200 {
+        let o = DVec2::new(rng.range(0.0, 20.0), rng.range(0.0, 15.0));
+        let near = world.walls_within(o, 4.0).expect("brute force");
+        culled += 40 - near.len();
+        for k in 0..181 {
+            let dir = DVec2::from_angle(k as f64 * PI / 180.0);
+            let all = world.cast(o, dir, 4.0);
+            assert_eq!(
+                world.cast_among(&near, o, dir, 4.0),
+                all,
+                "from {o} at {k} deg"
+            );
+            hits += all.is_some() as usize;
+        }
+    }
+    assert!(
+        culled > 200 * 20,
+        "most walls are out of range: {culled} left out"
+    );
+    assert!(hits > 200 * 181 / 4, "rays hit something: {hits}");
+}

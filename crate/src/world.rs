@@ -148,6 +148,55 @@ impl World {
         })
     }
 
+    /// For many rays from `p` out to `range_m` (a laser scan): the walls
+    /// that come within `range_m` of `p`, in index order, or `None` when
+    /// the world casts through its grid (whose cells already skip far
+    /// walls). A ray from `p` can only hit a wall within its range at a
+    /// distance no less than the wall's distance from `p`, so the others
+    /// can be left out; a micrometre of slack keeps a wall at exactly the
+    /// range in.
+    pub fn walls_within(&self, p: DVec2, range_m: f64) -> Option<Vec<u32>> {
+        if self.grid.is_some() {
+            return None;
+        }
+        let keep = range_m + 1e-6;
+        Some(
+            (0..self.walls.len() as u32)
+                .filter(|&i| {
+                    let w = &self.walls[i as usize];
+                    (w.closest_point(p) - p).length_squared() <= keep * keep
+                })
+                .collect(),
+        )
+    }
+
+    /// [`World::cast`] among `walls` only (from [`World::walls_within`] for
+    /// this ray's origin and a range no shorter than `max_range_m`): the
+    /// same answer, since the nearest wall is kept and ties still go to
+    /// the lower index.
+    pub fn cast_among(
+        &self,
+        walls: &[u32],
+        origin: DVec2,
+        dir: DVec2,
+        max_range_m: f64,
+    ) -> Option<RayHit> {
+        let mut best = f64::INFINITY;
+        let mut best_wall = usize::MAX;
+        for &i in walls {
+            if let Some(t) = self.walls[i as usize].ray_hit(origin, dir) {
+                if t < best {
+                    best = t;
+                    best_wall = i as usize;
+                }
+            }
+        }
+        (best <= max_range_m).then_some(RayHit {
+            range_m: best,
+            wall: Some(best_wall),
+        })
+    }
+
     fn cast_grid(
         &self,
         g: &WallGrid,

@@ -70,9 +70,12 @@ impl Laser {
         let mut max_range = Vec::with_capacity(LASER_BEAMS);
         let mut reflective = Vec::with_capacity(LASER_BEAMS);
         let origin = pose.position();
+        // 181 rays from one point: only walls within range can answer.
+        let near = scene.world.walls_within(origin, self.range_m);
         for i in 0..LASER_BEAMS {
             let a = pose.theta + beam_bearing(i);
-            match scene.cast(origin, DVec2::new(a.cos(), a.sin()), self.range_m) {
+            let dir = DVec2::new(a.cos(), a.sin());
+            match scene.cast_near(near.as_deref(), origin, dir, self.range_m) {
                 Some(h) => {
                     let r = h.range_m + self.rng.normal(self.noise_std_m);
                     ranges_m.push(r.clamp(0.0, self.range_m));

@@ -31,7 +31,24 @@ pub struct RangeScene<'a> {
 impl RangeScene<'_> {
     /// The nearest wall or obstacle along the unit ray, within `max_range_m`.
     pub fn cast(&self, origin: DVec2, dir: DVec2, max_range_m: f64) -> Option<RayHit> {
-        let mut hit = self.world.cast(origin, dir, max_range_m);
+        self.cast_near(None, origin, dir, max_range_m)
+    }
+
+    /// [`RangeScene::cast`] for rays from `origin`, given the walls near it
+    /// ([`World::walls_within`] for `origin` and at least `max_range_m`; `None`
+    /// casts among all walls as `cast` does). The same answer, cheaper when a
+    /// scan casts many rays from one point.
+    pub fn cast_near(
+        &self,
+        near: Option<&[u32]>,
+        origin: DVec2,
+        dir: DVec2,
+        max_range_m: f64,
+    ) -> Option<RayHit> {
+        let mut hit = match near {
+            Some(walls) => self.world.cast_among(walls, origin, dir, max_range_m),
+            None => self.world.cast(origin, dir, max_range_m),
+        };
         for s in self.obstacles {
             if let Some(t) = s.ray_hit(origin, dir) {
                 if t <= max_range_m && hit.is_none_or(|h| t < h.range_m) {

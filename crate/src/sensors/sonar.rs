@@ -74,6 +74,18 @@ impl Sonar {
 
     /// The range sonar `i` would read with no noise.
     pub fn exact_range(&self, scene: &RangeScene, pose: &Pose2, i: usize) -> Option<f64> {
+        self.exact_range_near(scene, None, pose, i)
+    }
+
+    /// [`Sonar::exact_range`] given the walls near the robot (see
+    /// [`RangeScene::cast_near`]).
+    fn exact_range_near(
+        &self,
+        scene: &RangeScene,
+        near: Option<&[u32]>,
+        pose: &Pose2,
+        i: usize,
+    ) -> Option<f64> {
         let (origin, axis) = Self::axis(pose, i);
         let mut best: Option<f64> = None;
         for k in 0..CONE_RAYS {
@@ -83,7 +95,9 @@ impl Sonar {
                 self.cone_rad * (k as f64 / (CONE_RAYS - 1) as f64 - 0.5)
             };
             let a = axis + off;
-            if let Some(h) = scene.cast(origin, DVec2::new(a.cos(), a.sin()), self.range_m) {
+            if let Some(h) =
+                scene.cast_near(near, origin, DVec2::new(a.cos(), a.sin()), self.range_m)
+            {
                 best = Some(best.map_or(h.range_m, |b: f64| b.min(h.range_m)));
             }
             if self.cone_rad == 0.0 {
@@ -96,8 +110,17 @@ impl Sonar {
     /// Reads all eight sonars at the true pose `pose`.
     pub fn read(&mut self, scene: &RangeScene, pose: &Pose2) -> SonarReading {
         let mut out = SonarReading::default();
+        // Every sonar sits within `ring` of the robot's centre, so only
+        // walls within range + ring of it can echo.
+        let ring = SONAR_POSITIONS_M
+            .iter()
+            .map(|p| DVec2::from(*p).length())
+            .fold(0.0, f64::max);
+        let near = scene
+            .world
+            .walls_within(pose.position(), self.range_m + ring);
         for i in 0..SONAR_COUNT {
-            match self.exact_range(scene, pose, i) {
+            match self.exact_range_near(scene, near.as_deref(), pose, i) {
                 Some(r) => {
                     let noisy = r + self.rng.normal(self.noise_std_m);
                     out.ranges_m[i] = noisy.clamp(0.0, self.range_m);
