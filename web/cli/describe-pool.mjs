@@ -27,8 +27,14 @@ export function defaultWorkers() {
   return Math.max(0, Math.min(4, cores - 1));
 }
 
-/** Frames a worker is handed ahead of what it has finished. */
-const AHEAD = 48;
+/**
+ * Frames a worker is handed ahead of what it has finished: while the robots
+ * run, enough to keep it busy between two of the run loop's pauses; after
+ * the run, few, so that the main thread and the workers share out the rest
+ * of the queue evenly (a frame handed to a worker cannot be taken back).
+ */
+const AHEAD_DURING_RUN = 48;
+const AHEAD_AFTER_RUN = 8;
 
 /** The --workers option (a string or undefined) as a count. */
 export function workersOf(options) {
@@ -49,6 +55,7 @@ export class DescribePool {
     this.method = method;
     this.sent = new Set();
     this.queue = [];
+    this.ahead = AHEAD_DURING_RUN;
     this.results = [];
     this.errors = [];
     this.waiting = null;
@@ -99,10 +106,10 @@ export class DescribePool {
     this.feed(lab);
   }
 
-  /** Tops every live worker up to AHEAD frames from the front of the queue. */
+  /** Tops every live worker up to `this.ahead` frames from the front of the queue. */
   feed(lab) {
     for (const w of this.workers) {
-      while (w.alive && w.pending < AHEAD && this.queue.length > 0) {
+      while (w.alive && w.pending < this.ahead && this.queue.length > 0) {
         const { robot, index } = this.queue.shift();
         w.thread.postMessage({ robot, index, spec: lab.frameSpecJson(robot, index) });
         w.pending += 1;
@@ -130,6 +137,7 @@ export class DescribePool {
    * Failures are reported on stderr (the merge describes those frames).
    */
   async finish(lab) {
+    this.ahead = AHEAD_AFTER_RUN;
     this.dispatch(lab);
     for (;;) {
       this.collect(lab);
@@ -163,36 +171,33 @@ export class DescribePool {
 export async function simulate(lab, method, workers, progress) {
   const total = JSON.parse(lab.stateJson()).total_steps;
   const pool = workers > 0 ? new DescribePool(lab, method, workers) : null;
-  const tSim = performance.now();
-  let done = 0;
-  let lastReport = tSim;
-  // Small slices keep the workers fed; without them, large ones.
-  const slice = pool ? 100 : 500;
-  while (done < total) {
-    const n = wasmCall(() => lab.step(Math.min(slice, total - done)));
-    if (n === 0) break;
-    done += n;
-    if (pool) {
-      pool.collect(lab);
-      pool.dispatch(lab);
-      await pool.breathe();
+  try {
+    const tSim = performance.now();
+    let done = 0;
+    let lastReport = tSim;
+    // Small slices keep the workers fed; without them, large ones.
+    const slice = pool ? 100 : 500;
+    while (done < total) {
+      const n = wasmCall(() => lab.step(Math.min(slice, total - done)));
+      if (n === 0) break;
+      done += n;
+      if (pool) {
+        pool.collect(lab);
+        pool.dispatch(lab);
+        await pool.breathe();
+      }
+      const now = performance.now();
+      if (progress && (now - lastReport > 1000 || done === total)) {
+        process.stderr.write(`simulated ${(done / 10).toFixed(1)} / ${(total / 10).toFixed(1)} s\n`);
+        lastReport = now;
+      }
     }
-    const now = performance.now();
-    if (progress && (now - lastReport > 1000 || done === total)) {
-      process.stderr.write(`simulated ${(done / 10).toFixed(1)} / ${(total / 10).toFixed(1)} s\n`);
-      lastReport = now;
-    }
-  }
-  const simulateMs = performance.now() - tSim;
-  let waitMs = 0;
-  if (pool) {
+    const simulateMs = performance.now() - tSim;
     const tWait = performance.now();
-    try {
-      await pool.finish(lab);
-    } finally {
-      pool.close();
-    }
-    waitMs = performance.now() - tWait;
+    if (pool) await pool.finish(lab);
+    return { simulateMs, waitMs: pool ? performance.now() - tWait : 0 };
+  } finally {
+    // Also when the run throws: live workers would keep node from exiting.
+    pool?.close();
   }
-  return { simulateMs, waitMs };
 }
