@@ -236,6 +236,8 @@ pub fn render(
         .collect();
     let mut memo: Option<(usize, bool, i64, std::sync::Arc<texture::Chunk>)> = None;
     let mut column = vec![0f64; h as usize];
+    // One wall column's texel rows, interpolated across x.
+    let mut across: Vec<f64> = Vec::with_capacity(h as usize + 2);
     let mut column_rgb = vec![[0u8; 3]; if colour { h as usize } else { 0 }];
     for c in 0..w {
         let local = cam.column_ray(c);
@@ -297,16 +299,26 @@ pub fn render(
             let x1 = (x0 + 1).min(tw as usize - 1);
             let fx = x - x0 as f64;
             let tw = tw as usize;
-            for r in r0..r1 {
-                let y = (ty0 + r as f64 * dty - 0.5).clamp(0.0, (th - 1) as f64);
-                let y0 = y as usize;
-                let y1 = (y0 + 1).min(th as usize - 1);
-                let fy = y - y0 as f64;
-                let (a, b) = (tex[y0 * tw + x0] as f64, tex[y0 * tw + x1] as f64);
-                let (c2, d) = (tex[y1 * tw + x0] as f64, tex[y1 * tw + x1] as f64);
-                let top_v = a + (b - a) * fx;
-                let bot_v = c2 + (d - c2) * fx;
-                column[r as usize] = top_v + (bot_v - top_v) * fy;
+            let y_at = |r: u32| (ty0 + r as f64 * dty - 0.5).clamp(0.0, (th - 1) as f64);
+            if r0 < r1 {
+                // The texel rows this span reads (y only grows with r),
+                // interpolated across x once each: close to a wall, many
+                // pixel rows share a texel row.
+                let y_lo = y_at(r0) as usize;
+                let y_hi = (y_at(r1 - 1) as usize + 1).min(th as usize - 1);
+                across.clear();
+                across.extend((y_lo..=y_hi).map(|ty| {
+                    let (a, b) = (tex[ty * tw + x0] as f64, tex[ty * tw + x1] as f64);
+                    a + (b - a) * fx
+                }));
+                for r in r0..r1 {
+                    let y = y_at(r);
+                    let y0 = y as usize;
+                    let y1 = (y0 + 1).min(th as usize - 1);
+                    let fy = y - y0 as f64;
+                    let (top_v, bot_v) = (across[y0 - y_lo], across[y1 - y_lo]);
+                    column[r as usize] = top_v + (bot_v - top_v) * fy;
+                }
             }
             if colour {
                 let (tw0, th0) = (chunk.width[0], chunk.height[0]);
