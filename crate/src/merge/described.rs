@@ -28,7 +28,7 @@
 //!    many threads helped, or none.
 
 use super::job::{frame_infos, frames_taking_part, strongest_features, MergeConfig};
-use crate::camera::RobotBox;
+use crate::camera::{CameraImage, RobotBox};
 use crate::geom::Pose2;
 use crate::sim::Simulation;
 use crate::surf::{Descriptor, Features, GrayImage, Keypoint, SurfConfig};
@@ -115,7 +115,12 @@ pub fn describe_spec(sim: &Simulation, spec: &FrameSpec, config: &MergeConfig) -
         })
         .collect();
     let truth = Pose2::new(spec.truth[0], spec.truth[1], spec.truth[2]);
-    let img = sim.render_stored(&truth, &others, spec.noise_seed);
+    describe_image(sim.render_stored(&truth, &others, spec.noise_seed), config)
+}
+
+/// The features a merge with `config` finds in a rendered frame (none in
+/// an image too small for SURF).
+pub fn describe_image(img: CameraImage, config: &MergeConfig) -> Features {
     match GrayImage::new(img.width as usize, img.height as usize, img.gray) {
         Ok(img) => strongest_features(&img, &config.surf, config.max_keypoints),
         Err(_) => Features::default(),

@@ -33,7 +33,7 @@
 //! and their maps. It never looks at the truth; [`crate::lab`] scores it.
 
 use super::baseline::{map_only_merge, BaselineConfig};
-use super::described::DescribedFrames;
+use super::described::{describe_image, DescribedFrames};
 use super::fuse::fuse;
 use super::graph::{spanning_tree, PairEdge};
 use super::mapsearch::{search_maps, MapSearchConfig};
@@ -498,13 +498,7 @@ impl MergeJob {
                     .frames
                     .iter()
                     .find(|f| f.index == info.index)
-                    .and_then(|f| {
-                        let img = sim.frame_image(f);
-                        GrayImage::new(img.width as usize, img.height as usize, img.gray).ok()
-                    })
-                    .map(|img| {
-                        strongest_features(&img, &self.config.surf, self.config.max_keypoints)
-                    })
+                    .map(|f| describe_image(sim.frame_image(f), &self.config))
                     .unwrap_or_default(),
             };
             robot.features.push(features);
@@ -513,6 +507,10 @@ impl MergeJob {
         }
         if self.cursor.0 >= self.robots.len() {
             self.stage = Stage::Proposals;
+        }
+        if self.stage != Stage::Features {
+            // Whatever was described ahead and not used is not needed.
+            self.described = DescribedFrames::default();
         }
         done
     }
