@@ -4,9 +4,9 @@
 //   node web/cli.mjs run SCENARIO.json [--seed N] [--duration S] [--method auto|thesis|map-only] [--json]
 //                                     [--workers N]
 //
-// While the robots run, worker threads (--workers, default one per core up to
-// 4, 0 for none) describe the camera frames the merge will use; the report is
-// the same with any number of them.
+// While the robots run, worker threads (--workers; by default one per core but
+// the main thread's, at most 4; 0 for none) describe the camera frames the
+// merge will use; the report is the same with any number of them.
 // Progress goes to stderr; with --json the report is the only thing on stdout.
 // Exit status: 0 when the run completed, 2 on bad input (message on stderr),
 // 1 on an internal error (a bug: please report it).
@@ -24,7 +24,8 @@ const USAGE = `usage:
       [--workers N]
       run the scenario headless, merge the robots' maps (default method: auto)
       and print a report (JSON with --json); N worker threads (default: one
-      per core, at most 4) describe camera frames while the robots run`;
+      per core but the main thread's, at most 4) describe camera frames while
+      the robots run`;
 
 async function run(argv, wasm) {
   const { positional, options } = parseArgs(argv, {

@@ -27,15 +27,6 @@ export function defaultWorkers() {
   return Math.max(0, Math.min(4, cores - 1));
 }
 
-/**
- * Frames a worker is handed ahead of what it has finished: while the robots
- * run, enough to keep it busy between two of the run loop's pauses; after
- * the run, few, so that the main thread and the workers share out the rest
- * of the queue evenly (a frame handed to a worker cannot be taken back).
- */
-const AHEAD_DURING_RUN = 48;
-const AHEAD_AFTER_RUN = 8;
-
 /** The --workers option (a string or undefined) as a count. */
 export function workersOf(options) {
   if (options.workers === undefined) return defaultWorkers();
@@ -45,6 +36,15 @@ export function workersOf(options) {
   }
   return n;
 }
+
+/**
+ * Frames a worker is handed ahead of what it has finished: while the robots
+ * run, enough to keep it busy between two of the run loop's pauses; after
+ * the run, few, so that the main thread and the workers share out the rest
+ * of the queue evenly (a frame handed to a worker cannot be taken back).
+ */
+const AHEAD_DURING_RUN = 48;
+const AHEAD_AFTER_RUN = 8;
 
 export class DescribePool {
   /**

@@ -221,7 +221,15 @@ impl Lab {
         features: crate::surf::Features,
     ) -> Result<(), String> {
         let sim = self.simulation().ok_or("nothing has run yet")?;
-        FrameSpec::of(sim, robot, index)?;
+        let frames = &sim
+            .robots
+            .get(robot)
+            .ok_or_else(|| format!("no robot {robot}"))?
+            .frames
+            .frames;
+        if !frames.iter().any(|f| f.index == index) {
+            return Err(format!("robot {robot} has no frame {index}"));
+        }
         let config = MergeConfig::new(method, sim.scenario.seed);
         self.described.insert(&config, robot, index, features);
         Ok(())
