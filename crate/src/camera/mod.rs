@@ -362,9 +362,14 @@ pub fn render(
         let out = &mut by_column[(c * h) as usize..((c + 1) * h) as usize];
         match &mut noise {
             Some(n) if n.pixel_std > 0.0 => {
+                // The generator's state in locals for the column, not
+                // behind a pointer the byte stores might alias.
+                let mut rng = n.rng.clone();
+                let std = n.pixel_std;
                 for (o, v) in out.iter_mut().zip(&column) {
-                    *o = to_byte(v * gain + n.pixel_std * n.rng.approx_gaussian());
+                    *o = to_byte(v * gain + std * rng.approx_gaussian());
                 }
+                *n.rng = rng;
             }
             _ => {
                 for (o, v) in out.iter_mut().zip(&column) {
