@@ -1,7 +1,8 @@
 //! Frames described by a second lab of the same scenario, as the command
 //! line's worker threads do (`slamlab::merge::described`): the features come
 //! out bit for bit the same, cross the boundary exactly, and a merge that
-//! takes them reports what a merge computing everything itself reports.
+//! takes them (or pictures rendered there and described here) reports what a
+//! merge computing everything itself reports.
 
 use slamlab::lab::Lab;
 use slamlab::maze::{random_maze, MazeSpec};
@@ -91,6 +92,9 @@ fn a_second_lab_describes_the_first_labs_frames_bit_for_bit() {
             .expect("describes");
         let frame = a.frame(robot, index).expect("frame").clone();
         let img = a.frame_image(&frame).expect("renders");
+        // Rendering alone gives the frame's own pixels, byte for byte.
+        let rendered = b.render_frame_spec(&spec).expect("renders there");
+        assert_eq!(rendered.gray, img.gray, "robot {robot} frame {index}");
         let img = GrayImage::new(img.width as usize, img.height as usize, img.gray).expect("img");
         let here = strongest_features(&img, &config.surf, config.max_keypoints);
         assert_eq!(
@@ -105,6 +109,17 @@ fn a_second_lab_describes_the_first_labs_frames_bit_for_bit() {
     assert!(a
         .store_described(7, 0, MergeMethod::Auto, Default::default())
         .is_err());
+    // Pixels of the wrong size, or of a frame that does not exist, are
+    // refused with a message.
+    let (robot, index) = todo[0];
+    let e = a
+        .describe_rendered(robot, index, MergeMethod::Auto, vec![0; 100])
+        .expect_err("wrong size");
+    assert!(e.contains("100 grey bytes for a 320 x 240 camera"), "{e}");
+    let e = a
+        .describe_rendered(robot, 1_000_000, MergeMethod::Auto, vec![0; 320 * 240])
+        .expect_err("no such frame");
+    assert!(e.contains("has no frame 1000000"), "{e}");
 }
 
 #[wasm_bindgen_test(unsupported = test)]
@@ -117,18 +132,27 @@ fn a_merge_that_takes_described_frames_reports_the_same() {
 
     let mut helped = Lab::new(&json).expect("lab");
     let mut helper = Lab::new(&json).expect("helper");
-    // Hand frames over while the run goes on, as the command line does.
+    // Hand frames over while the run goes on, as the command line does:
+    // the helper describes every other one, and only renders the rest for
+    // this lab to describe (as after the run).
     let mut handed = 0;
     while !helped.state().finished {
         helped.step(200).expect("steps");
         for (robot, index) in helped.frames_to_describe(MergeMethod::Auto) {
             let spec = helped.frame_spec(robot, index).expect("spec");
-            let f = helper
-                .describe_frame_spec(&spec, MergeMethod::Auto)
-                .expect("describes");
-            helped
-                .store_described(robot, index, MergeMethod::Auto, f)
-                .expect("stores");
+            if handed % 2 == 0 {
+                let f = helper
+                    .describe_frame_spec(&spec, MergeMethod::Auto)
+                    .expect("describes");
+                helped
+                    .store_described(robot, index, MergeMethod::Auto, f)
+                    .expect("stores");
+            } else {
+                let img = helper.render_frame_spec(&spec).expect("renders");
+                helped
+                    .describe_rendered(robot, index, MergeMethod::Auto, img.gray)
+                    .expect("describes here");
+            }
             handed += 1;
         }
     }

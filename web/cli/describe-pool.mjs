@@ -6,9 +6,12 @@
 // and each worker is kept a few frames ahead, taking them in capture order
 // (consecutive frames see the same walls, so a worker paints most wall
 // textures once). collect() stores what came back in the lab. After the
-// run, finish() has the main thread describe frames from the far end of the
-// queue too, until the queue is empty and the workers are done. The merge
-// then finds every frame described; any a worker could not do, it
+// run, finish() splits each remaining frame between the two halves of the
+// work: a worker, whose wall textures are painted, only renders it, and the
+// main thread, whose textures are not, runs SURF on the pixels. While the
+// workers still work through the frames handed to them during the run, the
+// main thread describes frames from the far end of the queue in full. The
+// merge then finds every frame described; any a worker could not do, it
 // describes itself (and stderr says so).
 import { Worker } from 'node:worker_threads';
 import os from 'node:os';
@@ -39,9 +42,11 @@ export function workersOf(options) {
 
 /**
  * Frames a worker is handed ahead of what it has finished: while the robots
- * run, enough to keep it busy between two of the run loop's pauses; after
- * the run, few, so that the main thread and the workers share out the rest
- * of the queue evenly (a frame handed to a worker cannot be taken back).
+ * run, enough to keep it busy between two of the run loop's pauses, but no
+ * more than it will finish before the run ends (at its pace so far), since
+ * a frame handed out cannot be taken back and the split of the work changes
+ * when the run ends; after the run, a few to render, enough to keep it busy
+ * while the main thread describes what it rendered before.
  */
 const AHEAD_DURING_RUN = 48;
 const AHEAD_AFTER_RUN = 8;
@@ -57,6 +62,9 @@ export class DescribePool {
     this.queue = [];
     this.ahead = AHEAD_DURING_RUN;
     this.results = [];
+    this.returned = 0;
+    this.grays = [];
+    this.render = false;
     this.errors = [];
     this.waiting = null;
     const workerData = {
@@ -70,7 +78,9 @@ export class DescribePool {
       const w = { thread, pending: 0, alive: true };
       thread.on('message', (msg) => {
         w.pending -= 1;
+        this.returned += 1;
         if (msg.error) this.errors.push(`frame ${msg.index} of robot ${msg.robot}: ${msg.error}`);
+        else if (msg.gray) this.grays.push(msg);
         else this.results.push(msg);
         this.wake();
       });
@@ -93,6 +103,17 @@ export class DescribePool {
     }
   }
 
+  /**
+   * While the run is `done` steps of `total` in: sets how far ahead the
+   * workers are fed from the frames they have returned per step so far.
+   */
+  pace(done, total) {
+    const live = this.workers.filter((w) => w.alive).length;
+    if (done === 0 || this.returned === 0 || live === 0) return;
+    const willFinish = Math.ceil((this.returned / done / live) * (total - done));
+    this.ahead = Math.max(AHEAD_AFTER_RUN, Math.min(AHEAD_DURING_RUN, willFinish));
+  }
+
   /** Queues the frames the lab wants described that nobody has yet, and hands them out. */
   dispatch(lab) {
     const flat = lab.framesToDescribe(this.method);
@@ -111,7 +132,7 @@ export class DescribePool {
     for (const w of this.workers) {
       while (w.alive && w.pending < this.ahead && this.queue.length > 0) {
         const { robot, index } = this.queue.shift();
-        w.thread.postMessage({ robot, index, spec: lab.frameSpecJson(robot, index) });
+        w.thread.postMessage({ robot, index, spec: lab.frameSpecJson(robot, index), render: this.render });
         w.pending += 1;
       }
     }
@@ -132,27 +153,41 @@ export class DescribePool {
   }
 
   /**
-   * After the run: describes queued frames on this thread too, from the
-   * back of the queue, until every frame handed out is back and stored.
-   * Failures are reported on stderr (the merge describes those frames).
+   * After the run: the workers only render what is left, and this thread
+   * describes their pictures. (Describing a frame here in full would cost
+   * this thread several times what rendering it costs a worker, as the
+   * wall textures it shows are not painted here.) Returns once every frame
+   * is back and stored. Failures are reported on stderr (the merge
+   * describes those frames); with no worker left, this thread describes
+   * the rest.
    */
   async finish(lab) {
     this.ahead = AHEAD_AFTER_RUN;
+    this.render = true;
     this.dispatch(lab);
     for (;;) {
       this.collect(lab);
-      if (this.queue.length > 0) {
+      const live = this.workers.filter((w) => w.alive);
+      if (this.grays.length > 0) {
+        const { robot, index, gray } = this.grays.shift();
+        try {
+          lab.describeRendered(robot, index, this.method, gray);
+        } catch (e) {
+          this.errors.push(`frame ${index} of robot ${robot}: ${e?.message ?? e}`);
+        }
+      } else if (this.queue.length > 0 && live.length === 0) {
         const { robot, index } = this.queue.pop();
         const packed = lab.describeFrameSpec(lab.frameSpecJson(robot, index), this.method);
         lab.storeDescribed(robot, index, this.method, packed);
-        await this.breathe();
-      } else if (this.workers.some((w) => w.alive && w.pending > 0)) {
+      } else if (live.some((w) => w.pending > 0)) {
         await new Promise((resolve) => {
           this.waiting = resolve;
         });
+        continue;
       } else {
         break;
       }
+      await this.breathe();
     }
     for (const e of this.errors) process.stderr.write(`describing frames: ${e}; the merge describes them itself\n`);
   }
@@ -183,6 +218,7 @@ export async function simulate(lab, method, workers, progress) {
       done += n;
       if (pool) {
         pool.collect(lab);
+        pool.pace(done, total);
         pool.dispatch(lab);
         await pool.breathe();
       }

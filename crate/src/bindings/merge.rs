@@ -73,6 +73,33 @@ impl Lab {
         Ok(crate::merge::described::encode(&f))
     }
 
+    /// In a lab of the same scenario (a worker's): the grey pixels of the
+    /// frame `spec_json` (from `frameSpecJson`), row by row, for this run's
+    /// lab to describe with `describeRendered`.
+    #[wasm_bindgen(js_name = renderFrameSpec)]
+    pub fn render_frame_spec(&mut self, spec_json: &str) -> Result<Vec<u8>, JsError> {
+        let spec: crate::merge::described::FrameSpec =
+            serde_json::from_str(spec_json).map_err(|e| err(format!("frame spec: {e}")))?;
+        Ok(self.inner.render_frame_spec(&spec).map_err(err)?.gray)
+    }
+
+    /// Describes frame `index` of robot `robot` of this run from its grey
+    /// pixels (from `renderFrameSpec` in another lab of the same scenario)
+    /// and keeps the features for the next merge with `method`.
+    #[wasm_bindgen(js_name = describeRendered)]
+    pub fn describe_rendered(
+        &mut self,
+        robot: u32,
+        index: u32,
+        method: &str,
+        gray: Vec<u8>,
+    ) -> Result<(), JsError> {
+        let method = MergeMethod::parse(method).map_err(err)?;
+        self.inner
+            .describe_rendered(robot as usize, index as usize, method, gray)
+            .map_err(err)
+    }
+
     /// Keeps the packed features (from `describeFrameSpec`) of frame `index`
     /// of robot `robot` of this run for the next merge with `method`, which
     /// takes them instead of describing the frame itself.

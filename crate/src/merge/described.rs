@@ -20,7 +20,12 @@
 //!    correctness.
 //! 2. [`FrameSpec`]: one frame's parts, as JSON, for the other lab, which
 //!    describes it with [`describe_spec`] and sends back the features
-//!    packed in a flat `f32` array ([`encode`]).
+//!    packed in a flat `f32` array ([`encode`]). The work splits in two
+//!    halves as well: the other lab may only render the frame
+//!    ([`render_spec`]) and send its grey bytes back, for this lab to
+//!    describe ([`describe_image`]). Rendering is the half that needs the
+//!    wall textures, which a lab paints on first use; a lab that has painted
+//!    them renders fast, and SURF needs nothing painted at all.
 //! 3. [`DescribedFrames`]: where this lab keeps what came back ([`decode`]),
 //!    keyed by robot and frame index and tied to the SURF settings they were
 //!    made with. A merge started afterwards takes the features it finds
@@ -106,6 +111,12 @@ impl FrameSpec {
 /// The features of the frame `spec` describes, rendered by `sim` (a
 /// simulation of the same scenario, at any time of its run).
 pub fn describe_spec(sim: &Simulation, spec: &FrameSpec, config: &MergeConfig) -> Features {
+    describe_image(render_spec(sim, spec), config)
+}
+
+/// The picture of the frame `spec` describes, rendered by `sim` (a
+/// simulation of the same scenario): exactly the frame's own pixels.
+pub fn render_spec(sim: &Simulation, spec: &FrameSpec) -> CameraImage {
     let others: Vec<RobotBox> = spec
         .others
         .iter()
@@ -115,7 +126,7 @@ pub fn describe_spec(sim: &Simulation, spec: &FrameSpec, config: &MergeConfig) -
         })
         .collect();
     let truth = Pose2::new(spec.truth[0], spec.truth[1], spec.truth[2]);
-    describe_image(sim.render_stored(&truth, &others, spec.noise_seed), config)
+    sim.render_stored(&truth, &others, spec.noise_seed)
 }
 
 /// The features a merge with `config` finds in a rendered frame (none in

@@ -11,9 +11,10 @@
 //! frames are the robots' odometry frames, whose origins are their start
 //! poses).
 
-use super::described::{describe_spec, frames_to_describe, FrameSpec};
+use super::described::{describe_image, describe_spec, frames_to_describe, render_spec, FrameSpec};
 use super::job::{MergeConfig, MergeJob, MergeOutcome, PairOutcome, RobotTransform, Stage};
 use super::{MergeMethod, MergeStatus};
+use crate::camera::CameraImage;
 use crate::geom::{wrap_angle, Pose2};
 use crate::lab::Lab;
 use crate::slam::export::{to_pgm, to_png, to_yaml, GridPicture};
@@ -211,6 +212,47 @@ impl Lab {
         Ok(describe_spec(sim, spec, &config))
     }
 
+    /// Renders a frame of *another* lab's run of this same scenario (see
+    /// [`Lab::describe_frame_spec`]), for that lab to describe with
+    /// [`Lab::describe_rendered`].
+    pub fn render_frame_spec(&mut self, spec: &FrameSpec) -> Result<CameraImage, String> {
+        let sim = self.start().map_err(|e| e.to_string())?;
+        Ok(render_spec(sim, spec))
+    }
+
+    /// Describes frame `index` of robot `robot` of this run from its grey
+    /// pixels, rendered by another lab of the same scenario
+    /// ([`Lab::render_frame_spec`]), and keeps the features for the next
+    /// merge with `method`. Fails if the frame does not exist or `gray` is
+    /// not the camera's size.
+    pub fn describe_rendered(
+        &mut self,
+        robot: usize,
+        index: usize,
+        method: MergeMethod,
+        gray: Vec<u8>,
+    ) -> Result<(), String> {
+        let sim = self.simulation().ok_or("nothing has run yet")?;
+        frame_exists(sim, robot, index)?;
+        let cam = &sim.scenario.camera;
+        let (width, height) = (cam.width, cam.height);
+        if gray.len() != (width * height) as usize {
+            return Err(format!(
+                "{} grey bytes for a {width} x {height} camera ({} expected)",
+                gray.len(),
+                width * height
+            ));
+        }
+        let config = MergeConfig::new(method, sim.scenario.seed);
+        let img = CameraImage {
+            width,
+            height,
+            gray,
+            rgba: None,
+        };
+        self.store_described(robot, index, method, describe_image(img, &config))
+    }
+
     /// Keeps features another lab described for frame `index` of robot
     /// `robot` of this run, for the next merge with `method` to take.
     pub fn store_described(
@@ -221,15 +263,7 @@ impl Lab {
         features: crate::surf::Features,
     ) -> Result<(), String> {
         let sim = self.simulation().ok_or("nothing has run yet")?;
-        let frames = &sim
-            .robots
-            .get(robot)
-            .ok_or_else(|| format!("no robot {robot}"))?
-            .frames
-            .frames;
-        if !frames.iter().any(|f| f.index == index) {
-            return Err(format!("robot {robot} has no frame {index}"));
-        }
+        frame_exists(sim, robot, index)?;
         let config = MergeConfig::new(method, sim.scenario.seed);
         self.described.insert(&config, robot, index, features);
         Ok(())
@@ -521,5 +555,20 @@ fn map_info(g: &OccupancyGrid) -> MergedMapInfo {
         resolution_m: g.resolution_m(),
         origin_m: [o.x, o.y],
         occupied_cells: g.occupied_count(),
+    }
+}
+
+/// Fails unless robot `robot` of `sim` has a stored frame `index`.
+fn frame_exists(sim: &crate::sim::Simulation, robot: usize, index: usize) -> Result<(), String> {
+    let frames = &sim
+        .robots
+        .get(robot)
+        .ok_or_else(|| format!("no robot {robot}"))?
+        .frames
+        .frames;
+    if frames.iter().any(|f| f.index == index) {
+        Ok(())
+    } else {
+        Err(format!("robot {robot} has no frame {index}"))
     }
 }
