@@ -8,10 +8,8 @@
 // textures once). collect() stores what came back in the lab. After the
 // run, finish() splits each remaining frame between the two halves of the
 // work: a worker, whose wall textures are painted, only renders it, and the
-// main thread, whose textures are not, runs SURF on the pixels. While the
-// workers still work through the frames handed to them during the run, the
-// main thread describes frames from the far end of the queue in full. The
-// merge then finds every frame described; any a worker could not do, it
+// main thread, whose textures are not, runs SURF on the pixels. The merge
+// then finds every frame described; any a worker could not do, it
 // describes itself (and stderr says so).
 import { Worker } from 'node:worker_threads';
 import os from 'node:os';
