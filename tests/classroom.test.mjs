@@ -46,8 +46,8 @@ test('guided mode: §6.2.1 to §6.2.5 on the thesis preset, numbers on the way, 
   const collect = await liveText(page);
   const pictures = /Pictures: robot1 (\d+), robot2 (\d+)/.exec(collect);
   assert.ok(pictures, `the step reports the pictures taken: ${collect}`);
-  assert.equal(Number(pictures[1]), 301, 'one picture per simulated second over 300 s');
-  assert.equal(Number(pictures[2]), 301);
+  assert.equal(Number(pictures[1]), 148, 'one picture per simulated second over 147 s, t = 0 included');
+  assert.equal(Number(pictures[2]), 148);
   assert.match(collect, /robot1 \d+\.\d\d m \(odometry alone \d+\.\d\d m\)/);
 
   // §6.2.2: a thesis merge starts, held before matching; its selection is
@@ -164,9 +164,9 @@ test('guided mode: §6.2.1 to §6.2.5 on the thesis preset, numbers on the way, 
   await summary.waitFor({ state: 'visible' });
   const sum = await summary.innerText();
   assert.match(sum, /Run summary: “thesis”/);
-  assert.match(sum, /Seed 7 · 300\.0 s simulated of 300 s/);
+  assert.match(sum, /Seed 7 · 147\.0 s simulated of 147 s/);
   assert.match(sum, /#preset=thesis&seed=7/);
-  assert.match(sum, /robot1\s+left wall, 0\.60 m\s+301\s+\d+\s+\d+\.\d\d m/);
+  assert.match(sum, /robot1\s+left wall, 0\.60 m\s+148\s+\d+\s+\d+\.\d\d m/);
   assert.match(sum, /Transform error of each method/);
   const images = await summary.locator('img').evaluateAll((imgs) => imgs.map((i) => i.naturalWidth));
   assert.ok(images.length >= 4 && images.every((w) => w > 0), `summary images: ${images}`);

@@ -41,7 +41,7 @@ const STEPS = [
       'merge will compare.',
     formula: [
       'steer so that  e = s₁ − 0.6 m → 0   (robot1; s₈ for robot2)',
-      'one picture per simulated second:  300 s → 301 pictures per robot',
+      'one picture per simulated second:  147 s → 148 pictures per robot (the thesis: 134 and 147)',
     ],
   },
   {
