@@ -422,3 +422,58 @@ fn camera_capture_and_mapping_do_not_change_the_run() {
         assert_eq!(b.frames.frames.len(), 1);
     }
 }
+
+/// The follower's scan-cover test answers exactly as the arctangent it
+/// replaces, on random points at every scale, on points a hair either side
+/// of the 88° edge, on the axes and at the origin.
+#[wasm_bindgen_test(unsupported = test)]
+fn scan_cover_test_answers_as_the_arctangent() {
+    use slamlab::follower::{outside_scan_cover, SCAN_COVER_RAD};
+    let t = SCAN_COVER_RAD.tan();
+    let atan = |q: DVec2| q.y.atan2(q.x).abs() > SCAN_COVER_RAD;
+    let mut rng = Rng::new(88);
+    let mut points = Vec::new();
+    for _ in 0..100_000 {
+        let scale = 10f64.powf(rng.range(-6.0, 2.0));
+        points.push(DVec2::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)) * scale);
+        // Near the edge: bearing 88° ± up to 1e-6 rad (decided from the
+        // tangent) or ± 1e-12 rad (within the band left to the arctangent).
+        let near = if rng.uniform() < 0.5 { 1e-6 } else { 1e-12 };
+        let a = SCAN_COVER_RAD + rng.range(-near, near);
+        let side = if rng.uniform() < 0.5 { 1.0 } else { -1.0 };
+        points.push(DVec2::new(a.cos(), side * a.sin()) * rng.range(0.01, 3.0));
+    }
+    for (x, y) in [
+        (0.0, 0.0),
+        (-0.0, 0.0),
+        (0.0, -0.0),
+        (0.0, 1.0),
+        (-1.0, 0.0),
+        (1.0, 0.0),
+        (1e-300, 1.0),
+        (1.0, t),
+        (1.0, -t),
+    ] {
+        points.push(DVec2::new(x, y));
+    }
+    let mut outside = 0;
+    for q in points {
+        assert_eq!(outside_scan_cover(q, t), atan(q), "{q:?}");
+        outside += usize::from(atan(q));
+    }
+    // Both answers were exercised, and near the edge both ways.
+    assert!(outside > 20_000 && outside < 180_000, "{outside}");
+}
+
+/// Beam unit vectors come from a table made once: the very numbers of the
+/// cosine and sine of each beam's bearing.
+#[wasm_bindgen_test(unsupported = test)]
+fn beam_units_are_the_cosine_and_sine_of_the_bearings() {
+    use slamlab::sensors::laser::{beam_bearing, beam_unit};
+    use slamlab::sensors::LASER_BEAMS;
+    for i in 0..LASER_BEAMS + 2 {
+        let a = beam_bearing(i);
+        assert_eq!(beam_unit(i), DVec2::new(a.cos(), a.sin()), "beam {i}");
+    }
+    assert_eq!(beam_unit(90), DVec2::new(1.0, 0.0));
+}

@@ -62,7 +62,32 @@ use glam::DVec2;
 /// Points further than this from the robot are forgotten (m).
 const MEMORY_RADIUS_M: f64 = 2.5;
 /// The current scan covers bearings within this of straight ahead (rad).
-const SCAN_COVER_RAD: f64 = 88.0 * std::f64::consts::PI / 180.0;
+pub const SCAN_COVER_RAD: f64 = 88.0 * std::f64::consts::PI / 180.0;
+
+/// Whether the robot-frame point `q` lies outside the scan's cover:
+/// `|atan2(q.y, q.x)| > SCAN_COVER_RAD`. Decided from the tangent (88° is
+/// below 90°: beyond it exactly when `|y| > x · tan 88°` or `x < 0`), and
+/// by the arctangent itself only within a relative 1e-9 of the boundary,
+/// far wider than either's rounding, so the answer is always the
+/// arctangent's, at a fraction of its cost.
+/// `tan_cover` is `SCAN_COVER_RAD.tan()`. (Points closer to the y axis than
+/// 1e-200 m, where products lose precision, go to the arctangent.)
+pub fn outside_scan_cover(q: DVec2, tan_cover: f64) -> bool {
+    if q.x < 0.0 {
+        return true;
+    }
+    if q.x > 1e-200 {
+        let edge = q.x * tan_cover;
+        let y = q.y.abs();
+        if y > edge * (1.0 + 1e-9) {
+            return true;
+        }
+        if y < edge * (1.0 - 1e-9) {
+            return false;
+        }
+    }
+    q.y.atan2(q.x).abs() > SCAN_COVER_RAD
+}
 /// Gain from distance error to lean toward / away from the wall (1/m).
 const LEAN_GAIN: f64 = 3.0;
 /// Gain from heading error to turn rate (1/s).
@@ -209,17 +234,14 @@ impl WallFollower {
         }
 
         // Points in the robot frame.
-        let pts: Vec<DVec2> = self
-            .memory
-            .iter()
-            .map(|&p| odom.inverse_transform_point(p))
-            .collect();
+        let frame = odom.frame();
+        let pts: Vec<DVec2> = self.memory.iter().map(|&p| frame.to_local(p)).collect();
 
         // The nearest point on the follow side (or straight ahead); right
         // after an encounter, on the remembered wall if it is in sight.
         let on_wall_line = |q: DVec2| match self.wall_line {
             Some((a, d)) if t_s < self.reacquire_until_s => {
-                crate::geom::cross(d, odom.transform_point(q) - a).abs() < WALL_LINE_TOLERANCE_M
+                crate::geom::cross(d, frame.to_parent(q) - a).abs() < WALL_LINE_TOLERANCE_M
             }
             _ => true,
         };
@@ -290,7 +312,7 @@ impl WallFollower {
         let robots: Vec<DVec2> = self
             .robots_seen
             .iter()
-            .map(|&p| odom.inverse_transform_point(p))
+            .map(|&p| frame.to_local(p))
             .collect();
         let centroid = (!self.robots_seen.is_empty()).then(|| {
             self.robots_seen.iter().copied().sum::<DVec2>() / self.robots_seen.len() as f64
@@ -379,14 +401,15 @@ impl WallFollower {
     /// Replaces the remembered points in the scan's field of view with the
     /// current scan, keeping older points behind the robot and within reach.
     fn remember(&mut self, odom: &Pose2, laser: &LaserScan) {
+        let frame = odom.frame();
+        let tan_cover = SCAN_COVER_RAD.tan();
         let mut kept: Vec<DVec2> = self
             .memory
             .iter()
             .copied()
             .filter(|&p| {
-                let q = odom.inverse_transform_point(p);
-                let r = q.length();
-                r < MEMORY_RADIUS_M && q.y.atan2(q.x).abs() > SCAN_COVER_RAD
+                let q = frame.to_local(p);
+                q.length() < MEMORY_RADIUS_M && outside_scan_cover(q, tan_cover)
             })
             .collect();
         self.robots_seen.clear();
@@ -394,7 +417,7 @@ impl WallFollower {
             if laser.max_range[i] || laser.ranges_m[i] > MEMORY_RADIUS_M {
                 continue;
             }
-            let p = odom.transform_point(laser.point(i));
+            let p = frame.to_parent(laser.point(i));
             if laser.reflective[i] {
                 self.robots_seen.push(p);
             } else if i % 2 == 0 {

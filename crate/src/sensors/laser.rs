@@ -28,6 +28,25 @@ pub fn beam_bearing(i: usize) -> f64 {
     -0.5 * LASER_FOV_RAD + LASER_FOV_RAD * i as f64 / (LASER_BEAMS - 1) as f64
 }
 
+/// Unit vector of beam `i` in the robot frame, `(cos, sin)` of its bearing,
+/// worked out once for all scans.
+pub fn beam_unit(i: usize) -> DVec2 {
+    static UNITS: std::sync::OnceLock<[DVec2; LASER_BEAMS]> = std::sync::OnceLock::new();
+    let units = UNITS.get_or_init(|| {
+        std::array::from_fn(|k| {
+            let a = beam_bearing(k);
+            DVec2::new(a.cos(), a.sin())
+        })
+    });
+    match units.get(i) {
+        Some(&u) => u,
+        None => {
+            let a = beam_bearing(i);
+            DVec2::new(a.cos(), a.sin())
+        }
+    }
+}
+
 /// One scan.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LaserScan {
@@ -42,8 +61,7 @@ pub struct LaserScan {
 impl LaserScan {
     /// The end point of beam `i` in the robot frame.
     pub fn point(&self, i: usize) -> DVec2 {
-        let a = beam_bearing(i);
-        DVec2::new(a.cos(), a.sin()) * self.ranges_m[i]
+        beam_unit(i) * self.ranges_m[i]
     }
 }
 
