@@ -68,7 +68,7 @@ test('guided mode: §6.2.1 to §6.2.5 on the thesis preset, numbers on the way, 
   const markers = await page.evaluate(() => window.slamlab.markers());
   assert.equal(markers.length, sel.robots[0].selected.length + sel.robots[1].selected.length, 'a marker per selected frame');
   const selText = await liveText(page);
-  assert.match(selText, new RegExp(`robot1: 301 pictures → ${sel.robots[0].square} facing a wall squarely → ${sel.robots[0].selected.length} kept`));
+  assert.match(selText, new RegExp(`robot1: 148 pictures → ${sel.robots[0].square} facing a wall squarely → ${sel.robots[0].selected.length} kept`));
   await page.waitForTimeout(300);
   const held = await mergeView(page);
   assert.equal(held.progress.stage, 'features');
