@@ -69,6 +69,12 @@ impl PoseFrame {
         )
     }
 
+    /// A direction of the local frame in the parent frame (rotation only).
+    pub fn rotate(&self, v: DVec2) -> DVec2 {
+        let (s, c) = (self.s, self.c);
+        DVec2::new(c * v.x - s * v.y, s * v.x + c * v.y)
+    }
+
     /// [`Pose2::inverse_transform_point`].
     pub fn to_local(&self, p: DVec2) -> DVec2 {
         let (s, c) = (self.s, self.c);

@@ -185,14 +185,13 @@ pub fn refine_to_surface(
     let reach = points.iter().map(|p| p.length()).fold(0.0, f64::max);
     // The surface point each point is measured against, at `pose`.
     let associate = |pose: &Pose2| -> Vec<Option<DVec2>> {
-        let (s, c) = pose.theta.sin_cos();
+        let frame = pose.frame();
         points
             .iter()
             .zip(normals)
             .map(|(&p, n)| {
-                let n = (*n)?;
-                let nw = DVec2::new(c * n.x - s * n.y, s * n.x + c * n.y);
-                surface_centroid(map, pose.transform_point(p), nw, radius)
+                let nw = frame.rotate((*n)?);
+                surface_centroid(map, frame.to_parent(p), nw, radius)
             })
             .collect()
     };
