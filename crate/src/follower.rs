@@ -70,6 +70,7 @@ pub const SCAN_COVER_RAD: f64 = 88.0 * std::f64::consts::PI / 180.0;
 /// by the arctangent itself only within a relative 1e-9 of the boundary,
 /// far wider than either's rounding, so the answer is always the
 /// arctangent's, at a fraction of its cost.
+///
 /// `tan_cover` is `SCAN_COVER_RAD.tan()`. (Points closer to the y axis than
 /// 1e-200 m, where products lose precision, go to the arctangent.)
 pub fn outside_scan_cover(q: DVec2, tan_cover: f64) -> bool {
@@ -88,6 +89,7 @@ pub fn outside_scan_cover(q: DVec2, tan_cover: f64) -> bool {
     }
     q.y.atan2(q.x).abs() > SCAN_COVER_RAD
 }
+
 /// Gain from distance error to lean toward / away from the wall (1/m).
 const LEAN_GAIN: f64 = 3.0;
 /// Gain from heading error to turn rate (1/s).
