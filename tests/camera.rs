@@ -348,8 +348,8 @@ fn texture_chunks_join_without_seams() {
 }
 
 /// A short unnamed wall's chunk is painted only as wide as the wall: the
-/// texels it has are the whole chunk's, at every mip level (up to
-/// anti-aliasing at a few shape edges).
+/// texels it has are the whole chunk's, at every mip level (up to a few
+/// texels at shape edges the narrower pixmap cuts).
 #[wasm_bindgen_test(unsupported = test)]
 fn narrow_chunks_hold_the_whole_chunks_texels() {
     let mut bank = TextureBank::new(3, 2.5);
@@ -374,11 +374,11 @@ fn narrow_chunks_hold_the_whole_chunks_texels() {
                 sum += f64::from(d);
             }
         }
-        // tiny-skia anti-aliases a path cut by the pixmap's edge a little
-        // differently: a few shape edges move by a fraction of a texel.
+        // tiny-skia rounds a path cut by the pixmap's edge a little
+        // differently: a texel or two at a shape's edge flips.
         let all = wb * a.height[level] as usize;
         assert!(
-            sum / (all as f64) < 0.25 && most <= 16,
+            differ * 50 <= all && sum / (all as f64) < 0.25,
             "level {level}: {differ} of {all} texels differ, by {sum} in all, most by {most}"
         );
     }

@@ -131,8 +131,8 @@ pub struct TextureKey {
     /// alone shows its texture (an unnamed wall) needs only its own length:
     /// a floor plan traced as thousands of short segments would otherwise
     /// paint a whole metre of texture for each centimetre of wall. The
-    /// texels painted are the same either way, up to anti-aliasing at a few
-    /// shape edges that the narrower pixmap cuts (`tests/camera.rs`).
+    /// texels painted are the same either way, up to a few texels at shape
+    /// edges that the narrower pixmap cuts (`tests/camera.rs`).
     pub width: u32,
 }
 
@@ -229,10 +229,19 @@ pub struct TextureBank {
     images: HashMap<String, ImageTexture>,
 }
 
+/// A solid paint, **not anti-aliased**. A texture is the wall itself, not
+/// a picture of it: its shapes may have hard, pixel-stepped edges like a
+/// tiled mosaic, and both robots see the same steps. What must not alias is
+/// the *camera's* sampling of the texture, and that is the mip levels' and
+/// bilinear filtering's job at render time. Anti-aliased filling (tiny-skia
+/// supersamples each scanline four times) cost half of all painting, and
+/// painting is the largest part of describing a run's frames
+/// (BENCHMARKS.md); without it, a chunk is also the same texel for texel
+/// however narrow a pixmap it is painted into.
 fn rgb(c: [u8; 3], a: u8) -> Paint<'static> {
     let mut p = Paint::default();
     p.set_color(Color::from_rgba8(c[0], c[1], c[2], a));
-    p.anti_alias = true;
+    p.anti_alias = false;
     p
 }
 
@@ -400,7 +409,7 @@ impl TextureBank {
                 pm.fill(Color::from_rgba8(g, g, g, 255));
             }
         }
-        Self::from_pixmap(&pm)
+        Self::from_pixmap(pm)
     }
 
     fn flat_chunk(w: u32, h: u32, g: u8) -> Chunk {
@@ -418,9 +427,10 @@ impl TextureBank {
         }
     }
 
-    fn from_pixmap(pm: &Pixmap) -> Chunk {
+    fn from_pixmap(pm: Pixmap) -> Chunk {
         let (w, h) = (pm.width(), pm.height());
-        let rgba = pm.data().to_vec();
+        // Opaque, so premultiplied bytes are straight RGBA: kept as they are.
+        let rgba = pm.take();
         let gray0: Vec<u8> = rgba
             .chunks_exact(4)
             .map(|p| luma(p[0], p[1], p[2]))
