@@ -32,19 +32,12 @@ pub fn beam_bearing(i: usize) -> f64 {
 /// worked out once for all scans.
 pub fn beam_unit(i: usize) -> DVec2 {
     static UNITS: std::sync::OnceLock<[DVec2; LASER_BEAMS]> = std::sync::OnceLock::new();
-    let units = UNITS.get_or_init(|| {
-        std::array::from_fn(|k| {
-            let a = beam_bearing(k);
-            DVec2::new(a.cos(), a.sin())
-        })
-    });
-    match units.get(i) {
-        Some(&u) => u,
-        None => {
-            let a = beam_bearing(i);
-            DVec2::new(a.cos(), a.sin())
-        }
-    }
+    let unit = |k: usize| {
+        let a = beam_bearing(k);
+        DVec2::new(a.cos(), a.sin())
+    };
+    let units = UNITS.get_or_init(|| std::array::from_fn(unit));
+    units.get(i).copied().unwrap_or_else(|| unit(i))
 }
 
 /// One scan.
