@@ -234,10 +234,9 @@ pub struct TextureBank {
 /// tiled mosaic, and both robots see the same steps. What must not alias is
 /// the *camera's* sampling of the texture, and that is the mip levels' and
 /// bilinear filtering's job at render time. Anti-aliased filling (tiny-skia
-/// supersamples each scanline four times) cost half of all painting, and
-/// painting is the largest part of describing a run's frames
-/// (BENCHMARKS.md); without it, a chunk is also the same texel for texel
-/// however narrow a pixmap it is painted into.
+/// covers each pixel row with four sub-scanlines) cost half of all
+/// painting, and painting was the largest part of describing a run's
+/// frames (BENCHMARKS.md, session 10).
 fn rgb(c: [u8; 3], a: u8) -> Paint<'static> {
     let mut p = Paint::default();
     p.set_color(Color::from_rgba8(c[0], c[1], c[2], a));
