@@ -8,6 +8,8 @@
 #   ./build.sh build         release wasm with SIMD128 + JS bindings into web/pkg
 #   ./build.sh build-scalar  the same without SIMD128 into web/pkg-scalar
 #   ./build.sh bench         the benchmarks behind BENCHMARKS.md
+#   ./build.sh test-real     the real-data suite: real maps and laser logs read
+#                            from ../shared/data (fails when it is missing)
 #
 # Each command installs what is missing (the wasm32 target, the wasm-bindgen
 # CLI pinned to the version in Cargo.lock, Debian's chromium + chromium-driver,
@@ -17,6 +19,9 @@ cd "$(dirname "$0")"
 ROOT=$(pwd)
 export PATH="$HOME/.cargo/bin:$PATH"
 SIMD_FLAGS='-C target-feature=+simd128'
+# The real-data suite's test files (each fails loudly without ../shared/data).
+REAL_RUST_TESTS=''
+REAL_NODE_TESTS=''
 
 log() { printf '\033[1;34m==>\033[0m %s\n' "$*" >&2; }
 
@@ -110,6 +115,37 @@ cmd_test() {
   node --test --test-concurrency=1 tests/cli.test.mjs tests/exercises.test.mjs tests/page.test.mjs tests/classroom.test.mjs
 }
 
+# The real-data suite reads third-party data from ../shared/data (or
+# $SLAMLAB_DATA); it is never copied into the repository. Missing data is a
+# failure, not a skip.
+data_dir() { echo "${SLAMLAB_DATA:-$ROOT/../shared/data}"; }
+
+cmd_test_real() {
+  local data
+  data=$(data_dir)
+  if [ ! -f "$data/README.md" ]; then
+    echo "error: the real-data suite needs ../shared/data (or SLAMLAB_DATA); not found at $data" >&2
+    exit 1
+  fi
+  export SLAMLAB_DATA="$data"
+  ensure_node_modules
+  cmd_build
+  if [ -z "$REAL_RUST_TESTS$REAL_NODE_TESTS" ]; then
+    echo "error: no real-data tests are registered in build.sh" >&2
+    exit 1
+  fi
+  if [ -n "$REAL_RUST_TESTS" ]; then
+    log "real-data tests: native (release)"
+    # shellcheck disable=SC2086
+    cargo test --release -p slamlab --features real-data $REAL_RUST_TESTS
+  fi
+  if [ -n "$REAL_NODE_TESTS" ]; then
+    log "real-data tests: command line (node --test)"
+    # shellcheck disable=SC2086
+    node --test --test-concurrency=1 $REAL_NODE_TESTS
+  fi
+}
+
 cmd_bench() {
   cmd_build
   log "native simulation benchmark"
@@ -124,5 +160,6 @@ case "${1:-}" in
   serve) cmd_serve ;;
   test) cmd_test ;;
   bench) cmd_bench ;;
-  *) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 2 ;;
+  test-real) cmd_test_real ;;
+  *) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 2 ;;
 esac
