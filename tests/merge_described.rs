@@ -6,8 +6,9 @@
 
 use slamlab::lab::Lab;
 use slamlab::maze::{random_maze, MazeSpec};
+use slamlab::merge::config::MergeConfig;
 use slamlab::merge::described::{decode, encode, PACKED_LEN};
-use slamlab::merge::job::{strongest_features, MergeConfig};
+use slamlab::merge::frames::strongest_features;
 use slamlab::merge::MergeMethod;
 use slamlab::surf::GrayImage;
 use wasm_bindgen_test::wasm_bindgen_test;

@@ -1,8 +1,8 @@
 //! The automatic map merge, part by part: lifting keypoints with the laser,
 //! the rigid MSAC, place recognition, the pairwise-consistency test, grid
-//! alignment, the verdict, fusion and the spanning tree; then the whole
-//! chain on simulated runs, scored against the truth (which only this test
-//! reads).
+//! alignment, the verdict, fusion and the spanning tree; then the product's
+//! whole automatic merge (`MergeJob`) on simulated runs, scored against the
+//! truth (which only this test reads).
 
 use glam::DVec2;
 use slamlab::camera::texture::TextureBank;
@@ -15,16 +15,13 @@ use slamlab::merge::consistency::{
 };
 use slamlab::merge::fuse::fuse;
 use slamlab::merge::graph::{spanning_tree, PairEdge};
-use slamlab::merge::lift::{
-    column_bearing_rad, laser_range_at, lift_keypoint, lift_keypoint_3d, liftable_features,
-    liftable_keypoints,
-};
+use slamlab::merge::job::{MergeConfig, MergeJob, Stage};
+use slamlab::merge::lift::{column_bearing_rad, laser_range_at, lift_keypoint_3d};
 use slamlab::merge::mapsearch::{dominant_rotation, search_maps, MapSearchConfig};
 use slamlab::merge::rigid::{fit_rigid_least_squares, fit_rigid_msac, RigidConfig};
-use slamlab::merge::verdict::{decide_pair, map_agreement, VerdictConfig};
-use slamlab::merge::verify::{verify_pair, VerifyConfig};
-use slamlab::merge::vocabulary::{propose_pairs, similarity, Bag, Vocabulary, VocabularyConfig};
-use slamlab::merge::{Candidate, FrameInfo, MergeStatus};
+use slamlab::merge::verdict::{decide_pair, map_agreement, PairDecision, VerdictConfig};
+use slamlab::merge::vocabulary::{propose_pairs, similarity, Vocabulary, VocabularyConfig};
+use slamlab::merge::{Candidate, FrameInfo, MergeMethod, MergeStatus};
 use slamlab::rng::Rng;
 use slamlab::scenario::{CameraSpec, Scenario, WallSpec};
 use slamlab::sensors::laser::{beam_bearing, LASER_BEAMS};
@@ -123,12 +120,14 @@ fn lifted_keypoints_land_on_the_wall_in_the_map_frame() {
     // the line y = 4 of the map frame.
     let pose = Pose2::new(1.0, 2.0, PI / 2.0);
     let frame = facing_wall(pose, 2.0);
-    let centre = lift_keypoint(&cam, &frame, 159.5).expect("lifts");
+    let lift =
+        |frame: &FrameInfo, x: f64| lift_keypoint_3d(&cam, frame, x, 119.5).map(|p| p.truncate());
+    let centre = lift(&frame, 159.5).expect("lifts");
     assert!((centre - DVec2::new(1.0, 4.0)).length() < 1e-9, "{centre}");
     // 80 px right of centre: X/Z = 80/f, so the point is 2·80/f = 0.577 m to
     // the robot's right, which is +x in the map. Interpolating 1/cos between
     // beams costs well under a millimetre.
-    let right = lift_keypoint(&cam, &frame, 239.5).expect("lifts");
+    let right = lift(&frame, 239.5).expect("lifts");
     assert!((right.y - 4.0).abs() < 1e-3, "{right}");
     assert!(
         (right.x - (1.0 + 2.0 * 80.0 / cam.f_px)).abs() < 1e-3,
@@ -146,33 +145,7 @@ fn lifted_keypoints_land_on_the_wall_in_the_map_frame() {
     );
     // Where the laser saw nothing, nothing lifts.
     let empty = frame_with_ranges(pose, |_| None);
-    assert_eq!(lift_keypoint(&cam, &empty, 159.5), None);
-}
-
-#[wasm_bindgen_test(unsupported = test)]
-fn only_keypoints_the_laser_reaches_are_kept_for_place_recognition() {
-    let cam = camera();
-    // The laser sees a wall 2 m ahead only to the left of the axis (bearings
-    // above 2°): columns left of x ≈ 149.8 lift, those right of it do not.
-    let frame = frame_with_ranges(Pose2::IDENTITY, |b| {
-        (b > 2f64.to_radians()).then(|| 2.0 / b.cos())
-    });
-    let mut f = Features::default();
-    for x in [10.0f32, 100.0, 140.0, 170.0, 300.0] {
-        f.keypoints.push(slamlab::surf::Keypoint {
-            x,
-            y: 120.0,
-            scale: 2.0,
-            orientation: 0.0,
-            laplacian: 1,
-            response: x,
-        });
-        f.descriptors.push(slamlab::surf::Descriptor([0.125; 64]));
-    }
-    assert_eq!(liftable_keypoints(&cam, &frame, &f), vec![0, 1, 2]);
-    let copy = liftable_features(&cam, &frame, &f);
-    assert_eq!(copy.keypoints.len(), 3);
-    assert_eq!(copy.keypoints[2].x, 140.0);
+    assert_eq!(lift(&empty, 159.5), None);
 }
 
 // ----- rigid ----------------------------------------------------------------
@@ -300,11 +273,8 @@ fn vocabulary_ranks_the_true_pair_first_among_frames_of_different_textures() {
     let sets: Vec<&Features> = fa.iter().chain(&fb).collect();
     let (vocab, bags) = Vocabulary::train_with_bags(&sets, &VocabularyConfig::default(), 5);
     assert!(vocab.len() > 100, "{} words", vocab.len());
-    // The bags from training are the bags `bag` gives, and a bag of all
-    // keypoints by index is the same bag.
+    // The bags from training are the bags `bag` gives.
     assert_eq!(bags[1], vocab.bag(&fa[1]));
-    let all: Vec<usize> = (0..fa[1].len()).collect();
-    assert_eq!(vocab.bag_of(&fa[1], &all), bags[1]);
     let (ba, bb) = (&bags[..4], &bags[4..]);
     for (i, bag) in ba.iter().enumerate() {
         let scores: Vec<f64> = bb.iter().map(|b| similarity(bag, b)).collect();
@@ -452,107 +422,34 @@ fn truth_b_in_a(sim: &Simulation) -> Pose2 {
     a.inverse().compose(&b)
 }
 
-/// What robot `i` knew at each frame: the SLAM estimate of the frame's step,
-/// the odometry turn over the last step.
-fn frame_infos(sim: &Simulation, i: usize) -> Vec<FrameInfo> {
-    let r = &sim.robots[i];
-    let odometry = &r.log.odometry;
-    r.frames
-        .frames
+/// The product's automatic merge ([`MergeJob`] with the default settings)
+/// on a finished run: the first robot pair's candidates, in table order,
+/// and the verdict on them.
+fn merge_auto(sim: &Simulation) -> (Vec<Candidate>, PairDecision) {
+    let config = MergeConfig::new(MergeMethod::Auto, sim.scenario.seed);
+    let mut job = MergeJob::new(sim, config).expect("a merge job");
+    job.run(sim).expect("the merge runs");
+    let feats: Vec<usize> = job
+        .robots
         .iter()
-        .map(|f| {
-            let before = f.step.checked_sub(1).and_then(|s| odometry.get(s));
-            FrameInfo {
-                index: f.index,
-                step: f.step,
-                pose: r
-                    .mapping
-                    .estimates()
-                    .get(f.step)
-                    .copied()
-                    .unwrap_or(f.odometry),
-                odometry: f.odometry,
-                turn_rad: before.map_or(0.0, |b| wrap_angle(f.odometry.theta - b.theta)),
-                sonar_m: f.sonar_m,
-                laser_mm: f.laser_mm,
-            }
-        })
-        .collect()
-}
-
-fn features(sim: &Simulation, i: usize) -> Vec<Features> {
-    sim.robots[i]
-        .frames
-        .frames
-        .iter()
-        .map(|f| {
-            let f = sim.frame_image(f);
-            let img = GrayImage::new(f.width as usize, f.height as usize, f.gray).expect("frame");
-            extract(&img, &upright())
-        })
-        .collect()
-}
-
-/// For each frame of both robots, in order, the keypoints whose bearing
-/// the laser reaches (the ones place recognition uses).
-fn liftable(
-    cam: &PinholeCamera,
-    infos: &[Vec<FrameInfo>; 2],
-    feats: &[Vec<Features>; 2],
-) -> Vec<Vec<usize>> {
-    (0..2)
-        .flat_map(|r| {
-            feats[r]
-                .iter()
-                .zip(&infos[r])
-                .map(|(f, info)| liftable_keypoints(cam, info, f))
-                .collect::<Vec<_>>()
-        })
-        .collect()
-}
-
-/// A vocabulary trained on both robots' frames (`keep`: their liftable
-/// keypoints) and each frame's bag of words.
-fn bags(feats: &[Vec<Features>; 2], keep: &[Vec<usize>]) -> Vec<Bag> {
-    let sets: Vec<&Features> = feats.iter().flatten().collect();
-    Vocabulary::train_with_bags_on(&sets, keep, &VocabularyConfig::default(), 1).1
-}
-
-/// The automatic chain on a finished run: features, place recognition on
-/// the keypoints that lift, verification, verdict.
-fn merge_auto(sim: &Simulation) -> (Vec<Candidate>, slamlab::merge::verdict::PairDecision) {
-    let cam = sim.camera.clone();
-    let infos = [frame_infos(sim, 0), frame_infos(sim, 1)];
-    let feats = [features(sim, 0), features(sim, 1)];
-    let mean_kp = feats.iter().flatten().map(|f| f.len()).sum::<usize>() as f64
-        / feats.iter().map(|f| f.len()).sum::<usize>().max(1) as f64;
+        .flat_map(|r| r.features.iter().map(|f| f.len()))
+        .collect();
+    let mean_kp = feats.iter().sum::<usize>() as f64 / feats.len().max(1) as f64;
     assert!(
         (80.0..500.0).contains(&mean_kp),
         "keypoints per 320 × 240 frame: {mean_kp}"
     );
-    let keep = liftable(&cam, &infos, &feats);
-    let bags = bags(&feats, &keep);
-    let n0 = feats[0].len();
-    let proposals = propose_pairs(&bags[..n0], &bags[n0..], 3, 300);
-    let cands: Vec<Candidate> = proposals
+    let pair = &job.pairs[0];
+    let cands: Vec<Candidate> = pair
+        .cells
         .iter()
-        .enumerate()
-        .filter_map(|(k, &(i, j, _))| {
-            verify_pair(
-                &cam,
-                &infos[0][i],
-                &feats[0][i],
-                &infos[1][j],
-                &feats[1][j],
-                &VerifyConfig::default(),
-                k as u64,
-            )
-            .candidate
-        })
+        .filter_map(|c| c.candidate.clone())
         .collect();
-    let map_a = sim.robots[0].mapping.map(MapperKind::Slam);
-    let map_b = sim.robots[1].mapping.map(MapperKind::Slam);
-    let d = decide_pair(&cands, map_a, map_b, &VerdictConfig::default());
+    let d = pair
+        .outcome
+        .as_ref()
+        .and_then(|o| o.verdict.clone())
+        .expect("the automatic method's verdict");
     (cands, d)
 }
 
@@ -982,62 +879,42 @@ fn bench_automatic_merge_stages() {
         ..slamlab::maze::MazeSpec::default()
     };
     let sim = run(&slamlab::maze::random_maze(&spec));
-    let cam = sim.camera.clone();
-    let t = now_ms();
-    let infos = [frame_infos(&sim, 0), frame_infos(&sim, 1)];
-    let feats = [features(&sim, 0), features(&sim, 1)];
-    let t_features = now_ms() - t;
-    let t = now_ms();
-    let keep = liftable(&cam, &infos, &feats);
-    let t_lift = now_ms() - t;
-    let t = now_ms();
-    let bags = bags(&feats, &keep);
-    let t_vocabulary = now_ms() - t;
-    let t = now_ms();
-    let n0 = feats[0].len();
-    let proposals = propose_pairs(&bags[..n0], &bags[n0..], 3, 600);
-    let t_proposals = now_ms() - t;
-    let t = now_ms();
-    let cands: Vec<Candidate> = proposals
+    let config = MergeConfig::new(MergeMethod::Auto, sim.scenario.seed);
+    let mut job = MergeJob::new(&sim, config).expect("a merge job");
+    // The product's own stages, one at a time: `advance` never crosses a
+    // stage boundary.
+    let mut times: Vec<(&str, f64)> = Vec::new();
+    while !job.is_done() {
+        let stage = job.stage();
+        let t = now_ms();
+        job.advance(&sim, usize::MAX).expect("advances");
+        times.push((stage.name(), now_ms() - t));
+    }
+    assert_eq!(job.stage(), Stage::Done);
+    let pair = &job.pairs[0];
+    let outcome = pair.outcome.as_ref().expect("decided");
+    let ms: Vec<String> = times.iter().map(|(s, t)| format!("{s} {t:.1}")).collect();
+    let verify_ms = times
         .iter()
-        .enumerate()
-        .filter_map(|(k, &(i, j, _))| {
-            let (a, b) = (&infos[0][i], &infos[1][j]);
-            let cfg = VerifyConfig::default();
-            verify_pair(&cam, a, &feats[0][i], b, &feats[1][j], &cfg, k as u64).candidate
-        })
-        .collect();
-    let t_verify = now_ms() - t;
-    let t = now_ms();
-    let map_a = sim.robots[0].mapping.map(MapperKind::Slam);
-    let map_b = sim.robots[1].mapping.map(MapperKind::Slam);
-    let d = decide_pair(&cands, map_a, map_b, &VerdictConfig::default());
-    let t_decide = now_ms() - t;
-    let t = now_ms();
-    let merged = fuse(
-        &[
-            (map_a, Pose2::IDENTITY),
-            (map_b, d.pose.unwrap_or_default()),
-        ],
-        map_a.config.clone(),
-    );
-    let t_fuse = now_ms() - t;
+        .find(|(s, _)| *s == "matching")
+        .map_or(0.0, |t| t.1);
     let report = format!(
-        "frames {}+{}, {} proposals, {} candidates: {}\n\
-         ms: features {t_features:.0}, lift filter {t_lift:.1}, vocabulary+bags {t_vocabulary:.1}, \
-         proposals {t_proposals:.1}, verify {t_verify:.0} ({:.2}/pair), decide {t_decide:.1}, \
-         fuse {t_fuse:.1} ({} cells)",
-        infos[0].len(),
-        infos[1].len(),
-        proposals.len(),
-        cands.len(),
-        d.reason,
-        t_verify / proposals.len().max(1) as f64,
-        merged.width() * merged.height()
+        "frames {}+{} (of {}+{}), {} proposals, {} candidates: {}\n\
+         ms: {} ({:.2}/pair), merged map {} cells",
+        job.robots[0].selected.len(),
+        job.robots[1].selected.len(),
+        job.robots[0].infos.len(),
+        job.robots[1].infos.len(),
+        pair.todo.len(),
+        outcome.candidates,
+        outcome.reason,
+        ms.join(", "),
+        verify_ms / pair.todo.len().max(1) as f64,
+        job.merged_map().map_or(0, |m| m.width() * m.height())
     );
     #[cfg(target_arch = "wasm32")]
     wasm_bindgen_test::console_log!("{report}");
     #[cfg(not(target_arch = "wasm32"))]
     println!("{report}");
-    assert_eq!(d.status, MergeStatus::Merged, "{}", d.reason);
+    assert_eq!(outcome.status, MergeStatus::Merged, "{}", outcome.reason);
 }

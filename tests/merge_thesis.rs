@@ -529,7 +529,7 @@ fn run_thesis(json: &str) -> ThesisRun {
     let mut infos = Vec::new();
     let mut features = Vec::new();
     for i in 0..2 {
-        let all = slamlab::merge::job::frame_infos(&sim, i);
+        let all = slamlab::merge::frames::frame_infos(&sim, i);
         let keep = select_frames(&all, &cfg);
         let frames = &sim.robots[i].frames.frames;
         features.push(

@@ -11,7 +11,8 @@
 //! to be faster but identical can be checked to be identical.
 
 use slamlab::lab::Lab;
-use slamlab::merge::job::{strongest_features, MergeConfig};
+use slamlab::merge::config::MergeConfig;
+use slamlab::merge::frames::strongest_features;
 use slamlab::merge::MergeMethod;
 use slamlab::surf::GrayImage;
 use std::time::Instant;

@@ -28,7 +28,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     lab.merge_start(method)?;
     lab.merge_finish()?;
     let total = start.elapsed().as_secs_f64() * 1e3;
-    let report = lab.report(slamlab::report::Timings {
+    let report = lab.report(slamlab::lab::report::Timings {
         simulate,
         total,
         ..Default::default()

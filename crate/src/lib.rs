@@ -7,25 +7,34 @@
 //! testable natively with `cargo test`; the only module that knows about
 //! JavaScript is [`bindings`], a thin wasm-bindgen layer over [`lab::Lab`].
 //!
-//! The folder list reads like the pipeline:
+//! The folder list reads like the pipeline, bottom layer first:
 //!
 //! | module | what it is |
 //! |---|---|
 //! | [`geom`] | poses, segments and exact ray casting |
 //! | [`rng`] | the seeded random numbers every noisy thing draws from |
-//! | [`scenario`] | the scenario file: walls, robots, noise; validation |
-//! | [`world`] | the walls robots live among, with a spatial index |
+//! | [`palette`] | robot colours, wall hint colours, name hashes |
 //! | [`kinematics`] | differential-drive motion of a P2DX |
-//! | [`odometry`] | wheel encoders with slip and bias: what the robot believes |
+//! | [`world`] | the walls robots live among, with a spatial index |
+//! | [`maze`] | random mazes for exercises and benchmarks |
+//! | [`scenario`] | the scenario file: walls, robots, noise; validation |
 //! | [`sensors`] | the sonar ring and the laser range finder |
-//! | [`camera`] | the pinhole camera, wall textures, frame capture |
+//! | [`odometry`] | wheel encoders with slip and bias: what the robot believes |
 //! | [`follower`] | the thesis's wall-following controller |
-//! | [`sim`] | the fixed-step simulation and its per-robot logs |
-//! | [`slam`] | per-robot occupancy grids, scan matching, map scoring and export |
-//! | [`render`] | tiny-skia drawing of the world, robots and sensors |
-//! | [`report`] | the JSON report of a run (`web/cli.mjs run --json`) |
+//! | [`camera`] | the pinhole camera, wall textures, frame capture |
 //! | [`surf`] | SURF features, matching and MSAC (Bay et al. 2008) |
-//! | [`lab`] | the session object the page and the CLI drive |
+//! | [`slam`] | per-robot occupancy grids, scan matching, map scoring and export |
+//! | [`sim`] | the fixed-step simulation and its per-robot logs |
+//! | [`render`] | tiny-skia drawing of the world, robots and sensors |
+//! | [`merge`] | map merging: the thesis's method, the automatic one, a map-only baseline |
+//! | [`lab`] | the session the page and the CLI drive, its views and the report |
+//! | [`bindings`] | the wasm-bindgen boundary |
+//!
+//! One rule orders them: `bindings → lab → {merge, render} → sim → {slam,
+//! camera, surf, follower, odometry} → … → geom`. A module imports only
+//! modules of the layers below it; nothing below [`lab`] imports it, and
+//! only [`lab`] reads the ground truth (to score and to show it).
+//! `tests/layers.rs` checks the rule (ARCHITECTURE.md, "Layers").
 //!
 //! Conventions everywhere: metres, radians, seconds; world frame x right,
 //! y up, θ counter-clockwise from +x. Only the renderer flips y.
@@ -39,8 +48,8 @@ pub mod lab;
 pub mod maze;
 pub mod merge;
 pub mod odometry;
+pub mod palette;
 pub mod render;
-pub mod report;
 pub mod rng;
 pub mod scenario;
 pub mod sensors;

@@ -14,6 +14,7 @@
 
 use crate::geom::Pose2;
 use crate::kinematics::P2dx;
+use crate::palette::{robot_colour, texture_hint};
 use crate::scenario::Scenario;
 use crate::sensors::laser::beam_bearing;
 use crate::sensors::sonar::SONAR_COUNT;
@@ -25,18 +26,6 @@ use tiny_skia::{
     Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Rect, Stroke, StrokeDash,
     Transform,
 };
-
-/// Robot colours, by robot index (the page's legend uses the same list).
-pub const ROBOT_COLOURS: [[u8; 3]; 8] = [
-    [31, 119, 180],
-    [230, 110, 20],
-    [44, 160, 44],
-    [200, 40, 60],
-    [148, 103, 189],
-    [140, 86, 75],
-    [220, 100, 180],
-    [23, 170, 190],
-];
 
 /// Which layers to draw.
 #[derive(Clone, Debug, Deserialize)]
@@ -138,39 +127,6 @@ impl RenderOptions {
             (self.height as f64 / 2.0 - (p.y - self.center[1]) * self.scale) as f32,
         )
     }
-}
-
-/// The hint colour for a wall's texture (a muted hue from the name; plain
-/// walls are grey).
-pub fn texture_hint(name: Option<&str>, wall_index: usize, seed: u64) -> [u8; 3] {
-    let key = match name {
-        Some("plain") => return [150, 150, 150],
-        Some(n) => crate::camera::texture::name_hash(n),
-        None => crate::camera::texture::name_hash(&format!("wall#{wall_index}/{seed}")),
-    };
-    let hue = (key % 360) as f64;
-    hsl_to_rgb(hue, 0.45, 0.45)
-}
-
-/// HSL (hue in degrees, saturation and lightness in 0..1) to 8-bit RGB.
-pub fn hsl_to_rgb(h: f64, s: f64, l: f64) -> [u8; 3] {
-    let c = (1.0 - (2.0 * l - 1.0).abs()) * s;
-    let hp = h / 60.0;
-    let x = c * (1.0 - (hp % 2.0 - 1.0).abs());
-    let (r, g, b) = match hp as u32 {
-        0 => (c, x, 0.0),
-        1 => (x, c, 0.0),
-        2 => (0.0, c, x),
-        3 => (0.0, x, c),
-        4 => (x, 0.0, c),
-        _ => (c, 0.0, x),
-    };
-    let m = l - c / 2.0;
-    [
-        ((r + m) * 255.0).round() as u8,
-        ((g + m) * 255.0).round() as u8,
-        ((b + m) * 255.0).round() as u8,
-    ]
 }
 
 fn paint(rgb: [u8; 3], alpha: f32) -> Paint<'static> {
@@ -306,7 +262,9 @@ pub fn scale_bar_m(scale_px_per_m: f64) -> f64 {
 }
 
 /// Renders the scenario (and the running simulation, if any) into `pm`,
-/// which must be `opts.width × opts.height`.
+/// which must be `opts.width × opts.height`. Layers go bottom to top: the
+/// grid, the trajectories, the walls, the sensors, the robots, the camera
+/// marker and the scale bar.
 pub fn render_world(
     pm: &mut Pixmap,
     scenario: &Scenario,
@@ -315,6 +273,36 @@ pub fn render_world(
 ) {
     pm.fill(Color::from_rgba8(250, 250, 247, 255));
     let o = opts;
+    if o.layers.grid {
+        draw_grid(pm, o);
+    }
+    // Trajectories under everything else.
+    if let Some(sim) = sim {
+        draw_paths(pm, o, sim);
+    }
+    draw_walls(pm, o, scenario);
+    // Sensors, then robots on top.
+    let poses: Vec<Pose2> = match sim {
+        Some(sim) => sim.robots.iter().map(|r| r.truth).collect(),
+        None => scenario.robots.iter().map(|r| r.start_pose()).collect(),
+    };
+    if let Some(sim) = sim {
+        draw_sensors(pm, o, sim);
+    }
+    let problems: Vec<usize> = if sim.is_none() {
+        misplaced_robots(scenario)
+    } else {
+        Vec::new()
+    };
+    draw_robots(pm, o, &poses, &problems);
+    if let Some(marker) = o.marker {
+        draw_marker(pm, o, marker);
+    }
+    draw_scale_bar(pm, o);
+}
+
+/// The metric grid: every `grid_step_m`, a darker line every fifth.
+fn draw_grid(pm: &mut Pixmap, o: &RenderOptions) {
     let (w, h) = (o.width as f64, o.height as f64);
     let world_lo = DVec2::new(
         o.center[0] - w / 2.0 / o.scale,
@@ -324,80 +312,80 @@ pub fn render_world(
         o.center[0] + w / 2.0 / o.scale,
         o.center[1] + h / 2.0 / o.scale,
     );
-
-    if o.layers.grid {
-        // Axis-aligned 1 px lines: filled as pixel-aligned rectangles, which
-        // is an order of magnitude cheaper than stroking long thin paths.
-        let step = grid_step_m(o.scale);
-        let (minor, major) = (paint([225, 225, 220], 1.0), paint([200, 200, 195], 1.0));
-        let mut x = (world_lo.x / step).floor() * step;
-        while x <= world_hi.x {
-            let (px, _) = o.to_px(DVec2::new(x, 0.0));
-            let is_major = ((x / step).round() as i64) % 5 == 0;
-            if let Some(r) = Rect::from_xywh(px.floor(), 0.0, 1.0, o.height as f32) {
-                pm.fill_rect(
-                    r,
-                    if is_major { &major } else { &minor },
-                    Transform::identity(),
-                    None,
-                );
-            }
-            x += step;
+    // Axis-aligned 1 px lines: filled as pixel-aligned rectangles, which
+    // is an order of magnitude cheaper than stroking long thin paths.
+    let step = grid_step_m(o.scale);
+    let (minor, major) = (paint([225, 225, 220], 1.0), paint([200, 200, 195], 1.0));
+    let mut x = (world_lo.x / step).floor() * step;
+    while x <= world_hi.x {
+        let (px, _) = o.to_px(DVec2::new(x, 0.0));
+        let is_major = ((x / step).round() as i64) % 5 == 0;
+        if let Some(r) = Rect::from_xywh(px.floor(), 0.0, 1.0, o.height as f32) {
+            pm.fill_rect(
+                r,
+                if is_major { &major } else { &minor },
+                Transform::identity(),
+                None,
+            );
         }
-        let mut y = (world_lo.y / step).floor() * step;
-        while y <= world_hi.y {
-            let (_, py) = o.to_px(DVec2::new(0.0, y));
-            let is_major = ((y / step).round() as i64) % 5 == 0;
-            if let Some(r) = Rect::from_xywh(0.0, py.floor(), o.width as f32, 1.0) {
-                pm.fill_rect(
-                    r,
-                    if is_major { &major } else { &minor },
-                    Transform::identity(),
-                    None,
-                );
-            }
-            y += step;
+        x += step;
+    }
+    let mut y = (world_lo.y / step).floor() * step;
+    while y <= world_hi.y {
+        let (_, py) = o.to_px(DVec2::new(0.0, y));
+        let is_major = ((y / step).round() as i64) % 5 == 0;
+        if let Some(r) = Rect::from_xywh(0.0, py.floor(), o.width as f32, 1.0) {
+            pm.fill_rect(
+                r,
+                if is_major { &major } else { &minor },
+                Transform::identity(),
+                None,
+            );
+        }
+        y += step;
+    }
+}
+
+/// Each robot's odometry path (dashed, from its true start) and true path.
+fn draw_paths(pm: &mut Pixmap, o: &RenderOptions, sim: &Simulation) {
+    for (i, r) in sim.robots.iter().enumerate() {
+        let c = robot_colour(i);
+        if o.layers.odometry_path && r.log.odometry.len() > 1 {
+            let start = r.spec.start_pose();
+            let mut s = stroke(1.0);
+            s.line_join = LineJoin::Bevel;
+            s.line_cap = LineCap::Butt;
+            s.dash = StrokeDash::new(vec![6.0, 4.0], 0.0);
+            let dark = [c[0] / 2, c[1] / 2, c[2] / 2];
+            polyline(
+                pm,
+                o,
+                r.log.odometry.iter().map(|p| start.compose(p).position()),
+                1.5,
+                &paint(dark, 0.8),
+                &s,
+            );
+        }
+        if o.layers.truth_path && r.log.truth.len() > 1 {
+            polyline(
+                pm,
+                o,
+                r.log.truth.iter().map(|p| p.position()),
+                1.5,
+                &paint(c, 0.75),
+                &Stroke {
+                    width: 2.0,
+                    line_join: LineJoin::Bevel,
+                    ..Stroke::default()
+                },
+            );
         }
     }
+}
 
-    // Trajectories under everything else.
-    if let Some(sim) = sim {
-        for (i, r) in sim.robots.iter().enumerate() {
-            let c = ROBOT_COLOURS[i % ROBOT_COLOURS.len()];
-            if o.layers.odometry_path && r.log.odometry.len() > 1 {
-                let start = r.spec.start_pose();
-                let mut s = stroke(1.0);
-                s.line_join = LineJoin::Bevel;
-                s.line_cap = LineCap::Butt;
-                s.dash = StrokeDash::new(vec![6.0, 4.0], 0.0);
-                let dark = [c[0] / 2, c[1] / 2, c[2] / 2];
-                polyline(
-                    pm,
-                    o,
-                    r.log.odometry.iter().map(|p| start.compose(p).position()),
-                    1.5,
-                    &paint(dark, 0.8),
-                    &s,
-                );
-            }
-            if o.layers.truth_path && r.log.truth.len() > 1 {
-                polyline(
-                    pm,
-                    o,
-                    r.log.truth.iter().map(|p| p.position()),
-                    1.5,
-                    &paint(c, 0.75),
-                    &Stroke {
-                        width: 2.0,
-                        line_join: LineJoin::Bevel,
-                        ..Stroke::default()
-                    },
-                );
-            }
-        }
-    }
-
-    // Walls.
+/// The walls (outlined, tinted with their texture's hint colour), the
+/// selected one highlighted, and the wall being drawn.
+fn draw_walls(pm: &mut Pixmap, o: &RenderOptions, scenario: &Scenario) {
     let wall_px = (0.06 * o.scale).clamp(2.0, 8.0) as f32;
     let outline = paint([40, 40, 40], 1.0);
     for (i, wall) in scenario.walls.iter().enumerate() {
@@ -443,86 +431,87 @@ pub fn render_world(
             &s,
         );
     }
+}
 
-    // Sensors, then robots on top.
-    let poses: Vec<Pose2> = match sim {
-        Some(sim) => sim.robots.iter().map(|r| r.truth).collect(),
-        None => scenario.robots.iter().map(|r| r.start_pose()).collect(),
-    };
-    if let Some(sim) = sim {
-        for r in &sim.robots {
-            if o.layers.sonar {
-                let half = (r.sonar_cone_rad() / 2.0).max(0.02);
-                for k in 0..SONAR_COUNT {
-                    let (origin, axis) = Sonar::axis(&r.truth, k);
-                    let range = r.last_sonar.ranges_m[k];
-                    let mut pts = vec![origin];
-                    for j in 0..=6 {
-                        let a = axis - half + 2.0 * half * j as f64 / 6.0;
-                        pts.push(origin + DVec2::new(a.cos(), a.sin()) * range);
+/// Sonar cones and laser rays at the robots' true poses.
+fn draw_sensors(pm: &mut Pixmap, o: &RenderOptions, sim: &Simulation) {
+    for r in &sim.robots {
+        if o.layers.sonar {
+            let half = (r.sonar_cone_rad() / 2.0).max(0.02);
+            for k in 0..SONAR_COUNT {
+                let (origin, axis) = Sonar::axis(&r.truth, k);
+                let range = r.last_sonar.ranges_m[k];
+                let mut pts = vec![origin];
+                for j in 0..=6 {
+                    let a = axis - half + 2.0 * half * j as f64 / 6.0;
+                    pts.push(origin + DVec2::new(a.cos(), a.sin()) * range);
+                }
+                let echo = !r.last_sonar.no_echo[k];
+                polygon(
+                    pm,
+                    o,
+                    &pts,
+                    Some(&paint(
+                        if echo { [60, 170, 90] } else { [160, 200, 170] },
+                        0.18,
+                    )),
+                    Some((&paint([40, 130, 70], 0.5), &stroke(1.0))),
+                );
+            }
+        }
+        if o.layers.laser {
+            let origin = r.truth.position();
+            let (mut hits, mut misses) = (Vec::new(), Vec::new());
+            let mut dots = PathBuilder::new();
+            for b in 0..r.last_scan.ranges_m.len() {
+                let a = r.truth.theta + beam_bearing(b);
+                let end = origin + DVec2::new(a.cos(), a.sin()) * r.last_scan.ranges_m[b];
+                if r.last_scan.max_range[b] {
+                    misses.push((origin, end));
+                } else {
+                    hits.push((origin, end));
+                    let (x, y) = o.to_px(end);
+                    if let Some(rect) = Rect::from_xywh(x - 1.5, y - 1.5, 3.0, 3.0) {
+                        dots.push_rect(rect);
                     }
-                    let echo = !r.last_sonar.no_echo[k];
-                    polygon(
-                        pm,
-                        o,
-                        &pts,
-                        Some(&paint(
-                            if echo { [60, 170, 90] } else { [160, 200, 170] },
-                            0.18,
-                        )),
-                        Some((&paint([40, 130, 70], 0.5), &stroke(1.0))),
-                    );
                 }
             }
-            if o.layers.laser {
-                let origin = r.truth.position();
-                let (mut hits, mut misses) = (Vec::new(), Vec::new());
-                let mut dots = PathBuilder::new();
-                for b in 0..r.last_scan.ranges_m.len() {
-                    let a = r.truth.theta + beam_bearing(b);
-                    let end = origin + DVec2::new(a.cos(), a.sin()) * r.last_scan.ranges_m[b];
-                    if r.last_scan.max_range[b] {
-                        misses.push((origin, end));
-                    } else {
-                        hits.push((origin, end));
-                        let (x, y) = o.to_px(end);
-                        if let Some(rect) = Rect::from_xywh(x - 1.5, y - 1.5, 3.0, 3.0) {
-                            dots.push_rect(rect);
-                        }
-                    }
-                }
-                let mut s1 = stroke(1.0);
-                s1.line_cap = LineCap::Butt;
-                segments(pm, o, &misses, &paint([220, 40, 40], 0.07), &s1);
-                segments(pm, o, &hits, &paint([220, 40, 40], 0.22), &s1);
-                if let Some(path) = dots.finish() {
-                    pm.fill_path(
-                        &path,
-                        &paint([200, 20, 20], 0.9),
-                        FillRule::Winding,
-                        Transform::identity(),
-                        None,
-                    );
-                }
+            let mut s1 = stroke(1.0);
+            s1.line_cap = LineCap::Butt;
+            segments(pm, o, &misses, &paint([220, 40, 40], 0.07), &s1);
+            segments(pm, o, &hits, &paint([220, 40, 40], 0.22), &s1);
+            if let Some(path) = dots.finish() {
+                pm.fill_path(
+                    &path,
+                    &paint([200, 20, 20], 0.9),
+                    FillRule::Winding,
+                    Transform::identity(),
+                    None,
+                );
             }
         }
     }
-    let problems: Vec<usize> = if sim.is_none() {
-        scenario
-            .placement_problems()
-            .iter()
-            .filter_map(|p| {
-                p.field
-                    .strip_prefix("robots[")
-                    .and_then(|s| s.split(']').next())
-                    .and_then(|s| s.parse().ok())
-            })
-            .collect()
-    } else {
-        Vec::new()
-    };
+}
+
+/// Indices of the robots a placement problem names (`robots[i]...`).
+fn misplaced_robots(scenario: &Scenario) -> Vec<usize> {
+    scenario
+        .placement_problems()
+        .iter()
+        .filter_map(|p| {
+            p.field
+                .strip_prefix("robots[")
+                .and_then(|s| s.split(']').next())
+                .and_then(|s| s.parse().ok())
+        })
+        .collect()
+}
+
+/// The robots' bodies with a heading arrow; the selected one
+/// highlighted, misplaced ones outlined in red.
+fn draw_robots(pm: &mut Pixmap, o: &RenderOptions, poses: &[Pose2], problems: &[usize]) {
     for (i, pose) in poses.iter().enumerate() {
-        let c = ROBOT_COLOURS[i % ROBOT_COLOURS.len()];
+        let c = robot_colour(i);
         let body = P2dx::body(pose);
         if o.selected_robot == Some(i) {
             polygon(
@@ -554,38 +543,41 @@ pub fn render_world(
         ];
         polygon(pm, o, &tri, Some(&paint([255, 255, 255], 1.0)), None);
     }
+}
 
-    if let Some([x, y, th]) = o.marker {
-        let p = DVec2::new(x, y);
-        let reach = 2.5;
-        let h = o.marker_fov / 2.0;
-        let wedge = [
-            p,
-            p + DVec2::from_angle(th + h) * reach,
-            p + DVec2::from_angle(th - h) * reach,
-        ];
-        polygon(
-            pm,
-            o,
-            &wedge,
-            Some(&paint([255, 190, 0], 0.25)),
-            Some((&paint([200, 120, 0], 1.0), &stroke(2.0))),
+/// Where a camera frame was taken: the field of view as a wedge.
+fn draw_marker(pm: &mut Pixmap, o: &RenderOptions, [x, y, th]: [f64; 3]) {
+    let p = DVec2::new(x, y);
+    let reach = 2.5;
+    let h = o.marker_fov / 2.0;
+    let wedge = [
+        p,
+        p + DVec2::from_angle(th + h) * reach,
+        p + DVec2::from_angle(th - h) * reach,
+    ];
+    polygon(
+        pm,
+        o,
+        &wedge,
+        Some(&paint([255, 190, 0], 0.25)),
+        Some((&paint([200, 120, 0], 1.0), &stroke(2.0))),
+    );
+    let (cx, cy) = o.to_px(p);
+    let mut pb = PathBuilder::new();
+    pb.push_circle(cx, cy, 6.0);
+    if let Some(path) = pb.finish() {
+        pm.fill_path(
+            &path,
+            &paint([200, 120, 0], 1.0),
+            FillRule::Winding,
+            Transform::identity(),
+            None,
         );
-        let (cx, cy) = o.to_px(p);
-        let mut pb = PathBuilder::new();
-        pb.push_circle(cx, cy, 6.0);
-        if let Some(path) = pb.finish() {
-            pm.fill_path(
-                &path,
-                &paint([200, 120, 0], 1.0),
-                FillRule::Winding,
-                Transform::identity(),
-                None,
-            );
-        }
     }
+}
 
-    // Scale bar, bottom left (its label is drawn by the page).
+/// The scale bar, bottom left (its label is drawn by the page).
+fn draw_scale_bar(pm: &mut Pixmap, o: &RenderOptions) {
     let bar_m = scale_bar_m(o.scale);
     let bar_px = (bar_m * o.scale) as f32;
     let y0 = o.height as f32 - 18.0;

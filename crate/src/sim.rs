@@ -19,6 +19,13 @@
 //! 5. **log** — one row per robot, as the thesis recorded them (§6.2.1):
 //!    time, odometry pose, 8 sonar ranges, 181 laser ranges; the true pose is
 //!    kept beside it, for scoring only.
+//! 6. **map** — each robot's two mappers ([`crate::slam`]) take the
+//!    odometry pose and the scan: the thesis's grid at raw odometry poses,
+//!    and online SLAM. Never the truth.
+//! 7. **camera** — once per capture period, each robot stores a frame: its
+//!    pose, the other robots' bodies and a noise seed, from which the
+//!    picture is rendered on demand ([`crate::camera::capture`]), with the
+//!    readings it took beside it.
 //!
 //! Row 0 is the start (time 0); a run of `n` steps has `n + 1` rows.
 
@@ -449,14 +456,14 @@ impl Simulation {
         for r in &mut self.robots {
             r.log_row(step, t);
         }
-        // 5b. mapping: odometry pose and scan into both mappers (never the truth)
+        // 6. map: odometry pose and scan into both mappers (never the truth)
         let t0 = self.clock.map_or(0.0, |now| now());
         if self.mapping {
             for r in &mut self.robots {
                 r.mapping.observe(&r.odometry.pose(), &r.last_scan);
             }
         }
-        // 6. camera frames, once per capture period
+        // 7. camera frames, once per capture period
         let t1 = self.clock.map_or(0.0, |now| now());
         self.capture_due_frames();
         if let Some(now) = self.clock {

@@ -7,19 +7,10 @@
 //! end, the verdict. Robot pairs and frame pairs are addressed by the
 //! positions `mergeViewJson` lists.
 
+use super::convert::{js_err as err, put_rgba, to_json as json};
 use super::Lab;
-use crate::merge::selection::{is_square, SONAR_4, SONAR_5};
 use crate::merge::MergeMethod;
 use wasm_bindgen::prelude::*;
-use wasm_bindgen::Clamped;
-
-fn err(e: impl std::fmt::Display) -> JsError {
-    JsError::new(&e.to_string())
-}
-
-fn json<T: serde::Serialize>(v: &T) -> Result<String, JsError> {
-    serde_json::to_string(v).map_err(err)
-}
 
 #[wasm_bindgen]
 impl Lab {
@@ -67,7 +58,7 @@ impl Lab {
         method: &str,
     ) -> Result<Vec<f32>, JsError> {
         let method = MergeMethod::parse(method).map_err(err)?;
-        let spec: crate::merge::described::FrameSpec =
+        let spec: crate::lab::described::FrameSpec =
             serde_json::from_str(spec_json).map_err(|e| err(format!("frame spec: {e}")))?;
         let f = self.inner.describe_frame_spec(&spec, method).map_err(err)?;
         Ok(crate::merge::described::encode(&f))
@@ -78,7 +69,7 @@ impl Lab {
     /// lab to describe with `describeRendered`.
     #[wasm_bindgen(js_name = renderFrameSpec)]
     pub fn render_frame_spec(&mut self, spec_json: &str) -> Result<Vec<u8>, JsError> {
-        let spec: crate::merge::described::FrameSpec =
+        let spec: crate::lab::described::FrameSpec =
             serde_json::from_str(spec_json).map_err(|e| err(format!("frame spec: {e}")))?;
         Ok(self.inner.render_frame_spec(&spec).map_err(err)?.gray)
     }
@@ -122,7 +113,7 @@ impl Lab {
     /// done); stepping, resetting or editing drops it.
     #[wasm_bindgen(js_name = hasMerge)]
     pub fn has_merge(&self) -> bool {
-        self.inner.merge.is_some()
+        self.inner.has_merge()
     }
 
     /// Does up to `units` units of work (frames described, frame pairs
@@ -157,48 +148,7 @@ impl Lab {
     /// (its map frame, never the truth).
     #[wasm_bindgen(js_name = mergeSelectionJson)]
     pub fn merge_selection_json(&self) -> Result<String, JsError> {
-        let job = self
-            .inner
-            .merge
-            .as_ref()
-            .ok_or_else(|| JsError::new("no merge has been started"))?;
-        let cfg = &job.config.selection;
-        let mm = |x: f64| (x * 1000.0).round() / 1000.0;
-        let robots: Vec<serde_json::Value> = job
-            .robots
-            .iter()
-            .map(|r| {
-                let selected: Vec<serde_json::Value> = r
-                    .selected
-                    .iter()
-                    .map(|&k| {
-                        let f = &r.infos[k];
-                        serde_json::json!({
-                            "frame": f.index,
-                            "step": f.step,
-                            "sonar4_m": mm(f64::from(f.sonar_m[SONAR_4])),
-                            "sonar5_m": mm(f64::from(f.sonar_m[SONAR_5])),
-                            "pose": [f.pose.x, f.pose.y, f.pose.theta],
-                        })
-                    })
-                    .collect();
-                serde_json::json!({
-                    "name": r.name,
-                    "captured": r.infos.len(),
-                    "square": r.infos.iter().filter(|f| is_square(f, cfg)).count(),
-                    "selected": selected,
-                })
-            })
-            .collect();
-        json(&serde_json::json!({
-            "method": job.config.method.name(),
-            "sonar_tolerance_m": cfg.sonar_tolerance_m,
-            "min_front_range_m": cfg.min_front_range_m,
-            "max_front_range_m": cfg.max_front_range_m,
-            "max_turn_per_step_rad": cfg.max_turn_per_step_rad,
-            "min_separation_m": cfg.min_separation_m,
-            "robots": robots,
-        }))
+        json(&self.inner.merge_selection().map_err(err)?)
     }
 
     /// One checked frame pair's matches, homography, quad and candidate
@@ -223,11 +173,7 @@ impl Lab {
         height: u32,
     ) -> Result<(), JsError> {
         let rgba = self.inner.merged_rgba(width, height).map_err(err)?;
-        let img =
-            web_sys::ImageData::new_with_u8_clamped_array_and_sh(Clamped(&rgba), width, height)
-                .map_err(|_| JsError::new("could not make ImageData"))?;
-        ctx.put_image_data(&img, 0.0, 0.0)
-            .map_err(|_| JsError::new("could not draw into the canvas"))
+        put_rgba(ctx, &rgba, width, height)
     }
 
     /// The merged map as straight RGBA pixels (for node and tests).

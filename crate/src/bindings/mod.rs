@@ -6,44 +6,18 @@
 //! function returns `Result<_, JsError>` so bad input reaches JavaScript as
 //! an exception with a message, never as a panic or a trap.
 
+mod convert;
 mod merge;
 mod slam;
 pub mod surf;
 
 use crate::lab;
-use crate::render::{grid_step_m, scale_bar_m, RenderOptions};
-use crate::report::Timings;
+use crate::lab::report::Timings;
+use crate::render::RenderOptions;
 use crate::scenario::Scenario;
+use convert::{js_err, put_rgba};
 use image::ImageEncoder;
 use wasm_bindgen::prelude::*;
-use wasm_bindgen::Clamped;
-
-fn js_err(e: impl std::fmt::Display) -> JsError {
-    JsError::new(&e.to_string())
-}
-
-/// Copies straight RGBA pixels into a canvas context at (0, 0).
-fn put_rgba(
-    ctx: &web_sys::CanvasRenderingContext2d,
-    rgba: &[u8],
-    w: u32,
-    h: u32,
-) -> Result<(), JsError> {
-    let img = web_sys::ImageData::new_with_u8_clamped_array_and_sh(Clamped(rgba), w, h)
-        .map_err(|_| JsError::new("could not make ImageData"))?;
-    ctx.put_image_data(&img, 0.0, 0.0)
-        .map_err(|_| JsError::new("could not draw into the canvas"))
-}
-
-fn frame_meta(f: &crate::camera::capture::CapturedFrame) -> serde_json::Value {
-    serde_json::json!({
-        "index": f.index,
-        "step": f.step,
-        "time_s": f.time_s,
-        "odometry": [f.odometry.x, f.odometry.y, f.odometry.theta],
-        "truth": [f.truth.x, f.truth.y, f.truth.theta],
-    })
-}
 
 #[wasm_bindgen]
 extern "C" {
@@ -97,7 +71,7 @@ pub fn version() -> String {
 /// `[[r, g, b], ...]` (the page's legend and readouts use the same).
 #[wasm_bindgen(js_name = robotColours)]
 pub fn robot_colours() -> String {
-    serde_json::to_string(&crate::render::ROBOT_COLOURS).unwrap_or_else(|_| "[]".into())
+    serde_json::to_string(&crate::palette::ROBOT_COLOURS).unwrap_or_else(|_| "[]".into())
 }
 
 /// Whether this build was compiled with wasm SIMD128.
@@ -139,13 +113,7 @@ impl Lab {
     /// Placement problems, as a JSON array of `{field, message}`.
     #[wasm_bindgen(js_name = problemsJson)]
     pub fn problems_json(&self) -> String {
-        let v: Vec<serde_json::Value> = self
-            .inner
-            .problems()
-            .iter()
-            .map(|p| serde_json::json!({"field": p.field, "message": p.message, "text": p.to_string()}))
-            .collect();
-        serde_json::Value::Array(v).to_string()
+        self.inner.problems_json()
     }
 
     /// Sets the seed (a whole number from 0 to 2^53) and stops the run.
@@ -196,7 +164,7 @@ impl Lab {
     /// Live state for readouts (JSON).
     #[wasm_bindgen(js_name = stateJson)]
     pub fn state_json(&self) -> Result<String, JsError> {
-        serde_json::to_string(&self.inner.state()).map_err(js_err)
+        convert::to_json(&self.inner.state())
     }
 
     /// Sets the view (JSON: width, height, center, scale, layers,
@@ -212,29 +180,20 @@ impl Lab {
     /// `{center, scale}` as JSON.
     #[wasm_bindgen(js_name = fitView)]
     pub fn fit_view(&mut self, width: u32, height: u32) -> Result<String, JsError> {
-        let v = self.inner.fit_view(width, height).map_err(js_err)?;
-        Ok(serde_json::json!({"center": v.center, "scale": v.scale}).to_string())
+        self.inner.fit_view_json(width, height).map_err(js_err)
     }
 
     /// Grid spacing and scale-bar length (m) the renderer uses at a zoom,
     /// so the page can label them.
     #[wasm_bindgen(js_name = viewMetrics)]
     pub fn view_metrics(&self) -> String {
-        let s = self.inner.view().scale;
-        serde_json::json!({"grid_m": grid_step_m(s), "scale_bar_m": scale_bar_m(s)}).to_string()
+        self.inner.view_metrics_json()
     }
 
     /// Renders the view and draws it into a 2-D canvas context.
     pub fn draw(&mut self, ctx: &web_sys::CanvasRenderingContext2d) -> Result<(), JsError> {
         let pm = self.inner.render().map_err(js_err)?;
-        let img = web_sys::ImageData::new_with_u8_clamped_array_and_sh(
-            Clamped(pm.data()),
-            pm.width(),
-            pm.height(),
-        )
-        .map_err(|_| JsError::new("could not make ImageData"))?;
-        ctx.put_image_data(&img, 0.0, 0.0)
-            .map_err(|_| JsError::new("could not draw into the canvas"))
+        put_rgba(ctx, pm.data(), pm.width(), pm.height())
     }
 
     /// Renders the view into the lab's own image without copying it out
@@ -262,9 +221,7 @@ impl Lab {
     /// The camera image size as JSON `{width, height, hfov_deg}`.
     #[wasm_bindgen(js_name = cameraInfo)]
     pub fn camera_info(&self) -> String {
-        let c = &self.inner.scenario().camera;
-        serde_json::json!({"width": c.width, "height": c.height, "hfov_deg": c.hfov_deg})
-            .to_string()
+        self.inner.camera_info_json()
     }
 
     /// Draws what robot `robot`'s camera sees now (noise-free, in colour) into
@@ -297,9 +254,7 @@ impl Lab {
     /// odometry: [x, y, theta], truth: [x, y, theta]}]` (no pixels).
     #[wasm_bindgen(js_name = framesJson)]
     pub fn frames_json(&self, robot: u32) -> Result<String, JsError> {
-        let frames = self.inner.frames(robot as usize).map_err(js_err)?;
-        let v: Vec<serde_json::Value> = frames.iter().map(frame_meta).collect();
-        Ok(serde_json::Value::Array(v).to_string())
+        self.inner.frames_json(robot as usize).map_err(js_err)
     }
 
     /// How many frames robot `robot` has captured (and kept).
@@ -311,12 +266,9 @@ impl Lab {
     /// Metadata of frame `index` of robot `robot`, as JSON.
     #[wasm_bindgen(js_name = frameJson)]
     pub fn frame_json(&self, robot: u32, index: u32) -> Result<String, JsError> {
-        Ok(frame_meta(
-            self.inner
-                .frame(robot as usize, index as usize)
-                .map_err(js_err)?,
-        )
-        .to_string())
+        self.inner
+            .frame_json(robot as usize, index as usize)
+            .map_err(js_err)
     }
 
     /// Draws captured frame `index` of robot `robot` (grey) into a context.

@@ -5,14 +5,10 @@
 //! and error series the page plots. Robots are addressed by index (the
 //! order of the scenario's `robots`); `robotIndex(name)` looks one up.
 
+use super::convert::{js_err as err, put_rgba, to_json};
 use super::Lab;
 use crate::slam::MapperKind;
 use wasm_bindgen::prelude::*;
-use wasm_bindgen::Clamped;
-
-fn err(e: impl std::fmt::Display) -> JsError {
-    JsError::new(&e.to_string())
-}
 
 fn kind(mapper: &str) -> Result<MapperKind, JsError> {
     MapperKind::parse(mapper).map_err(err)
@@ -58,14 +54,14 @@ impl Lab {
             .inner
             .map_info(robot as usize, kind(mapper)?)
             .map_err(err)?;
-        serde_json::to_string(&info).map_err(err)
+        to_json(&info)
     }
 
     /// ATE and map figures of one robot (JSON, as in the report).
     #[wasm_bindgen(js_name = slamFiguresJson)]
     pub fn slam_figures_json(&self, robot: u32) -> Result<String, JsError> {
         let f = self.inner.slam_figures(robot as usize).map_err(err)?;
-        serde_json::to_string(&f).map_err(err)
+        to_json(&f)
     }
 
     /// Position error over time, `{"rows": [[t, slam_m, odometry_m], ...]}`,
@@ -76,7 +72,7 @@ impl Lab {
             .inner
             .slam_errors(robot as usize, max_rows as usize)
             .map_err(err)?;
-        serde_json::to_string(&s).map_err(err)
+        to_json(&s)
     }
 
     /// Draws a robot's map with its estimated (red) and true (green) paths
@@ -94,10 +90,7 @@ impl Lab {
             .inner
             .map_rgba(robot as usize, kind(mapper)?, width, height)
             .map_err(err)?;
-        let img = web_sys::ImageData::new_with_u8_clamped_array_and_sh(Clamped(&px), width, height)
-            .map_err(|_| JsError::new("could not make ImageData"))?;
-        ctx.put_image_data(&img, 0.0, 0.0)
-            .map_err(|_| JsError::new("could not draw into the canvas"))
+        put_rgba(ctx, &px, width, height)
     }
 
     /// Re-matches robot `robot`'s latest scan against its SLAM map from the
@@ -105,17 +98,7 @@ impl Lab {
     /// Returns the matched pose `[x, y, theta]`.
     #[wasm_bindgen(js_name = benchMatchScan)]
     pub fn bench_match_scan(&self, robot: u32) -> Result<Vec<f64>, JsError> {
-        let sim = self
-            .inner
-            .simulation()
-            .ok_or_else(|| JsError::new("nothing has run yet: run the scenario first"))?;
-        let r = sim
-            .robots
-            .get(robot as usize)
-            .ok_or_else(|| JsError::new(&format!("no robot with index {robot}")))?;
-        let m = &r.mapping;
-        let out =
-            crate::slam::mapper::match_scan(&m.slam_map, &r.last_scan, &m.estimate(), &m.config);
-        Ok(vec![out.pose.x, out.pose.y, out.pose.theta])
+        let pose = self.inner.bench_match_scan(robot as usize).map_err(err)?;
+        Ok(vec![pose.x, pose.y, pose.theta])
     }
 }

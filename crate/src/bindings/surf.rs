@@ -10,6 +10,8 @@
 use serde_json::{json, Value};
 use wasm_bindgen::prelude::*;
 
+use super::convert::js_err;
+
 use crate::surf::{
     extract, fit_homography, match_features, Features, GrayImage, MatchConfig, MatchedRegion,
     MsacConfig, SurfConfig, SurfError,
@@ -74,10 +76,6 @@ fn match_value(image1: &GrayImage, f1: &Features, image2: &GrayImage, f2: &Featu
 fn pt(f: &Features, i: usize) -> [f64; 2] {
     let k = &f.keypoints[i];
     [k.x as f64, k.y as f64]
-}
-
-fn js_err(e: SurfError) -> JsError {
-    JsError::new(&e.to_string())
 }
 
 /// SURF keypoints and descriptors of a PNG/JPEG, as the `features` JSON.

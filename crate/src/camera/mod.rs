@@ -135,7 +135,7 @@ pub fn robot_boxes(poses: &[Pose2], skip: usize) -> Vec<RobotBox> {
         .filter(|(j, _)| *j != skip)
         .map(|(j, pose)| RobotBox {
             corners: crate::kinematics::P2dx::body(pose).corners,
-            rgb: crate::render::ROBOT_COLOURS[j % crate::render::ROBOT_COLOURS.len()],
+            rgb: crate::palette::robot_colour(j),
         })
         .collect()
 }

@@ -25,6 +25,7 @@
 //! featureless wall (nothing for SURF to find, on purpose), and `image:NAME`,
 //! a picture the user loaded (see [`ImageTexture`]).
 
+use crate::palette::{hsl_to_rgb, name_hash};
 use crate::rng::Rng;
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -67,16 +68,6 @@ fn stroke_path(pm: &mut Pixmap, path: &Path, paint: &Paint, stroke: &Stroke, t: 
     if reaches(pm, path.bounds(), t, 4.0 * stroke.width + 1.0) {
         pm.stroke_path(path, paint, stroke, t, None);
     }
-}
-
-/// FNV-1a hash of a string.
-pub fn name_hash(s: &str) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for b in s.bytes() {
-        h ^= b as u64;
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    h
 }
 
 /// The look of a texture family.
@@ -253,7 +244,7 @@ fn colour(rng: &mut Rng, base_hue: f64, spread: f64) -> [u8; 3] {
     let h = (base_hue + rng.range(-spread, spread)).rem_euclid(360.0);
     let s = rng.range(0.25, 0.85);
     let l = rng.range(0.12, 0.88);
-    crate::render::hsl_to_rgb(h, s, l)
+    hsl_to_rgb(h, s, l)
 }
 
 impl Clone for TextureBank {

@@ -18,12 +18,12 @@
 //!    method's choice, thinning by motion, only ever adds frames as the run
 //!    goes on; a frame chosen early and dropped later costs work, not
 //!    correctness.
-//! 2. [`FrameSpec`]: one frame's parts, as JSON, for the other lab, which
-//!    describes it with [`describe_spec`] and sends back the features
-//!    packed in a flat `f32` array ([`encode`]). The work splits in two
-//!    halves as well: the other lab may only render the frame
-//!    ([`render_spec`]) and send its grey bytes back, for this lab to
-//!    describe ([`describe_image`]). Rendering is the half that needs the
+//! 2. One frame's parts, as JSON (the session's `FrameSpec`, in
+//!    `crate::lab::described`, since they hold the camera's true pose), for
+//!    the other lab, which describes it and sends back the features packed
+//!    in a flat `f32` array ([`encode`]). The work splits in two halves as
+//!    well: the other lab may only render the frame and send its grey bytes
+//!    back, for this lab to describe ([`describe_image`]). Rendering is the half that needs the
 //!    wall textures, which a lab paints on first use; a lab that has painted
 //!    them renders fast, and SURF needs nothing painted at all.
 //! 3. [`DescribedFrames`]: where this lab keeps what came back ([`decode`]),
@@ -32,13 +32,11 @@
 //!    there and describes the rest itself, so the report is the same however
 //!    many threads helped, or none.
 
-use super::job::{frame_infos, frames_taking_part, strongest_features, MergeConfig};
-use crate::camera::{CameraImage, RobotBox};
-use crate::geom::Pose2;
+use super::config::MergeConfig;
+use super::frames::{frame_infos, frames_taking_part, strongest_features};
+use crate::camera::CameraImage;
 use crate::sim::Simulation;
 use crate::surf::{Descriptor, Features, GrayImage, Keypoint, SurfConfig};
-use glam::DVec2;
-use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 
 /// Numbers per keypoint in [`encode`]'s array: x, y, scale, orientation,
@@ -57,76 +55,6 @@ pub fn frames_to_describe(sim: &Simulation, config: &MergeConfig) -> Vec<(usize,
                 .collect::<Vec<_>>()
         })
         .collect()
-}
-
-/// Another robot's body as a frame shows it.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct BodySpec {
-    pub corners: Vec<[f64; 2]>,
-    pub rgb: [u8; 3],
-}
-
-/// One stored frame's parts: enough for a lab of the same scenario to
-/// render it exactly. The truth pose is the simulator's (a camera images the
-/// real world); nothing of it reaches the merge but the pixels.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct FrameSpec {
-    pub robot: usize,
-    pub index: usize,
-    pub truth: [f64; 3],
-    pub others: Vec<BodySpec>,
-    pub noise_seed: u64,
-}
-
-impl FrameSpec {
-    /// Frame `index` of robot `robot` of `sim`.
-    pub fn of(sim: &Simulation, robot: usize, index: usize) -> Result<FrameSpec, String> {
-        let r = sim
-            .robots
-            .get(robot)
-            .ok_or_else(|| format!("no robot {robot}"))?;
-        let f = r
-            .frames
-            .frames
-            .iter()
-            .find(|f| f.index == index)
-            .ok_or_else(|| format!("robot {robot} has no frame {index}"))?;
-        Ok(FrameSpec {
-            robot,
-            index,
-            truth: [f.truth.x, f.truth.y, f.truth.theta],
-            others: f
-                .others
-                .iter()
-                .map(|b| BodySpec {
-                    corners: b.corners.iter().map(|c| [c.x, c.y]).collect(),
-                    rgb: b.rgb,
-                })
-                .collect(),
-            noise_seed: f.noise_seed,
-        })
-    }
-}
-
-/// The features of the frame `spec` describes, rendered by `sim` (a
-/// simulation of the same scenario, at any time of its run).
-pub fn describe_spec(sim: &Simulation, spec: &FrameSpec, config: &MergeConfig) -> Features {
-    describe_image(render_spec(sim, spec), config)
-}
-
-/// The picture of the frame `spec` describes, rendered by `sim` (a
-/// simulation of the same scenario): exactly the frame's own pixels.
-pub fn render_spec(sim: &Simulation, spec: &FrameSpec) -> CameraImage {
-    let others: Vec<RobotBox> = spec
-        .others
-        .iter()
-        .map(|b| RobotBox {
-            corners: b.corners.iter().map(|c| DVec2::new(c[0], c[1])).collect(),
-            rgb: b.rgb,
-        })
-        .collect();
-    let truth = Pose2::new(spec.truth[0], spec.truth[1], spec.truth[2]);
-    sim.render_stored(&truth, &others, spec.noise_seed)
 }
 
 /// The features a merge with `config` finds in a rendered frame (none in

@@ -3,11 +3,15 @@
 //! [`MergeJob`] runs a whole merge — any of the three methods — in small
 //! increments, so the page can draw the matched-pair table as it fills in
 //! and stay responsive, and the command line can time each stage. The
-//! stages are those of thesis §6.2, generalised:
+//! stages are those of thesis §6.2, generalised. The job is the driver: at
+//! each stage it asks the method's own stages ([`super::method`], one file
+//! per method behind the [`MethodStages`] trait) what to do, and never
+//! which method it runs.
 //!
 //! 1. **Selection.** The thesis keeps only frames taken facing a wall
 //!    squarely, thinned by distance (§6.2.2, [`super::selection`]); the
-//!    automatic method keeps every frame; the map-only baseline uses none.
+//!    automatic method keeps every frame, thinned by motion; the map-only
+//!    baseline uses none, and the job goes straight to the decision.
 //! 2. **Features.** Upright SURF on each kept frame (the cameras never
 //!    roll, so orientation assignment would only cost time and
 //!    distinctiveness: Bay et al. 2008 §4.1). One unit of work per frame.
@@ -30,88 +34,26 @@
 //!    robot's frame ([`super::fuse`]).
 //!
 //! The job reads only what the robots knew: their frames, their SLAM poses
-//! and their maps. It never looks at the truth; [`crate::lab`] scores it.
+//! and their maps. It never looks at the truth; the session layer
+//! (`crate::lab`) scores it.
 
-use super::baseline::{map_only_merge, BaselineConfig};
 use super::described::{describe_image, DescribedFrames};
+use super::frames::MergeInput;
 use super::fuse::fuse;
 use super::graph::{spanning_tree, PairEdge};
-use super::mapsearch::{search_maps, MapSearchConfig};
-use super::selection::{select_frames, SelectionConfig};
-use super::thesis::{thesis_merge, DistanceSolution, PairMatch};
-use super::verdict::{decide_pair_after_search, SearchSummary, VerdictConfig};
+use super::method::{pose3, stages_of, MethodStages, PairInput};
 use super::verify::{verify_pair, PairCheck, VerifyConfig};
-use super::vocabulary::{propose_pairs, Bag, Vocabulary, VocabularyConfig};
-use super::{Candidate, FrameInfo, MergeMethod, MergeStatus};
+use super::MergeStatus;
 use crate::camera::PinholeCamera;
-use crate::geom::{wrap_angle, Pose2};
-use crate::sim::Simulation;
-use crate::slam::{MapperKind, OccupancyGrid};
-use crate::surf::descriptor::describe_all;
-use crate::surf::orientation::assign_orientations;
-use crate::surf::{FastHessian, Features, GrayImage, Homography, IntegralImage, SurfConfig};
+use crate::geom::Pose2;
+use crate::scenario::CameraSpec;
+use crate::slam::OccupancyGrid;
 use serde::Serialize;
 
-/// Every setting of a merge. `MergeConfig::new(method)` gives the defaults.
-#[derive(Clone, Debug)]
-pub struct MergeConfig {
-    pub method: MergeMethod,
-    /// SURF on the robots' frames (upright by default).
-    pub surf: SurfConfig,
-    pub selection: SelectionConfig,
-    pub verify: VerifyConfig,
-    pub vocabulary: VocabularyConfig,
-    /// At most this many keypoints per frame, the strongest (det H) kept:
-    /// description and matching cost grow with the count, and the weakest
-    /// blobs are the least repeatable.
-    pub max_keypoints: usize,
-    /// Automatic method: a frame takes part only if the robot moved at
-    /// least `min_motion_m` or turned `min_turn_rad` since the last frame
-    /// that does (consecutive views 0.3 m apart show nearly the same).
-    pub min_motion_m: f64,
-    pub min_turn_rad: f64,
-    /// Automatic method: frames of the other robot proposed per frame.
-    pub proposals_per_frame: usize,
-    /// Automatic method: at most this many pairs verified per robot pair.
-    pub max_pairs: usize,
-    pub verdict: VerdictConfig,
-    /// Automatic method: when vision finds no transform the maps confirm,
-    /// search the maps alone ([`super::mapsearch`]); `None` turns that off.
-    pub map_search: Option<MapSearchConfig>,
-    pub baseline: BaselineConfig,
-    /// Which map each robot contributes (SLAM by default).
-    pub mapper: MapperKind,
-    /// Seed of every random choice (MSAC samples, k-means seeding).
-    pub seed: u64,
-}
-
-impl MergeConfig {
-    pub fn new(method: MergeMethod, seed: u64) -> MergeConfig {
-        MergeConfig {
-            method,
-            // Three octaves: the fourth's filters (up to 195 px) hardly fit
-            // a 240-pixel-high frame.
-            surf: SurfConfig {
-                upright: true,
-                octaves: 3,
-                ..SurfConfig::default()
-            },
-            selection: SelectionConfig::default(),
-            max_keypoints: 160,
-            min_motion_m: 0.5,
-            min_turn_rad: 15f64.to_radians(),
-            verify: VerifyConfig::default(),
-            vocabulary: VocabularyConfig::default(),
-            proposals_per_frame: 3,
-            max_pairs: 600,
-            verdict: VerdictConfig::default(),
-            map_search: Some(MapSearchConfig::default()),
-            baseline: BaselineConfig::default(),
-            mapper: MapperKind::Slam,
-            seed,
-        }
-    }
-}
+// Also here for the job's callers: the settings, and the pieces a job
+// works on.
+pub use super::config::MergeConfig;
+pub use super::work::{Cell, PairOutcome, PairWork, RobotFrames};
 
 /// The stage a job is in; [`MergeJob::advance`] never crosses a stage
 /// boundary in one call, so a caller can time each stage.
@@ -139,70 +81,13 @@ impl Stage {
     }
 }
 
-/// One robot's side of the merge.
-pub struct RobotFrames {
-    pub name: String,
-    /// What the robot knew at each captured frame, in capture order.
-    pub infos: Vec<FrameInfo>,
-    /// Positions in `infos` that take part (all of them for the automatic
-    /// method, the thesis's selection otherwise).
-    pub selected: Vec<usize>,
-    /// SURF features per selected frame (same order as `selected`).
-    pub features: Vec<Features>,
-}
-
-/// One checked frame pair: a cell of the matched-pair table.
-#[derive(Clone, Debug, Serialize)]
-pub struct Cell {
-    /// Positions in the two robots' `selected` lists.
-    pub row: usize,
-    pub col: usize,
-    /// The figure the table shows: MSAC homography inliers for the thesis's
-    /// method (its Table 1), rigid-transform inliers for the automatic one.
-    pub inliers: u32,
-    /// Ratio-test matches.
-    pub matches: u32,
-    /// Rigid-fit inliers, also when too few for a candidate (automatic
-    /// method): the "too few inliers" reason quotes the best.
-    #[serde(skip)]
-    pub rigid_inliers: u32,
-    /// The candidate transform this pair gives (automatic method).
-    #[serde(skip)]
-    pub candidate: Option<Candidate>,
-    /// The MSAC homography and the matched-region quad (thesis Figure 8).
-    #[serde(skip)]
-    pub homography: Option<Homography>,
-    pub quad: Option<[[f64; 2]; 4]>,
-}
-
-/// The work on one pair of robots.
-pub struct PairWork {
-    pub a: usize,
-    pub b: usize,
-    /// Frame pairs to check, as positions in the `selected` lists.
-    pub todo: Vec<(usize, usize)>,
-    pub cells: Vec<Cell>,
-    pub outcome: Option<PairOutcome>,
-}
-
-/// The decision on one pair of robots.
-#[derive(Clone, Debug, Serialize)]
-pub struct PairOutcome {
-    pub a: String,
-    pub b: String,
-    pub status: MergeStatus,
-    pub reason: String,
-    pub confidence: f64,
-    /// Pose of b's map frame in a's map frame, `[x, y, theta]`.
-    pub pose: Option<[f64; 3]>,
-    /// Candidates found and how many of them agree (automatic method).
-    pub candidates: usize,
-    pub support: usize,
-    /// Thesis method: the best pair and the second (table positions), and
-    /// the numbers of §6.2.4.
-    pub best: Option<[usize; 2]>,
-    pub second: Option<[usize; 2]>,
-    pub distance: Option<DistanceSolution>,
+/// Milliseconds per merge stage (zero without a clock; measured by the
+/// caller, as the job reads no clock).
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct MergeTimes {
+    pub features: f64,
+    pub matching: f64,
+    pub merge: f64,
 }
 
 /// The pose of one robot's map frame in the merged frame.
@@ -251,114 +136,31 @@ pub struct MergeJob {
     cursor: (usize, usize),
     /// Matching stage: next pair of robots.
     pair_cursor: usize,
-    bags: Vec<Vec<Bag>>,
+    /// The method's stages ([`super::method`]).
+    method: &'static dyn MethodStages,
     outcome: Option<MergeOutcome>,
     merged: Option<OccupancyGrid>,
-    /// Time per stage, measured by the caller's clock ([`crate::merge::lab`]).
-    pub times_ms: super::lab::MergeTimes,
+    /// Time per stage, measured by the caller's clock (the session's).
+    pub times_ms: MergeTimes,
     /// Frames described ahead, elsewhere ([`super::described`]): taken
     /// instead of describing them again.
     described: DescribedFrames,
 }
 
-fn pose3(p: &Pose2) -> [f64; 3] {
-    [p.x, p.y, p.theta]
-}
-
-/// What robot `i` knew at each of its frames (never the truth).
-pub fn frame_infos(sim: &Simulation, i: usize) -> Vec<FrameInfo> {
-    let r = &sim.robots[i];
-    let estimates = r.mapping.estimates();
-    let odometry = &r.log.odometry;
-    r.frames
-        .frames
-        .iter()
-        .map(|f| {
-            let odo = odometry.get(f.step).copied().unwrap_or(f.odometry);
-            let before = f
-                .step
-                .checked_sub(1)
-                .and_then(|s| odometry.get(s))
-                .copied()
-                .unwrap_or(odo);
-            FrameInfo {
-                index: f.index,
-                step: f.step,
-                pose: estimates.get(f.step).copied().unwrap_or(f.odometry),
-                odometry: f.odometry,
-                turn_rad: wrap_angle(odo.theta - before.theta),
-                sonar_m: f.sonar_m,
-                laser_mm: f.laser_mm,
-            }
-        })
-        .collect()
-}
-
-/// Positions in `infos` of the frames taken after the robot moved at least
-/// `min_m` or turned `min_rad` (SLAM pose) since the last frame kept; the
-/// first frame is always kept.
-pub fn thin_by_motion(infos: &[FrameInfo], min_m: f64, min_rad: f64) -> Vec<usize> {
-    let mut kept: Vec<usize> = Vec::new();
-    for (k, f) in infos.iter().enumerate() {
-        let keep = match kept.last() {
-            None => true,
-            Some(&j) => {
-                let last = &infos[j].pose;
-                (f.pose.position() - last.position()).length() >= min_m
-                    || wrap_angle(f.pose.theta - last.theta).abs() >= min_rad
-            }
-        };
-        if keep {
-            kept.push(k);
-        }
-    }
-    kept
-}
-
-/// Positions in `infos` of the frames a merge with `config` describes: all
-/// of them thinned by motion for the automatic method, the thesis's
-/// selection for its method, none for the map-only one.
-pub fn frames_taking_part(infos: &[FrameInfo], config: &MergeConfig) -> Vec<usize> {
-    match config.method {
-        MergeMethod::Auto => thin_by_motion(infos, config.min_motion_m, config.min_turn_rad),
-        MergeMethod::Thesis => select_frames(infos, &config.selection),
-        MergeMethod::MapOnly => Vec::new(),
-    }
-}
-
-/// SURF on one frame, keeping the `max` strongest keypoints (ties broken
-/// by position, so the result is deterministic) before describing them.
-pub fn strongest_features(image: &GrayImage, config: &SurfConfig, max: usize) -> Features {
-    let integral = IntegralImage::new(image);
-    let mut keypoints = FastHessian::new(config).detect(&integral);
-    keypoints.sort_by(|a, b| {
-        b.response
-            .total_cmp(&a.response)
-            .then(a.y.total_cmp(&b.y))
-            .then(a.x.total_cmp(&b.x))
-    });
-    keypoints.truncate(max);
-    if !config.upright {
-        assign_orientations(&integral, &mut keypoints);
-    }
-    let descriptors = describe_all(&integral, &keypoints);
-    Features {
-        keypoints,
-        descriptors,
-    }
-}
-
 impl MergeJob {
-    /// A merge of the robots of a finished (or paused) simulation.
-    /// Fails when there is nothing to merge.
-    pub fn new(sim: &Simulation, config: MergeConfig) -> Result<MergeJob, String> {
-        let method = config.method;
-        let robots: Vec<RobotFrames> = (0..sim.robots.len())
-            .map(|i| {
-                let infos = frame_infos(sim, i);
-                let selected = frames_taking_part(&infos, &config);
+    /// A merge of the robots of a finished (or paused) simulation, or of
+    /// any other [`MergeInput`]. Fails when there is nothing to merge.
+    pub fn new(input: &impl MergeInput, config: MergeConfig) -> Result<MergeJob, String> {
+        let method = stages_of(config.method);
+        let robots: Vec<RobotFrames> = input
+            .robot_names()
+            .into_iter()
+            .enumerate()
+            .map(|(i, name)| {
+                let infos = input.frame_infos(i);
+                let selected = method.select(&infos, &config);
                 RobotFrames {
-                    name: sim.robots[i].spec.name.clone(),
+                    name,
                     infos,
                     selected,
                     features: Vec::new(),
@@ -379,20 +181,22 @@ impl MergeJob {
         }
         // A lone robot has nothing to match: straight to the verdict (which
         // says so) without describing a single frame.
-        let stage = match method {
-            MergeMethod::MapOnly => Stage::Decision,
-            _ if pairs.is_empty() => Stage::Decision,
-            _ => Stage::Features,
+        let stage = if method.uses_frames() && !pairs.is_empty() {
+            Stage::Features
+        } else {
+            Stage::Decision
         };
         Ok(MergeJob {
-            camera: sim.camera.clone(),
+            camera: input
+                .camera()
+                .unwrap_or_else(|| PinholeCamera::new(&CameraSpec::default())),
             config,
             robots,
             pairs,
             stage,
             cursor: (0, 0),
             pair_cursor: 0,
-            bags: Vec::new(),
+            method,
             outcome: None,
             merged: None,
             times_ms: Default::default(),
@@ -445,25 +249,26 @@ impl MergeJob {
 
     /// Does up to `units` units of work (frames described, pairs checked;
     /// the proposal, decision and fusion stages are one unit each) without
-    /// leaving the current stage. `sim` must be the simulation the job was
-    /// made from. Returns the units done (0 once finished).
-    pub fn advance(&mut self, sim: &Simulation, units: usize) -> Result<usize, String> {
+    /// leaving the current stage. `input` must be what the job was made
+    /// from. Returns the units done (0 once finished).
+    pub fn advance(&mut self, input: &impl MergeInput, units: usize) -> Result<usize, String> {
         let units = units.max(1);
         match self.stage {
-            Stage::Features => Ok(self.advance_features(sim, units)),
+            Stage::Features => Ok(self.advance_features(input, units)),
             Stage::Proposals => {
-                self.propose();
+                self.method
+                    .propose(&self.robots, &mut self.pairs, &self.config);
                 self.stage = Stage::Matching;
                 Ok(1)
             }
             Stage::Matching => Ok(self.advance_matching(units)),
             Stage::Decision => {
-                self.decide(sim);
+                self.decide(input);
                 self.stage = Stage::Fusion;
                 Ok(1)
             }
             Stage::Fusion => {
-                self.fuse_maps(sim);
+                self.fuse_maps(input);
                 self.stage = Stage::Done;
                 Ok(1)
             }
@@ -472,12 +277,12 @@ impl MergeJob {
     }
 
     /// Runs the job to the end.
-    pub fn run(&mut self, sim: &Simulation) -> Result<(), String> {
-        while self.advance(sim, usize::MAX)? > 0 {}
+    pub fn run(&mut self, input: &impl MergeInput) -> Result<(), String> {
+        while self.advance(input, usize::MAX)? > 0 {}
         Ok(())
     }
 
-    fn advance_features(&mut self, sim: &Simulation, units: usize) -> usize {
+    fn advance_features(&mut self, input: &impl MergeInput, units: usize) -> usize {
         let mut done = 0;
         while done < units {
             let (ri, k) = self.cursor;
@@ -493,12 +298,9 @@ impl MergeJob {
             let info = &robot.infos[robot.selected[k]];
             let features = match self.described.take(&self.config, ri, info.index) {
                 Some(ready) => ready,
-                None => sim.robots[ri]
-                    .frames
-                    .frames
-                    .iter()
-                    .find(|f| f.index == info.index)
-                    .map(|f| describe_image(sim.frame_image(f), &self.config))
+                None => input
+                    .frame_image(ri, info.index)
+                    .map(|img| describe_image(img, &self.config))
                     .unwrap_or_default(),
             };
             robot.features.push(features);
@@ -513,46 +315,6 @@ impl MergeJob {
             self.described = DescribedFrames::default();
         }
         done
-    }
-
-    /// Fills every robot pair's to-do list: all pairs for the thesis's
-    /// method, the vocabulary's proposals for the automatic one.
-    fn propose(&mut self) {
-        match self.config.method {
-            MergeMethod::Thesis => {
-                for p in &mut self.pairs {
-                    let (na, nb) = (
-                        self.robots[p.a].selected.len(),
-                        self.robots[p.b].selected.len(),
-                    );
-                    p.todo = (0..na).flat_map(|i| (0..nb).map(move |j| (i, j))).collect();
-                }
-            }
-            MergeMethod::Auto => {
-                let sets: Vec<&Features> =
-                    self.robots.iter().flat_map(|r| r.features.iter()).collect();
-                let vocabulary = Vocabulary::train(
-                    &sets,
-                    &self.config.vocabulary,
-                    self.config.seed ^ 0x766f_6361,
-                );
-                self.bags = self
-                    .robots
-                    .iter()
-                    .map(|r| r.features.iter().map(|f| vocabulary.bag(f)).collect())
-                    .collect();
-                for p in &mut self.pairs {
-                    let proposals = propose_pairs(
-                        &self.bags[p.a],
-                        &self.bags[p.b],
-                        self.config.proposals_per_frame,
-                        self.config.max_pairs,
-                    );
-                    p.todo = proposals.into_iter().map(|(i, j, _)| (i, j)).collect();
-                }
-            }
-            MergeMethod::MapOnly => {}
-        }
     }
 
     /// Checks one frame pair (positions in the robots' selected lists).
@@ -592,20 +354,10 @@ impl MergeJob {
             }
             let (row, col) = p.todo[p.cells.len()];
             let (a, b) = (p.a, p.b);
-            // The automatic method decides on the rigid fit alone: the
-            // homography (the thesis's table figure) is fitted again only
-            // for a pair the user opens (`check`).
-            let verify = VerifyConfig {
-                homography: self.config.verify.homography
-                    && self.config.method == MergeMethod::Thesis,
-                ..self.config.verify
-            };
+            let verify = self.method.verify_config(&self.config);
             let cell = match self.check_with(a, row, b, col, &verify) {
                 Some(check) => {
-                    let inliers = match self.config.method {
-                        MergeMethod::Thesis => check.homography_inliers,
-                        _ => check.candidate.as_ref().map_or(0, |c| c.inliers),
-                    };
+                    let inliers = self.method.table_figure(&check);
                     Cell {
                         row,
                         col,
@@ -637,121 +389,25 @@ impl MergeJob {
         done
     }
 
-    fn map<'s>(&self, sim: &'s Simulation, i: usize) -> &'s OccupancyGrid {
-        sim.robots[i].mapping.map(self.config.mapper)
-    }
-
-    fn decide(&mut self, sim: &Simulation) {
-        let mut outcomes = Vec::with_capacity(self.pairs.len());
-        for p in &self.pairs {
-            let (map_a, map_b) = (self.map(sim, p.a), self.map(sim, p.b));
-            let (name_a, name_b) = (self.robots[p.a].name.clone(), self.robots[p.b].name.clone());
-            let outcome = match self.config.method {
-                MergeMethod::Auto => {
-                    let cands: Vec<Candidate> =
-                        p.cells.iter().filter_map(|c| c.candidate.clone()).collect();
-                    let summary = SearchSummary {
-                        proposed_pairs: p.cells.len(),
-                        best_rigid_inliers: p
-                            .cells
-                            .iter()
-                            .map(|c| c.rigid_inliers as usize)
-                            .max()
-                            .unwrap_or(0),
-                        min_inliers: self.config.verify.min_inliers,
-                    };
-                    let mut d = decide_pair_after_search(
-                        &cands,
-                        &summary,
-                        map_a,
-                        map_b,
-                        &self.config.verdict,
-                    );
-                    // Vision found nothing the maps confirm (and was not
-                    // torn between two transforms): ask the maps alone.
-                    if let Some(ms) = self
-                        .config
-                        .map_search
-                        .as_ref()
-                        .filter(|_| d.status != MergeStatus::Merged && !d.ambiguous)
-                    {
-                        let m = search_maps(map_a, map_b, ms, &self.config.verdict);
-                        if m.status == MergeStatus::Merged {
-                            d.status = MergeStatus::Merged;
-                            d.pose = m.pose;
-                            d.confidence = m.confidence;
-                            d.support.clear();
-                            d.reason = format!("merged: {} (vision: {})", m.reason, d.reason);
-                        } else {
-                            d.reason = format!("{}; {}", d.reason, m.reason);
-                        }
-                    }
-                    PairOutcome {
-                        a: name_a,
-                        b: name_b,
-                        status: d.status,
-                        reason: d.reason,
-                        confidence: d.confidence,
-                        pose: d.pose.as_ref().map(pose3),
-                        candidates: cands.len(),
-                        support: d.support.len(),
-                        best: None,
-                        second: None,
-                        distance: None,
-                    }
-                }
-                MergeMethod::Thesis => {
-                    let (ra, rb) = (&self.robots[p.a], &self.robots[p.b]);
-                    let a_frames: Vec<FrameInfo> =
-                        ra.selected.iter().map(|&k| ra.infos[k].clone()).collect();
-                    let b_frames: Vec<FrameInfo> =
-                        rb.selected.iter().map(|&k| rb.infos[k].clone()).collect();
-                    let table: Vec<PairMatch> = p
-                        .cells
-                        .iter()
-                        .map(|c| PairMatch {
-                            a: c.row,
-                            b: c.col,
-                            inliers: c.inliers as usize,
-                            homography: c.homography,
-                            quad: c.quad,
-                        })
-                        .collect();
-                    let t = thesis_merge(&self.camera, &a_frames, &b_frames, &table);
-                    PairOutcome {
-                        a: name_a,
-                        b: name_b,
-                        status: t.status,
-                        reason: t.reason,
-                        confidence: t.confidence,
-                        pose: t.pose.as_ref().map(pose3),
-                        candidates: table.len(),
-                        support: usize::from(t.best.is_some()),
-                        best: t.best.map(|(i, j)| [i, j]),
-                        second: t.second.map(|(i, j)| [i, j]),
-                        distance: t.distance,
-                    }
-                }
-                MergeMethod::MapOnly => {
-                    let seed = self.config.seed ^ ((p.a * 16 + p.b) as u64);
-                    let o = map_only_merge(map_a, map_b, &self.config.baseline, seed);
-                    PairOutcome {
-                        a: name_a,
-                        b: name_b,
-                        status: o.status,
-                        reason: o.reason,
-                        confidence: o.confidence,
-                        pose: o.pose.as_ref().map(pose3),
-                        candidates: o.matches,
-                        support: o.inliers,
-                        best: None,
-                        second: None,
-                        distance: None,
-                    }
-                }
-            };
-            outcomes.push(outcome);
-        }
+    /// The decision on every pair of robots, by the method's own rule,
+    /// then the join.
+    fn decide(&mut self, input: &impl MergeInput) {
+        let mapper = self.config.mapper;
+        let outcomes: Vec<PairOutcome> = self
+            .pairs
+            .iter()
+            .map(|p| {
+                self.method.decide(&PairInput {
+                    work: p,
+                    robot_a: &self.robots[p.a],
+                    robot_b: &self.robots[p.b],
+                    map_a: input.map(p.a, mapper),
+                    map_b: input.map(p.b, mapper),
+                    camera: &self.camera,
+                    config: &self.config,
+                })
+            })
+            .collect();
         for (p, o) in self.pairs.iter_mut().zip(&outcomes) {
             p.outcome = Some(o.clone());
         }
@@ -858,7 +514,7 @@ impl MergeJob {
         }
     }
 
-    fn fuse_maps(&mut self, sim: &Simulation) {
+    fn fuse_maps(&mut self, input: &impl MergeInput) {
         let Some(outcome) = &self.outcome else {
             return;
         };
@@ -871,12 +527,12 @@ impl MergeJob {
             .filter_map(|t| {
                 let i = self.robots.iter().position(|r| r.name == t.robot)?;
                 Some((
-                    self.map(sim, i),
+                    input.map(i, self.config.mapper),
                     Pose2::new(t.pose[0], t.pose[1], t.pose[2]),
                 ))
             })
             .collect();
-        let config = self.map(sim, 0).config.clone();
+        let config = input.map(0, self.config.mapper).config.clone();
         self.merged = Some(fuse(&maps, config));
     }
 

@@ -38,7 +38,6 @@ use super::FrameInfo;
 use crate::camera::PinholeCamera;
 use crate::sensors::laser::{beam_bearing, LASER_BEAMS};
 use crate::sim::LASER_LOG_NO_RETURN;
-use crate::surf::Features;
 use glam::{DVec2, DVec3};
 
 /// Neighbouring beams further apart than `JUMP_ABS_M + JUMP_REL · r` mark a
@@ -106,18 +105,10 @@ pub fn laser_range_at(laser_mm: &[u16; LASER_BEAMS], bearing_rad: f64) -> Option
     (r > 0.0).then_some(r)
 }
 
-/// The point on the wall that keypoint column `x_px` shows, in the robot's
-/// map frame (via the SLAM pose `frame.pose`). `None` where the laser gives
-/// no trustworthy range (see [`laser_range_at`]).
-pub fn lift_keypoint(camera: &PinholeCamera, frame: &FrameInfo, x_px: f64) -> Option<DVec2> {
-    let bearing = column_bearing_rad(camera, x_px);
-    let r = laser_range_at(&frame.laser_mm, bearing)?;
-    let local = DVec2::new(bearing.cos(), bearing.sin()) * r;
-    Some(frame.pose.transform_point(local))
-}
-
-/// [`lift_keypoint`] with the height of the point on the wall as `z` (m
-/// above the floor), from the keypoint's row `y_px` (SURF convention).
+/// The point on the wall that keypoint (`x_px`, `y_px`) shows (SURF's
+/// pixel convention): `x`, `y` in the robot's map frame (via the SLAM pose
+/// `frame.pose`) and `z` its height on the wall (m above the floor). `None`
+/// where the laser gives no trustworthy range (see [`laser_range_at`]).
 pub fn lift_keypoint_3d(
     camera: &PinholeCamera,
     frame: &FrameInfo,
@@ -133,39 +124,4 @@ pub fn lift_keypoint_3d(
         .pose
         .transform_point(DVec2::new(bearing.cos(), bearing.sin()) * r);
     Some(DVec3::new(p.x, p.y, z))
-}
-
-/// Indices of the keypoints of `features` that lift (the laser has a
-/// trustworthy range at their column). Place recognition should describe a
-/// frame by these alone ([`super::vocabulary::Vocabulary::train_with_bags_on`]):
-/// a frame pair can only be verified through points that lift, and a far
-/// wall both robots saw from beyond the laser's reach would otherwise fill
-/// the proposals with pairs that cannot verify (measured: two 600 s runs of
-/// the `loop` and `thesis` presets went from 0 and 1 verified pairs to 65
-/// and 60).
-pub fn liftable_keypoints(
-    camera: &PinholeCamera,
-    frame: &FrameInfo,
-    features: &Features,
-) -> Vec<usize> {
-    (0..features.keypoints.len().min(features.descriptors.len()))
-        .filter(|&i| {
-            let bearing = column_bearing_rad(camera, features.keypoints[i].x as f64);
-            laser_range_at(&frame.laser_mm, bearing).is_some()
-        })
-        .collect()
-}
-
-/// The keypoints of `features` that lift, with their descriptors: a copy,
-/// for callers that want [`Features`]; [`liftable_keypoints`] avoids it.
-pub fn liftable_features(
-    camera: &PinholeCamera,
-    frame: &FrameInfo,
-    features: &Features,
-) -> Features {
-    let keep = liftable_keypoints(camera, frame, features);
-    Features {
-        keypoints: keep.iter().map(|&i| features.keypoints[i]).collect(),
-        descriptors: keep.iter().map(|&i| features.descriptors[i]).collect(),
-    }
 }

@@ -29,28 +29,39 @@
 //!
 //! With three or more robots the pairwise results form a graph and the maps
 //! are joined along its most confident spanning tree ([`graph`]); the grids
-//! are fused by adding log-odds ([`fuse`]). [`job`] runs all of this in
-//! small increments so the page can show the matched-pair table filling in;
-//! [`described`] lets other threads describe the frames ahead of it.
+//! are fused by adding log-odds ([`fuse`]).
 //!
-//! Ground truth is never read here; [`crate::lab`] scores the result.
+//! One driver runs every method: [`job`] goes through the stages in small
+//! increments so the page can show the matched-pair table filling in, and
+//! asks the method's own stages ([`method`], one file per method behind one
+//! trait) what to select, propose, check and decide. [`frames`] chooses and
+//! describes the frames that take part (and says what a merge reads,
+//! [`frames::MergeInput`]); [`work`] holds what the job works on; [`config`]
+//! every setting; [`described`] lets other threads describe the frames
+//! ahead of the job.
+//!
+//! Ground truth is never read here: the session layer (`crate::lab`) scores
+//! the result.
 
 pub mod align;
 pub mod baseline;
+pub mod config;
 pub mod consistency;
 pub mod described;
+pub mod frames;
 pub mod fuse;
 pub mod graph;
 pub mod job;
-pub mod lab;
 pub mod lift;
 pub mod mapsearch;
+pub mod method;
 pub mod rigid;
 pub mod selection;
 pub mod thesis;
 pub mod verdict;
 pub mod verify;
 pub mod vocabulary;
+pub mod work;
 
 use crate::geom::Pose2;
 use crate::sensors::laser::LASER_BEAMS;

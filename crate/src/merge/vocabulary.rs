@@ -32,11 +32,10 @@
 //!   is cut to `max_pairs`.
 //!
 //! Similar-looking frames are only *proposals*: repeated textures make
-//! different places look alike. [`super::verify`] checks each geometrically,
-//! through keypoints the laser can range; so a frame is best described by
-//! those keypoints alone ([`Vocabulary::train_with_bags_on`] with
-//! [`super::lift::liftable_keypoints`]), or far walls seen beyond the
-//! laser's reach fill the proposals with pairs that cannot verify.
+//! different places look alike, so [`super::verify`] checks each
+//! geometrically. A bag is made of a frame's strongest keypoints, whether
+//! or not the laser reaches them: a wall seen beyond the laser's range can
+//! still propose a pair whose nearer keypoints verify.
 //!
 //! Cost, for 2 × 301 frames of 200-350 keypoints (150 strongest per bag,
 //! 512 words): training and all bags about 60-80 ms natively, proposals
@@ -252,22 +251,19 @@ fn argmax(values: impl Iterator<Item = f32>) -> usize {
     best.0
 }
 
-/// The strongest `max` keypoints of a frame with a usable descriptor,
-/// among `keep` (all keypoints when `None`): indices, strongest first.
-fn strongest(f: &Features, keep: Option<&[usize]>, max: usize) -> Vec<usize> {
+/// The strongest `max` keypoints of a frame with a usable descriptor:
+/// indices, strongest first.
+fn strongest(f: &Features, max: usize) -> Vec<usize> {
     let n = f.keypoints.len().min(f.descriptors.len());
-    let usable = |&i: &usize| i < n && f.descriptors[i].0.iter().any(|&v| v != 0.0);
-    let mut idx: Vec<usize> = match keep {
-        Some(k) => k.iter().copied().filter(usable).collect(),
-        None => (0..n).filter(usable).collect(),
-    };
+    let mut idx: Vec<usize> = (0..n)
+        .filter(|&i| f.descriptors[i].0.iter().any(|&v| v != 0.0))
+        .collect();
     idx.sort_by(|&a, &b| {
         f.keypoints[b]
             .response
             .total_cmp(&f.keypoints[a].response)
             .then(a.cmp(&b))
     });
-    idx.dedup();
     idx.truncate(max);
     idx
 }
@@ -290,25 +286,8 @@ impl Vocabulary {
         cfg: &VocabularyConfig,
         seed: u64,
     ) -> (Vocabulary, Vec<Bag>) {
-        Self::train_with_bags_on(sets, &[], cfg, seed)
-    }
-
-    /// [`Vocabulary::train_with_bags`] on a subset of each frame's
-    /// keypoints: `keep[i]` lists the keypoints of `sets[i]` that count (for
-    /// example [`super::lift::liftable_keypoints`]); frames beyond
-    /// `keep.len()` use all theirs. Choosing by index copies no descriptor.
-    pub fn train_with_bags_on(
-        sets: &[&Features],
-        keep: &[Vec<usize>],
-        cfg: &VocabularyConfig,
-        seed: u64,
-    ) -> (Vocabulary, Vec<Bag>) {
         let per_frame = cfg.max_words_per_frame.max(1);
-        let chosen: Vec<Vec<usize>> = sets
-            .iter()
-            .enumerate()
-            .map(|(i, f)| strongest(f, keep.get(i).map(Vec::as_slice), per_frame))
-            .collect();
+        let chosen: Vec<Vec<usize>> = sets.iter().map(|f| strongest(f, per_frame)).collect();
         // Descriptors by sign of the Laplacian, an even stride over all.
         let total: usize = chosen.iter().map(Vec::len).sum();
         let stride = total.div_ceil(cfg.max_training.max(1)).max(1);
@@ -480,13 +459,7 @@ impl Vocabulary {
     /// words, unit length (empty for a frame without features, or when
     /// every word it has is on every training frame).
     pub fn bag(&self, f: &Features) -> Bag {
-        let idx = strongest(f, None, self.max_words_per_frame);
-        self.weigh(&self.words_of(f, &idx), idx.len())
-    }
-
-    /// [`Vocabulary::bag`] of the keypoints `keep` of `f` only.
-    pub fn bag_of(&self, f: &Features, keep: &[usize]) -> Bag {
-        let idx = strongest(f, Some(keep), self.max_words_per_frame);
+        let idx = strongest(f, self.max_words_per_frame);
         self.weigh(&self.words_of(f, &idx), idx.len())
     }
 }

@@ -27,7 +27,6 @@ pub mod export;
 pub mod filter;
 pub mod gauss_newton;
 pub mod grid;
-pub mod lab;
 pub mod likelihood;
 pub mod mapper;
 pub mod scoring;

@@ -11,12 +11,15 @@
 //! frames are the robots' odometry frames, whose origins are their start
 //! poses).
 
-use super::described::{describe_image, describe_spec, frames_to_describe, render_spec, FrameSpec};
-use super::job::{MergeConfig, MergeJob, MergeOutcome, PairOutcome, RobotTransform, Stage};
-use super::{MergeMethod, MergeStatus};
+use super::described::{describe_spec, render_spec, FrameSpec};
+use super::Lab;
 use crate::camera::CameraImage;
 use crate::geom::{wrap_angle, Pose2};
-use crate::lab::Lab;
+use crate::merge::described::{describe_image, frames_to_describe};
+use crate::merge::job::{
+    MergeConfig, MergeJob, MergeOutcome, MergeTimes, PairOutcome, RobotTransform, Stage,
+};
+use crate::merge::{MergeMethod, MergeStatus};
 use crate::slam::export::{to_pgm, to_png, to_yaml, GridPicture};
 use crate::slam::OccupancyGrid;
 use glam::DVec2;
@@ -30,14 +33,6 @@ pub struct MergeProgress {
     pub done: usize,
     pub total: usize,
     pub finished: bool,
-}
-
-/// Milliseconds per merge stage (zero without a clock).
-#[derive(Clone, Copy, Debug, Default, Serialize)]
-pub struct MergeTimes {
-    pub features: f64,
-    pub matching: f64,
-    pub merge: f64,
 }
 
 /// Error of one estimated transform against the truth.
@@ -526,7 +521,7 @@ impl Lab {
                 .iter()
                 .map(|p| frame.transform_point(p.position()))
                 .collect();
-            let [r, gr, b] = crate::render::ROBOT_COLOURS[i % crate::render::ROBOT_COLOURS.len()];
+            let [r, gr, b] = crate::palette::robot_colour(i);
             pic.polyline(&path, [r, gr, b, 220], 1.5);
             if let Some(last) = est.last() {
                 pic.dot(frame.compose(last).position(), 4.0, [r, gr, b, 220]);

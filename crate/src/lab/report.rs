@@ -43,7 +43,7 @@ pub struct RobotReport {
     /// SLAM pose per step, same frame and times as `odometry`.
     pub estimate: Vec<[f64; 4]>,
     /// ATE and map figures of the SLAM and odometry-only mappers.
-    pub slam: crate::slam::lab::SlamFigures,
+    pub slam: super::maps::SlamFigures,
     pub bumps: u32,
     /// Camera frames captured.
     pub frames: usize,
@@ -90,7 +90,7 @@ pub struct Report {
     /// One matched-pair table per pair of robots (empty before a merge).
     pub match_tables: Vec<crate::merge::job::MatchTable>,
     /// The merge verdict, transforms and their errors; null before a merge.
-    pub merge: Option<crate::merge::lab::MergeReport>,
+    pub merge: Option<super::merge::MergeReport>,
     pub timings_ms: Timings,
 }
 
@@ -121,7 +121,7 @@ impl Report {
                     truth: rows(&log.times_s, &log.truth),
                     odometry: rows(&log.times_s, &log.odometry),
                     estimate: rows(&log.times_s, r.mapping.estimates()),
-                    slam: crate::slam::lab::figures(sim, r),
+                    slam: super::maps::figures(sim, r),
                     bumps: r.bumps,
                     frames: r.frames.next_index(),
                     frames_dropped: r.frames.dropped,

@@ -1,16 +1,16 @@
 //! # What the page and the CLI ask of a robot's maps
 //!
-//! A separate `impl Lab` block (the session object lives in
-//! [`crate::lab`]) built on its public accessors: a robot's map as ROS
-//! files or as a picture, its metadata, and the figures that score it.
+//! A separate `impl Lab` block (the session object is [`super::Lab`]): a
+//! robot's map as ROS files or as a picture, its metadata, and the figures
+//! that score it.
 //! Scoring reads the truth, as display and scoring may; the mappers never do.
 
-use super::export::{to_pgm, to_png, to_yaml, GridPicture};
-use super::grid::OccupancyGrid;
-use super::mapper::{MapperKind, RobotMapping};
-use super::scoring::{ate_m, map_accuracy, position_errors_m};
-use crate::lab::Lab;
+use super::Lab;
 use crate::sim::{RobotSim, Simulation};
+use crate::slam::export::{to_pgm, to_png, to_yaml, GridPicture};
+use crate::slam::grid::OccupancyGrid;
+use crate::slam::mapper::{MapperKind, RobotMapping};
+use crate::slam::scoring::{ate_m, map_accuracy, position_errors_m};
 use glam::DVec2;
 use serde::Serialize;
 
@@ -101,6 +101,23 @@ pub struct ErrorSeries {
 }
 
 impl Lab {
+    /// Re-matches robot `robot`'s latest scan against its SLAM map from
+    /// the current prior, without changing anything (for timing the
+    /// matcher); returns the matched pose.
+    pub fn bench_match_scan(&self, robot: usize) -> Result<crate::geom::Pose2, String> {
+        let sim = self
+            .simulation()
+            .ok_or("nothing has run yet: run the scenario first")?;
+        let r = sim
+            .robots
+            .get(robot)
+            .ok_or_else(|| format!("no robot with index {robot}"))?;
+        let m = &r.mapping;
+        let out =
+            crate::slam::mapper::match_scan(&m.slam_map, &r.last_scan, &m.estimate(), &m.config);
+        Ok(out.pose)
+    }
+
     fn robot_sim(&self, robot: usize) -> Result<(&Simulation, &RobotSim), String> {
         let sim = self
             .simulation()

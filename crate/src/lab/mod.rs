@@ -7,24 +7,45 @@
 //! Nothing the user made is lost on a bad input: a scenario that fails to
 //! parse leaves the current one in place; one whose robots are badly placed
 //! is kept (so the page can show the problem) but refuses to run until fixed.
+//!
+//! This folder is the session layer, the only part of the crate that reads
+//! the ground truth (to score and to show it) and the only one the bindings
+//! call. The algorithms below it never import it:
+//!
+//! | file | what the session does there |
+//! |---|---|
+//! | `mod.rs` | the scenario, the run, the top view, the camera, frames and logs |
+//! | [`merge`] | merging the run's maps, the merge's views, scoring it against the truth |
+//! | [`described`] | a stored frame's parts, for another lab to render and describe |
+//! | [`maps`] | a robot's maps as files and pictures, their figures against the truth |
+//! | [`report`] | the JSON report of a run (`web/cli.mjs run --json`) |
+//! | [`views`] | the small JSON views the page reads |
+//!
+//! `Lab`'s fields are private to this folder: callers use its methods.
 
 use crate::camera::capture::CapturedFrame;
 use crate::camera::texture::{ImageTexture, TextureBank};
 use crate::camera::{render as render_camera, robot_boxes, CameraImage, PinholeCamera};
 use crate::render::{render_world, RenderOptions};
-use crate::report::{Report, Timings};
 use crate::scenario::{Scenario, ScenarioError, MAX_DURATION_S};
 use crate::sensors::laser::beam_bearing;
 use crate::sim::{Simulation, LASER_LOG_NO_RETURN};
 use crate::world::World;
+use report::{Report, Timings};
 use serde::Serialize;
 use std::fmt::Write;
 use tiny_skia::Pixmap;
 
+pub mod described;
+pub mod maps;
+pub mod merge;
+pub mod report;
+pub mod views;
+
 /// A lab session: a scenario, and its simulation once started.
 pub struct Lab {
     scenario: Scenario,
-    pub(crate) sim: Option<Simulation>,
+    sim: Option<Simulation>,
     view: RenderOptions,
     pixmap: Option<Pixmap>,
     /// Texture cache and loaded pictures while no simulation holds them.
@@ -32,13 +53,13 @@ pub struct Lab {
     /// The world of the scenario being edited (for camera previews).
     preview_world: Option<World>,
     /// The map merge of the current run, once asked for (see
-    /// [`crate::merge::lab`]); dropped when the run changes.
-    pub(crate) merge: Option<crate::merge::job::MergeJob>,
+    /// [`merge`]); dropped when the run changes.
+    merge: Option<crate::merge::job::MergeJob>,
     /// Features of this run's frames described ahead of a merge by other
     /// threads ([`crate::merge::described`]); dropped when the run changes.
-    pub(crate) described: crate::merge::described::DescribedFrames,
+    described: crate::merge::described::DescribedFrames,
     /// The host's millisecond clock, for stage timings.
-    pub(crate) clock: Option<fn() -> f64>,
+    clock: Option<fn() -> f64>,
 }
 
 /// Live figures for the page's readouts.

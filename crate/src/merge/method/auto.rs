@@ -1,0 +1,139 @@
+//! # The automatic method as a merge method
+//!
+//! Every frame takes part, thinned by motion (consecutive views a few
+//! centimetres apart show nearly the same); a bag of visual words trained on
+//! this run's descriptors proposes the frame pairs most likely to show the
+//! same place ([`crate::merge::vocabulary`]); each is verified by a rigid
+//! fit of keypoints lifted with the laser ([`crate::merge::verify`]), the
+//! table showing its inliers. The decision combines the candidates that
+//! agree with the agreement of the overlaid maps
+//! ([`crate::merge::verdict`]); when vision finds no transform the maps
+//! confirm, and was not torn between two, the maps alone are searched
+//! ([`crate::merge::mapsearch`]) and judged as strictly.
+
+use super::{pose3, MethodStages, PairInput};
+use crate::geom::wrap_angle;
+use crate::merge::config::MergeConfig;
+use crate::merge::mapsearch::search_maps;
+use crate::merge::verdict::{decide_pair_after_search, SearchSummary};
+use crate::merge::verify::{PairCheck, VerifyConfig};
+use crate::merge::vocabulary::{propose_pairs, Bag, Vocabulary};
+use crate::merge::work::{PairOutcome, PairWork, RobotFrames};
+use crate::merge::{Candidate, FrameInfo, MergeMethod, MergeStatus};
+use crate::surf::Features;
+
+/// The `auto` method.
+pub struct Auto;
+
+/// Positions in `infos` of the frames taken after the robot moved at least
+/// `min_m` or turned `min_rad` (SLAM pose) since the last frame kept; the
+/// first frame is always kept.
+pub fn thin_by_motion(infos: &[FrameInfo], min_m: f64, min_rad: f64) -> Vec<usize> {
+    let mut kept: Vec<usize> = Vec::new();
+    for (k, f) in infos.iter().enumerate() {
+        let keep = match kept.last() {
+            None => true,
+            Some(&j) => {
+                let last = &infos[j].pose;
+                (f.pose.position() - last.position()).length() >= min_m
+                    || wrap_angle(f.pose.theta - last.theta).abs() >= min_rad
+            }
+        };
+        if keep {
+            kept.push(k);
+        }
+    }
+    kept
+}
+
+impl MethodStages for Auto {
+    fn method(&self) -> MergeMethod {
+        MergeMethod::Auto
+    }
+
+    fn select(&self, infos: &[FrameInfo], config: &MergeConfig) -> Vec<usize> {
+        thin_by_motion(infos, config.min_motion_m, config.min_turn_rad)
+    }
+
+    /// The vocabulary's proposals: trained on every described frame of
+    /// every robot, then each robot pair's frames nominate their partners.
+    fn propose(&self, robots: &[RobotFrames], pairs: &mut [PairWork], config: &MergeConfig) {
+        let sets: Vec<&Features> = robots.iter().flat_map(|r| r.features.iter()).collect();
+        let vocabulary = Vocabulary::train(&sets, &config.vocabulary, config.seed ^ 0x766f_6361);
+        let bags: Vec<Vec<Bag>> = robots
+            .iter()
+            .map(|r| r.features.iter().map(|f| vocabulary.bag(f)).collect())
+            .collect();
+        for p in pairs {
+            let proposals = propose_pairs(
+                &bags[p.a],
+                &bags[p.b],
+                config.proposals_per_frame,
+                config.max_pairs,
+            );
+            p.todo = proposals.into_iter().map(|(i, j, _)| (i, j)).collect();
+        }
+    }
+
+    /// The decision rests on the rigid fit alone: the homography (the
+    /// thesis's table figure) is fitted only for a pair the user opens.
+    fn verify_config(&self, config: &MergeConfig) -> VerifyConfig {
+        VerifyConfig {
+            homography: false,
+            ..config.verify
+        }
+    }
+
+    fn table_figure(&self, check: &PairCheck) -> usize {
+        check.candidate.as_ref().map_or(0, |c| c.inliers)
+    }
+
+    fn decide(&self, pair: &PairInput) -> PairOutcome {
+        let (p, config) = (pair.work, pair.config);
+        let cands: Vec<Candidate> = p.cells.iter().filter_map(|c| c.candidate.clone()).collect();
+        let summary = SearchSummary {
+            proposed_pairs: p.cells.len(),
+            best_rigid_inliers: p
+                .cells
+                .iter()
+                .map(|c| c.rigid_inliers as usize)
+                .max()
+                .unwrap_or(0),
+            min_inliers: config.verify.min_inliers,
+        };
+        let mut d =
+            decide_pair_after_search(&cands, &summary, pair.map_a, pair.map_b, &config.verdict);
+        // Vision found nothing the maps confirm (and was not torn between
+        // two transforms): ask the maps alone.
+        if let Some(ms) = config
+            .map_search
+            .as_ref()
+            .filter(|_| d.status != MergeStatus::Merged && !d.ambiguous)
+        {
+            let m = search_maps(pair.map_a, pair.map_b, ms, &config.verdict);
+            if m.status == MergeStatus::Merged {
+                d.status = MergeStatus::Merged;
+                d.pose = m.pose;
+                d.confidence = m.confidence;
+                d.support.clear();
+                d.reason = format!("merged: {} (vision: {})", m.reason, d.reason);
+            } else {
+                d.reason = format!("{}; {}", d.reason, m.reason);
+            }
+        }
+        PairOutcome {
+            a: pair.robot_a.name.clone(),
+            b: pair.robot_b.name.clone(),
+            status: d.status,
+            reason: d.reason.clone(),
+            confidence: d.confidence,
+            pose: d.pose.as_ref().map(pose3),
+            candidates: cands.len(),
+            support: d.support.len(),
+            best: None,
+            second: None,
+            distance: None,
+            verdict: Some(d),
+        }
+    }
+}

@@ -1,0 +1,91 @@
+//! # The merge methods, each behind one interface
+//!
+//! A merge method is what [`super::job::MergeJob`]'s stages ask of it: which
+//! frames take part, which frame pairs to check, how to check one and what
+//! its table cell shows, and the decision on a pair of robots.
+//! [`MethodStages`] is that interface; each method is one file:
+//!
+//! | method | file | follows |
+//! |---|---|---|
+//! | `thesis` | [`thesis`] | thesis §6.2: square frames, every pair, the distance computation |
+//! | `auto` | [`auto`] | every frame, visual-word proposals, rigid fits, the verdict, the map search |
+//! | `map-only` | [`map_only`] | features on the grid images (the baseline) |
+//!
+//! The driver never asks which method it runs; adding a method is adding a
+//! file here, a [`MergeMethod`] name, and its line in [`stages_of`]. A
+//! method that reads the maps only says so with
+//! [`MethodStages::uses_frames`]: the job then goes straight to the
+//! decision, and its input may have no frames at all
+//! ([`super::frames::MergeInput`]).
+
+pub mod auto;
+pub mod map_only;
+pub mod thesis;
+
+use super::config::MergeConfig;
+use super::verify::{PairCheck, VerifyConfig};
+use super::work::{PairOutcome, PairWork, RobotFrames};
+use super::{FrameInfo, MergeMethod};
+use crate::camera::PinholeCamera;
+use crate::slam::OccupancyGrid;
+
+/// What the decision on one pair of robots reads: both robots' frames
+/// (empty for a method that reads the maps only), the checked cells, both
+/// maps, the camera and the settings.
+pub struct PairInput<'a> {
+    /// Robot pair `a`-`b`, as positions in the job's robot list.
+    pub work: &'a PairWork,
+    pub robot_a: &'a RobotFrames,
+    pub robot_b: &'a RobotFrames,
+    pub map_a: &'a OccupancyGrid,
+    pub map_b: &'a OccupancyGrid,
+    pub camera: &'a PinholeCamera,
+    pub config: &'a MergeConfig,
+}
+
+/// The stages of one merge method, as [`super::job::MergeJob`] calls them.
+pub trait MethodStages: Sync {
+    /// The method's name (`run --method`).
+    fn method(&self) -> MergeMethod;
+
+    /// Whether the method looks at camera frames. One that does not reads
+    /// the maps only: the job skips the features, proposals and matching
+    /// stages.
+    fn uses_frames(&self) -> bool {
+        true
+    }
+
+    /// Positions in `infos` (one robot's frames, in capture order) of the
+    /// frames that take part.
+    fn select(&self, infos: &[FrameInfo], config: &MergeConfig) -> Vec<usize>;
+
+    /// Fills every robot pair's to-do list (`todo`, positions in the two
+    /// robots' `selected` lists), once every selected frame is described.
+    fn propose(&self, _robots: &[RobotFrames], _pairs: &mut [PairWork], _config: &MergeConfig) {}
+
+    /// The verification settings of the matching stage (a pair the user
+    /// opens is always checked with every setting on).
+    fn verify_config(&self, config: &MergeConfig) -> VerifyConfig {
+        config.verify
+    }
+
+    /// The figure a checked pair's table cell shows.
+    fn table_figure(&self, check: &PairCheck) -> usize;
+
+    /// The decision on one pair of robots.
+    fn decide(&self, pair: &PairInput) -> PairOutcome;
+}
+
+/// The stages of `method`.
+pub fn stages_of(method: MergeMethod) -> &'static dyn MethodStages {
+    match method {
+        MergeMethod::Auto => &auto::Auto,
+        MergeMethod::Thesis => &thesis::Thesis,
+        MergeMethod::MapOnly => &map_only::MapOnly,
+    }
+}
+
+/// `[x, y, theta]` of a pose, the form outcomes carry.
+pub(crate) fn pose3(p: &crate::geom::Pose2) -> [f64; 3] {
+    [p.x, p.y, p.theta]
+}
