@@ -78,12 +78,36 @@ fn names_after(code: &str, prefix: &str) -> BTreeSet<String> {
         if before.is_some_and(|c| c.is_alphanumeric() || c == '_' || c == ':') {
             continue;
         }
-        let name: String = rest
-            .chars()
-            .take_while(|c| c.is_alphanumeric() || *c == '_')
-            .collect();
-        if !name.is_empty() {
-            out.insert(name);
+        let ident = |t: &str| -> String {
+            t.trim_start()
+                .chars()
+                .take_while(|c| c.is_alphanumeric() || *c == '_')
+                .collect()
+        };
+        if let Some(group) = rest.strip_prefix('{') {
+            // `crate::{a::X, b}`: every first-level name of the group.
+            let (mut depth, mut start) = (0usize, 0usize);
+            for (k, c) in group.char_indices() {
+                match c {
+                    '{' => depth += 1,
+                    '}' if depth == 0 => {
+                        out.insert(ident(&group[start..k]));
+                        break;
+                    }
+                    '}' => depth -= 1,
+                    ',' if depth == 0 => {
+                        out.insert(ident(&group[start..k]));
+                        start = k + 1;
+                    }
+                    _ => {}
+                }
+            }
+            out.remove("");
+        } else {
+            let name = ident(rest);
+            if !name.is_empty() {
+                out.insert(name);
+            }
         }
     }
     out
@@ -207,6 +231,9 @@ fn the_scanner_finds_names_outside_comments_and_the_table_is_ordered() {
         .collect();
     assert_eq!(got, vec!["geom".to_string(), "lab".to_string()]);
     assert!(names_after(code, "crate::").contains("bindings"));
+    let group = "use crate::{lab::Lab, geom::{Pose2, wrap_angle}};";
+    let got: Vec<String> = names_after(group, "crate::").into_iter().collect();
+    assert_eq!(got, vec!["geom".to_string(), "lab".to_string()]);
     let order = ["geom", "sim", "merge", "lab", "bindings"];
     let ranks: Vec<usize> = order.iter().map(|m| layer_of(m).expect("known")).collect();
     assert!(ranks.windows(2).all(|w| w[0] < w[1]), "{ranks:?}");
