@@ -13,6 +13,7 @@ use slamlab::merge::consistency::{
     independent_places, max_consistent_places, max_consistent_set, pairwise_consistent,
     ConsistencyConfig,
 };
+use slamlab::merge::frames::MergeInput;
 use slamlab::merge::fuse::fuse;
 use slamlab::merge::graph::{spanning_tree, PairEdge};
 use slamlab::merge::job::{MergeConfig, MergeJob, Stage};
@@ -673,6 +674,53 @@ fn map_search_finds_a_turned_and_shifted_map_within_0_1_m_and_1_degree() {
     let pose = found.pose.expect("pose");
     let (m, deg) = pose_error(&pose, &truth);
     assert!(m < 0.1 && deg < 1.0, "off by {m:.3} m, {deg:.2}°");
+}
+
+/// Maps and no frames, as real robots' map files give them.
+struct MapsOnly(Vec<OccupancyGrid>);
+
+impl MergeInput for MapsOnly {
+    fn robot_names(&self) -> Vec<String> {
+        (0..self.0.len()).map(|i| format!("map{i}")).collect()
+    }
+    fn map(&self, robot: usize, _mapper: MapperKind) -> &OccupancyGrid {
+        &self.0[robot]
+    }
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn the_merge_job_merges_maps_that_come_without_frames() {
+    // The building of the map search test, through the product's driver.
+    let walls = building(16.0, 12.0, &HOUSE);
+    let frame_a = Pose2::new(1.3, 0.7, 17f64.to_radians());
+    let frame_b = Pose2::new(9.2, 4.1, -110f64.to_radians());
+    let a = scanned_map(&walls, &frame_a, &stops(0.0, 11.0, 0.0, 12.0));
+    let b = scanned_map(&walls, &frame_b, &stops(5.0, 16.0, 0.0, 12.0));
+    let truth = frame_a.inverse().compose(&frame_b);
+    let input = MapsOnly(vec![a, b]);
+    // The automatic method finds no frame to describe or match; vision
+    // has nothing to say, so the maps alone decide.
+    let mut job = MergeJob::new(&input, MergeConfig::new(MergeMethod::Auto, 1)).expect("a job");
+    assert_eq!(job.stage(), Stage::Features);
+    job.run(&input).expect("runs");
+    assert!(job.robots.iter().all(|r| r.infos.is_empty()));
+    assert_eq!(job.pairs[0].cells.len(), 0);
+    let outcome = job.outcome().expect("decided");
+    assert_eq!(outcome.status, MergeStatus::Merged, "{}", outcome.reason);
+    assert!(
+        outcome.reason.contains("maps alone agree"),
+        "{}",
+        outcome.reason
+    );
+    let t = &outcome.transforms[1];
+    assert_eq!(t.robot, "map1");
+    let (m, deg) = pose_error(&Pose2::new(t.pose[0], t.pose[1], t.pose[2]), &truth);
+    assert!(m < 0.1 && deg < 1.0, "off by {m:.3} m, {deg:.2}°");
+    assert!(job.merged_map().is_some_and(|g| g.occupied_count() > 0));
+    // A method that reads the maps only goes straight to the decision.
+    let config = MergeConfig::new(MergeMethod::MapOnly, 1);
+    let job = MergeJob::new(&input, config).expect("a job");
+    assert_eq!(job.stage(), Stage::Decision);
 }
 
 #[wasm_bindgen_test(unsupported = test)]

@@ -276,9 +276,12 @@ impl MergeJob {
         }
     }
 
-    /// Runs the job to the end.
+    /// Runs the job to the end (also through stages with no work, such as
+    /// the features of robots that stored no frame).
     pub fn run(&mut self, input: &impl MergeInput) -> Result<(), String> {
-        while self.advance(input, usize::MAX)? > 0 {}
+        while !self.is_done() {
+            self.advance(input, usize::MAX)?;
+        }
         Ok(())
     }
 
