@@ -81,49 +81,104 @@ struct Tally {
     errors: Vec<(f64, f64)>,
 }
 
-fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    let runs: u64 = arg(&args, "--runs")
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(20);
-    let others: u64 = arg(&args, "--others")
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(5);
-    let duration: f64 = arg(&args, "--duration")
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(300.0);
-    let methods: Vec<MergeMethod> = arg(&args, "--methods")
-        .unwrap_or_else(|| "auto,thesis,map-only".into())
-        .split(',')
-        .map(|m| MergeMethod::parse(m).expect("method"))
-        .collect();
-    let multi: u64 = arg(&args, "--multi")
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(0);
-    let verbose = args.iter().any(|a| a == "--verbose");
-    // `--only maze-14`: just that case, with the whole reason.
-    let only = arg(&args, "--only");
-    // `--scenario-out DIR`: write the cases' scenario files instead of running them.
-    let scenario_out = arg(&args, "--scenario-out");
-    // `--min-places N`: the verdict's independent places (an experiment).
-    let min_places: Option<usize> = arg(&args, "--min-places").and_then(|s| s.parse().ok());
-    // `--min-inliers N`: rigid inliers a frame pair needs (an experiment).
-    let min_inliers: Option<usize> = arg(&args, "--min-inliers").and_then(|s| s.parse().ok());
-    // `--max-keypoints N`, `--min-motion M`: frame features and thinning (experiments).
-    let max_keypoints: Option<usize> = arg(&args, "--max-keypoints").and_then(|s| s.parse().ok());
-    let min_motion: Option<f64> = arg(&args, "--min-motion").and_then(|s| s.parse().ok());
-    let proposals: Option<usize> = arg(&args, "--proposals").and_then(|s| s.parse().ok());
-    let max_pairs: Option<usize> = arg(&args, "--max-pairs").and_then(|s| s.parse().ok());
-    // `--first-seed S`: mazes S..S+runs (default 1), e.g. for a held-out set.
-    let first_seed: u64 = arg(&args, "--first-seed")
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(1);
-    let dump_search = args.iter().any(|a| a == "--dump-search");
-    // `--no-map-search`: the automatic method on vision alone (as before
-    // the map search existed).
-    let no_map_search = args.iter().any(|a| a == "--no-map-search");
+/// The command line (see the module docs); the experiments' knobs are
+/// `None` unless given.
+struct Options {
+    runs: u64,
+    others: u64,
+    duration: f64,
+    methods: Vec<MergeMethod>,
+    multi: u64,
+    verbose: bool,
+    /// `--only maze-14`: just that case, with the whole reason.
+    only: Option<String>,
+    /// `--scenario-out DIR`: write the cases' scenario files instead of running them.
+    scenario_out: Option<String>,
+    /// `--min-places N`: the verdict's independent places (an experiment).
+    min_places: Option<usize>,
+    /// `--min-inliers N`: rigid inliers a frame pair needs (an experiment).
+    min_inliers: Option<usize>,
+    /// `--max-keypoints N`, `--min-motion M`: frame features and thinning (experiments).
+    max_keypoints: Option<usize>,
+    min_motion: Option<f64>,
+    proposals: Option<usize>,
+    max_pairs: Option<usize>,
+    /// `--first-seed S`: mazes S..S+runs (default 1), e.g. for a held-out set.
+    first_seed: u64,
+    /// `--first-other S`: the no-overlap and repeated-texture cases use seeds
+    /// S..S+others (default 1: disjoint-101…, repeated-201…).
+    first_other: u64,
+    dump_search: bool,
+    /// `--no-map-search`: the automatic method on vision alone (as before
+    /// the map search existed).
+    no_map_search: bool,
+}
+
+impl Options {
+    fn parse(args: &[String]) -> Options {
+        let number = |name: &str| arg(args, name).and_then(|s| s.parse().ok());
+        Options {
+            runs: number("--runs").unwrap_or(20),
+            others: number("--others").unwrap_or(5),
+            duration: arg(args, "--duration")
+                .and_then(|s| s.parse().ok())
+                .unwrap_or(300.0),
+            methods: arg(args, "--methods")
+                .unwrap_or_else(|| "auto,thesis,map-only".into())
+                .split(',')
+                .map(|m| MergeMethod::parse(m).expect("method"))
+                .collect(),
+            multi: number("--multi").unwrap_or(0),
+            verbose: args.iter().any(|a| a == "--verbose"),
+            only: arg(args, "--only"),
+            scenario_out: arg(args, "--scenario-out"),
+            min_places: arg(args, "--min-places").and_then(|s| s.parse().ok()),
+            min_inliers: arg(args, "--min-inliers").and_then(|s| s.parse().ok()),
+            max_keypoints: arg(args, "--max-keypoints").and_then(|s| s.parse().ok()),
+            min_motion: arg(args, "--min-motion").and_then(|s| s.parse().ok()),
+            proposals: arg(args, "--proposals").and_then(|s| s.parse().ok()),
+            max_pairs: arg(args, "--max-pairs").and_then(|s| s.parse().ok()),
+            first_seed: number("--first-seed").unwrap_or(1),
+            first_other: number("--first-other").unwrap_or(1),
+            dump_search: args.iter().any(|a| a == "--dump-search"),
+            no_map_search: args.iter().any(|a| a == "--no-map-search"),
+        }
+    }
+
+    /// The merge's configuration for `method`, with the experiments' knobs.
+    fn merge_config(&self, method: MergeMethod, seed: u64) -> MergeConfig {
+        let mut cfg = MergeConfig::new(method, seed);
+        if let Some(n) = self.min_places {
+            cfg.verdict.min_places = n;
+        }
+        if let Some(n) = self.min_inliers {
+            cfg.verify.min_inliers = n;
+        }
+        if let Some(n) = self.max_keypoints {
+            cfg.max_keypoints = n;
+        }
+        if let Some(m) = self.min_motion {
+            cfg.min_motion_m = m;
+        }
+        if let Some(n) = self.proposals {
+            cfg.proposals_per_frame = n;
+        }
+        if let Some(n) = self.max_pairs {
+            cfg.max_pairs = n;
+        }
+        if self.no_map_search {
+            cfg.map_search = None;
+        }
+        cfg
+    }
+}
+
+/// The benchmark's cases, (name, scenario JSON): random mazes, then
+/// disjoint pairs and repeated-texture mazes, then three-robot mazes.
+fn bench_cases(o: &Options) -> Vec<(String, String)> {
+    let duration = o.duration;
     let mut cases: Vec<(String, String)> = Vec::new();
-    for seed in first_seed..first_seed + runs {
+    for seed in o.first_seed..o.first_seed + o.runs {
         let spec = MazeSpec {
             seed,
             duration_s: duration,
@@ -131,12 +186,7 @@ fn main() {
         };
         cases.push((format!("maze-{seed}"), random_maze(&spec)));
     }
-    // `--first-other S`: the no-overlap and repeated-texture cases use seeds
-    // S..S+others (default 1: disjoint-101…, repeated-201…).
-    let first_other: u64 = arg(&args, "--first-other")
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(1);
-    for seed in first_other..first_other + others {
+    for seed in o.first_other..o.first_other + o.others {
         let spec = MazeSpec {
             seed: 100 + seed,
             duration_s: duration,
@@ -151,7 +201,7 @@ fn main() {
         };
         cases.push((format!("repeated-{}", 200 + seed), random_maze(&spec)));
     }
-    for seed in 1..=multi {
+    for seed in 1..=o.multi {
         let spec = MazeSpec {
             seed: 300 + seed,
             robots: 3,
@@ -160,7 +210,15 @@ fn main() {
         };
         cases.push((format!("three-{}", 300 + seed), random_maze(&spec)));
     }
-    let mut tallies: Vec<(String, Tally)> = methods
+    cases
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let o = Options::parse(&args);
+    let cases = bench_cases(&o);
+    let mut tallies: Vec<(String, Tally)> = o
+        .methods
         .iter()
         .flat_map(|m| {
             ["maze", "disjoint", "repeated", "three"]
@@ -171,10 +229,10 @@ fn main() {
     let mut multi_tally: Vec<(&'static str, MultiTally)> = Vec::new();
     println!("case            method    common  status    error_m  error_deg  ms     reason");
     for (name, json) in &cases {
-        if only.as_ref().is_some_and(|o| o != name) {
+        if o.only.as_ref().is_some_and(|only| only != name) {
             continue;
         }
-        if let Some(dir) = &scenario_out {
+        if let Some(dir) = &o.scenario_out {
             // `--scenario-out DIR`: each case as a scenario file, to open in
             // the page or run with `node web/cli.mjs run`.
             let path = std::path::Path::new(dir).join(format!("{name}.json"));
@@ -194,131 +252,173 @@ fn main() {
         );
         let kind = name.split('-').next().unwrap_or("maze");
         let has_common = kind != "disjoint" && common >= COMMON_CELLS;
-        if dump_search {
+        if o.dump_search {
             // `--dump-search`: the map-only search on robots 1 and 2 alone,
             // every hypothesis scored against the truth (an experiment).
             dump_map_search(name, common, &sim, &truth);
             continue;
         }
-        for &method in &methods {
+        for &method in &o.methods {
             let t0 = Instant::now();
-            let mut cfg = MergeConfig::new(method, scenario.seed);
-            if let Some(n) = min_places {
-                cfg.verdict.min_places = n;
-            }
-            if let Some(n) = min_inliers {
-                cfg.verify.min_inliers = n;
-            }
-            if let Some(n) = max_keypoints {
-                cfg.max_keypoints = n;
-            }
-            if let Some(m) = min_motion {
-                cfg.min_motion_m = m;
-            }
-            if let Some(n) = proposals {
-                cfg.proposals_per_frame = n;
-            }
-            if let Some(n) = max_pairs {
-                cfg.max_pairs = n;
-            }
-            if no_map_search {
-                cfg.map_search = None;
-            }
-            let mut job = MergeJob::new(&sim, cfg).expect("job");
-            let mut stage_ms: Vec<(&'static str, f64)> = Vec::new();
-            while !job.is_done() {
-                let stage = job.stage().name();
-                let t = Instant::now();
-                job.advance(&sim, usize::MAX).expect("merge runs");
-                let dt = t.elapsed().as_secs_f64() * 1e3;
-                match stage_ms.iter_mut().find(|(s, _)| *s == stage) {
-                    Some(e) => e.1 += dt,
-                    None => stage_ms.push((stage, dt)),
-                }
-            }
+            let (job, stage_ms) = run_merge(&sim, o.merge_config(method, scenario.seed));
             let ms = t0.elapsed().as_secs_f64() * 1e3;
-            if verbose {
-                let frames: usize = job.robots.iter().map(|r| r.selected.len()).sum();
-                let pairs: usize = job.pairs.iter().map(|p| p.cells.len()).sum();
-                let parts: Vec<String> = stage_ms
-                    .iter()
-                    .map(|(s, t)| format!("{s} {t:.0}"))
-                    .collect();
-                let kps: usize = job
-                    .robots
-                    .iter()
-                    .flat_map(|r| r.features.iter())
-                    .map(|f| f.len())
-                    .sum();
-                println!(
-                    "    {frames} frames ({:.0} keypoints each), {pairs} pairs checked; ms: {}",
-                    kps as f64 / frames.max(1) as f64,
-                    parts.join(", ")
-                );
+            if o.verbose {
+                print_merge_work(&job, &stage_ms);
             }
             let outcome = job.outcome().expect("outcome");
-            let merged = outcome.status == MergeStatus::Merged;
             if kind == "three" {
                 score_robots(&sim, &starts, outcome, &mut multi_tally, method, name, ms);
                 continue;
             }
-            let err = outcome
-                .transforms
-                .iter()
-                .find(|t| t.robot == sim.robots[1].spec.name)
-                .map(|t| {
-                    let p = Pose2::new(t.pose[0], t.pose[1], t.pose[2]);
-                    (
-                        (p.position() - truth.position()).length(),
-                        wrap_angle(p.theta - truth.theta).to_degrees().abs(),
-                    )
-                });
-            let key = format!("{}/{kind}", method.name());
-            let tally = &mut tallies
-                .iter_mut()
-                .find(|(k, _)| *k == key)
-                .expect("tally")
-                .1;
-            tally.runs += 1;
-            tally.ms.push(ms);
-            if has_common {
-                tally.common += 1;
-            }
-            if merged {
-                let (m, d) = err.unwrap_or((f64::INFINITY, f64::INFINITY));
-                tally.errors.push((m, d));
-                if has_common {
-                    tally.merged_common += 1;
-                } else {
-                    tally.no_common_merged += 1;
-                }
-                if m <= 0.1 && d <= 1.0 {
-                    tally.correct += 1;
-                } else if m > 0.3 || d > 3.0 {
-                    tally.wrong += 1;
-                } else {
-                    tally.imprecise += 1;
-                }
-            }
-            let reason: String = if only.is_some() {
-                outcome.reason.clone()
-            } else {
-                outcome.reason.chars().take(90).collect()
+            let case = Case {
+                name,
+                kind,
+                common,
+                has_common,
+                truth: &truth,
             };
-            println!(
-                "{name:<15} {:<9} {common:>6}  {:<8} {:>8} {:>9} {ms:>6.0}  {reason}",
-                method.name(),
-                if merged { "merged" } else { "no_merge" },
-                err.filter(|_| merged)
-                    .map_or("-".into(), |e| format!("{:.3}", e.0)),
-                err.filter(|_| merged)
-                    .map_or("-".into(), |e| format!("{:.2}", e.1)),
+            score_pair(
+                &case,
+                &sim,
+                outcome,
+                &mut tallies,
+                method,
+                ms,
+                o.only.is_some(),
             );
         }
     }
+    print_summary(&tallies, &multi_tally);
+}
+
+/// Runs the merge stage by stage, timing each stage (ms).
+fn run_merge(sim: &Simulation, cfg: MergeConfig) -> (MergeJob, Vec<(&'static str, f64)>) {
+    let mut job = MergeJob::new(sim, cfg).expect("job");
+    let mut stage_ms: Vec<(&'static str, f64)> = Vec::new();
+    while !job.is_done() {
+        let stage = job.stage().name();
+        let t = Instant::now();
+        job.advance(sim, usize::MAX).expect("merge runs");
+        let dt = t.elapsed().as_secs_f64() * 1e3;
+        match stage_ms.iter_mut().find(|(s, _)| *s == stage) {
+            Some(e) => e.1 += dt,
+            None => stage_ms.push((stage, dt)),
+        }
+    }
+    (job, stage_ms)
+}
+
+/// What the merge looked at, and each stage's milliseconds (`--verbose`).
+fn print_merge_work(job: &MergeJob, stage_ms: &[(&'static str, f64)]) {
+    let frames: usize = job.robots.iter().map(|r| r.selected.len()).sum();
+    let pairs: usize = job.pairs.iter().map(|p| p.cells.len()).sum();
+    let parts: Vec<String> = stage_ms
+        .iter()
+        .map(|(s, t)| format!("{s} {t:.0}"))
+        .collect();
+    let kps: usize = job
+        .robots
+        .iter()
+        .flat_map(|r| r.features.iter())
+        .map(|f| f.len())
+        .sum();
+    println!(
+        "    {frames} frames ({:.0} keypoints each), {pairs} pairs checked; ms: {}",
+        kps as f64 / frames.max(1) as f64,
+        parts.join(", ")
+    );
+}
+
+/// A two-robot case as the scoring sees it.
+struct Case<'a> {
+    name: &'a str,
+    kind: &'a str,
+    /// Wall cells the two SLAM maps share under the true transform.
+    common: usize,
+    has_common: bool,
+    /// Robot 2's start in robot 1's start frame.
+    truth: &'a Pose2,
+}
+
+/// Scores robot 2's transform against the truth, counts it in its
+/// method's tally for the case's kind, and prints the case's line.
+fn score_pair(
+    case: &Case,
+    sim: &Simulation,
+    outcome: &slamlab::merge::job::MergeOutcome,
+    tallies: &mut [(String, Tally)],
+    method: MergeMethod,
+    ms: f64,
+    whole_reason: bool,
+) {
+    let (name, kind, common, has_common, truth) = (
+        case.name,
+        case.kind,
+        case.common,
+        case.has_common,
+        case.truth,
+    );
+    let merged = outcome.status == MergeStatus::Merged;
+    let err = outcome
+        .transforms
+        .iter()
+        .find(|t| t.robot == sim.robots[1].spec.name)
+        .map(|t| {
+            let p = Pose2::new(t.pose[0], t.pose[1], t.pose[2]);
+            (
+                (p.position() - truth.position()).length(),
+                wrap_angle(p.theta - truth.theta).to_degrees().abs(),
+            )
+        });
+    let key = format!("{}/{kind}", method.name());
+    let tally = &mut tallies
+        .iter_mut()
+        .find(|(k, _)| *k == key)
+        .expect("tally")
+        .1;
+    tally.runs += 1;
+    tally.ms.push(ms);
+    if has_common {
+        tally.common += 1;
+    }
+    if merged {
+        let (m, d) = err.unwrap_or((f64::INFINITY, f64::INFINITY));
+        tally.errors.push((m, d));
+        if has_common {
+            tally.merged_common += 1;
+        } else {
+            tally.no_common_merged += 1;
+        }
+        if m <= 0.1 && d <= 1.0 {
+            tally.correct += 1;
+        } else if m > 0.3 || d > 3.0 {
+            tally.wrong += 1;
+        } else {
+            tally.imprecise += 1;
+        }
+    }
+    let reason: String = if whole_reason {
+        outcome.reason.clone()
+    } else {
+        outcome.reason.chars().take(90).collect()
+    };
+    println!(
+        "{name:<15} {:<9} {common:>6}  {:<8} {:>8} {:>9} {ms:>6.0}  {reason}",
+        method.name(),
+        if merged { "merged" } else { "no_merge" },
+        err.filter(|_| merged)
+            .map_or("-".into(), |e| format!("{:.3}", e.0)),
+        err.filter(|_| merged)
+            .map_or("-".into(), |e| format!("{:.2}", e.1)),
+    );
+}
+
+/// The tables at the end: each method's two-robot tallies by kind of case,
+/// then its three-robot joins.
+fn print_summary(tallies: &[(String, Tally)], multi_tally: &[(&'static str, MultiTally)]) {
     println!();
     println!("method/cases        runs  common  merged(common)  correct  imprecise  wrong  merged(no common)  median ms");
-    for (key, t) in &tallies {
+    for (key, t) in tallies {
         if t.runs == 0 {
             continue;
         }
@@ -336,7 +436,7 @@ fn main() {
             ms[ms.len() / 2]
         );
     }
-    for (method, t) in &multi_tally {
+    for (method, t) in multi_tally {
         println!(
             "{method}/three: {} robots to join in {} runs, {} joined ({} correct, {} imprecise, {} wrong)",
             t.robots, t.runs, t.joined, t.correct, t.imprecise, t.wrong

@@ -52,7 +52,7 @@
 //! space ahead, a push away from anything closer than the body allows, and a
 //! short back-off after a bump keep the body off the walls.
 
-use crate::geom::Pose2;
+use crate::geom::{Pose2, PoseFrame};
 use crate::kinematics::P2dx;
 use crate::scenario::FollowSide;
 use crate::sensors::sonar::{SONAR_BEARINGS_DEG, SONAR_POSITIONS_M};
@@ -239,32 +239,11 @@ impl WallFollower {
         let frame = odom.frame();
         let pts: Vec<DVec2> = self.memory.iter().map(|&p| frame.to_local(p)).collect();
 
-        // The nearest point on the follow side (or straight ahead); right
-        // after an encounter, on the remembered wall if it is in sight.
-        let on_wall_line = |q: DVec2| match self.wall_line {
-            Some((a, d)) if t_s < self.reacquire_until_s => {
-                crate::geom::cross(d, frame.to_parent(q) - a).abs() < WALL_LINE_TOLERANCE_M
-            }
-            _ => true,
-        };
-        let pick = |restrict: bool| {
-            let mut best: Option<(f64, DVec2)> = None;
-            for &q in &pts {
-                if s * q.y < -0.05 || (restrict && !on_wall_line(q)) {
-                    continue;
-                }
-                let r = q.length();
-                if r < MEMORY_RADIUS_M && best.is_none_or(|(rb, _)| r < rb) {
-                    best = Some((r, q));
-                }
-            }
-            best
-        };
         // Right after an encounter only the remembered wall will do: if it
         // is out of sight, the Seek branch below heads back to it (falling
         // back on any nearer point here is how robots got captured by a
         // pillar next to the place where they met).
-        let nearest = pick(true);
+        let nearest = self.nearest_wall_point(t_s, &frame, &pts);
         if let Some((r, q)) = nearest {
             // Remember the wall we follow, as long as no encounter is on.
             if self.waiting_since_s.is_none() && t_s >= self.reacquire_until_s {
@@ -273,8 +252,61 @@ impl WallFollower {
                 self.wall_line = Some((odom.transform_point(q), tangent_odom));
             }
         }
+        let dir = self.steer_by_wall(t_s, odom, sonar, nearest);
 
-        let mut dir = match nearest {
+        // Other robots: is one coming at us in our lane?
+        let robots: Vec<DVec2> = self
+            .robots_seen
+            .iter()
+            .map(|&p| frame.to_local(p))
+            .collect();
+        let Some(dir) = self.steer_by_robots(t_s, odom, &robots, dir) else {
+            return Command::default();
+        };
+        self.drive(&pts, &robots, dir)
+    }
+
+    /// The nearest remembered point (robot frame) on the follow side or
+    /// straight ahead, with its distance; right after an encounter, only a
+    /// point on the remembered wall.
+    fn nearest_wall_point(
+        &self,
+        t_s: f64,
+        frame: &PoseFrame,
+        pts: &[DVec2],
+    ) -> Option<(f64, DVec2)> {
+        let s = self.side.sign();
+        let on_wall_line = |q: DVec2| match self.wall_line {
+            Some((a, d)) if t_s < self.reacquire_until_s => {
+                crate::geom::cross(d, frame.to_parent(q) - a).abs() < WALL_LINE_TOLERANCE_M
+            }
+            _ => true,
+        };
+        let mut best: Option<(f64, DVec2)> = None;
+        for &q in pts {
+            if s * q.y < -0.05 || !on_wall_line(q) {
+                continue;
+            }
+            let r = q.length();
+            if r < MEMORY_RADIUS_M && best.is_none_or(|(rb, _)| r < rb) {
+                best = Some((r, q));
+            }
+        }
+        best
+    }
+
+    /// The heading (robot frame, unit) that follows the wall at `nearest`:
+    /// along it, leaning in or out to hold the clearance; with no wall in
+    /// sight, straight ahead or back to the wall left at an encounter.
+    fn steer_by_wall(
+        &mut self,
+        t_s: f64,
+        odom: &Pose2,
+        sonar: &SonarReading,
+        nearest: Option<(f64, DVec2)>,
+    ) -> DVec2 {
+        let s = self.side.sign();
+        match nearest {
             None => {
                 self.mode = FollowerMode::Seek;
                 match self.wall_line {
@@ -308,14 +340,20 @@ impl WallFollower {
                 self.mode = FollowerMode::Follow;
                 (tangent + lean * n).normalize_or(DVec2::X)
             }
-        };
+        }
+    }
 
-        // Other robots: is one coming at us in our lane?
-        let robots: Vec<DVec2> = self
-            .robots_seen
-            .iter()
-            .map(|&p| frame.to_local(p))
-            .collect();
+    /// Encounters with other robots (`robots`, robot frame): with one
+    /// closing in our lane, the right-follower waits (`None`: stand still)
+    /// and then, like the left-follower, goes around it; the heading `dir`
+    /// is changed only while passing.
+    fn steer_by_robots(
+        &mut self,
+        t_s: f64,
+        odom: &Pose2,
+        robots: &[DVec2],
+        mut dir: DVec2,
+    ) -> Option<DVec2> {
         let centroid = (!self.robots_seen.is_empty()).then(|| {
             self.robots_seen.iter().copied().sum::<DVec2>() / self.robots_seen.len() as f64
         });
@@ -333,7 +371,7 @@ impl WallFollower {
             let yields = self.side == FollowSide::Right;
             if yields && t_s - since < MAX_WAIT_S {
                 self.mode = FollowerMode::Yield;
-                return Command::default();
+                return None;
             }
             // Go around it: follow its body as a wall on our left (our right
             // is free), or, after waiting in vain, on our right.
@@ -352,10 +390,17 @@ impl WallFollower {
         } else if self.waiting_since_s.take().is_some() {
             self.reacquire_until_s = t_s + REACQUIRE_S;
         }
+        Some(dir)
+    }
 
+    /// The command that heads along `dir` (robot frame), pushed away from
+    /// anything inside the body's personal space, slowing for turns and for
+    /// obstacles in the swept corridor ahead.
+    fn drive(&mut self, pts: &[DVec2], robots: &[DVec2], mut dir: DVec2) -> Command {
+        let s = self.side.sign();
         // Push away from anything inside the body's personal space.
         let mut push = DVec2::ZERO;
-        for &q in pts.iter().chain(&robots) {
+        for &q in pts.iter().chain(robots) {
             let r = q.length();
             if r < PERSONAL_SPACE_M && r > 1e-6 {
                 push -= q / r * ((PERSONAL_SPACE_M - r) / PERSONAL_SPACE_M) * 3.0;
@@ -373,7 +418,7 @@ impl WallFollower {
         let front = 0.5 * P2dx::BODY_LENGTH_M;
         let gap = pts
             .iter()
-            .chain(&robots)
+            .chain(robots)
             .filter(|q| q.x > 0.0 && q.y.abs() < half_w)
             .map(|q| q.x - front)
             .fold(f64::INFINITY, f64::min);

@@ -1,9 +1,9 @@
 //! # The scenario file
 //!
 //! A scenario is everything a run depends on: the walls, the robots and where
-//! they start, the noise, and the seed. Its JSON form is fixed by
-//! `shared/docs/interfaces.md` and documented, with every default, in the
-//! README. A run is a pure function of the scenario (and its seed).
+//! they start, the noise, and the seed. Its JSON form is fixed by the
+//! interface contract, `docs/interfaces.md`, and documented, with every
+//! default, in the README. A run is a pure function of the scenario (and its seed).
 //!
 //! Parsing goes in two layers so that every error names the field at fault
 //! (`robots[1].start: …`):
@@ -382,261 +382,12 @@ impl Scenario {
             None => DEFAULT_DURATION_S,
         };
 
-        let walls_v =
-            opt(root, "walls").ok_or_else(|| ScenarioError::new("walls", "is required"))?;
-        let walls_a = walls_v.as_array().ok_or_else(|| {
-            ScenarioError::new(
-                "walls",
-                format!("expected an array, found {}", type_name(walls_v)),
-            )
-        })?;
-        if walls_a.len() > MAX_WALLS {
-            return Err(ScenarioError::new(
-                "walls",
-                format!("{} walls, at most {MAX_WALLS} allowed", walls_a.len()),
-            ));
-        }
-        let mut walls = Vec::with_capacity(walls_a.len());
-        for (i, w) in walls_a.iter().enumerate() {
-            let path = format!("walls[{i}]");
-            let m = as_object(w, &path)?;
-            check_keys(m, &path, &["from", "to", "texture"])?;
-            let from = numbers::<2>(
-                m.get("from")
-                    .ok_or_else(|| ScenarioError::new(join(&path, "from"), "is required"))?,
-                &join(&path, "from"),
-                "[x, y]",
-            )?;
-            let to = numbers::<2>(
-                m.get("to")
-                    .ok_or_else(|| ScenarioError::new(join(&path, "to"), "is required"))?,
-                &join(&path, "to"),
-                "[x, y]",
-            )?;
-            let texture = match m.get("texture") {
-                None | Some(Value::Null) => None,
-                Some(v) => Some(string(v, &join(&path, "texture"))?),
-            };
-            let wall = WallSpec { from, to, texture };
-            if wall.segment().length() < 1e-6 {
-                return Err(ScenarioError::new(
-                    path,
-                    "zero-length wall (from equals to)",
-                ));
-            }
-            walls.push(wall);
-        }
-
-        let robots_v =
-            opt(root, "robots").ok_or_else(|| ScenarioError::new("robots", "is required"))?;
-        let robots_a = robots_v.as_array().ok_or_else(|| {
-            ScenarioError::new(
-                "robots",
-                format!("expected an array, found {}", type_name(robots_v)),
-            )
-        })?;
-        if robots_a.is_empty() {
-            return Err(ScenarioError::new(
-                "robots",
-                "at least one robot is required",
-            ));
-        }
-        if robots_a.len() > MAX_ROBOTS {
-            return Err(ScenarioError::new(
-                "robots",
-                format!("{} robots, at most {MAX_ROBOTS} allowed", robots_a.len()),
-            ));
-        }
-        let mut robots: Vec<RobotSpec> = Vec::with_capacity(robots_a.len());
-        for (i, r) in robots_a.iter().enumerate() {
-            let path = format!("robots[{i}]");
-            let m = as_object(r, &path)?;
-            check_keys(m, &path, &["name", "start", "follow", "distance", "speed"])?;
-            let name_path = join(&path, "name");
-            let name = string(
-                m.get("name")
-                    .ok_or_else(|| ScenarioError::new(&name_path, "is required"))?,
-                &name_path,
-            )?;
-            if name.trim().is_empty() {
-                return Err(ScenarioError::new(name_path, "must not be empty"));
-            }
-            if name.chars().count() > 64 {
-                return Err(ScenarioError::new(name_path, "longer than 64 characters"));
-            }
-            if robots.iter().any(|o| o.name == name) {
-                return Err(ScenarioError::new(
-                    name_path,
-                    format!("duplicate robot name '{name}'"),
-                ));
-            }
-            let start_path = join(&path, "start");
-            let start = numbers::<3>(
-                m.get("start")
-                    .ok_or_else(|| ScenarioError::new(&start_path, "is required"))?,
-                &start_path,
-                "[x, y, theta]",
-            )?;
-            let follow_path = join(&path, "follow");
-            let follow = match m.get("follow") {
-                None => return Err(ScenarioError::new(follow_path, "is required")),
-                Some(Value::String(s)) if s == "left" => FollowSide::Left,
-                Some(Value::String(s)) if s == "right" => FollowSide::Right,
-                Some(v) => {
-                    return Err(ScenarioError::new(
-                        follow_path,
-                        format!("expected \"left\" or \"right\", found {v}"),
-                    ))
-                }
-            };
-            let distance = match m.get("distance") {
-                Some(v) => number_in(v, &join(&path, "distance"), 0.3, 1.5)?,
-                None => DEFAULT_DISTANCE_M,
-            };
-            let speed = match m.get("speed") {
-                Some(v) => number_in(v, &join(&path, "speed"), 0.05, 0.5)?,
-                None => DEFAULT_SPEED_MPS,
-            };
-            robots.push(RobotSpec {
-                name,
-                start,
-                follow,
-                distance,
-                speed,
-            });
-        }
-
-        let mut noise = NoiseSpec::default();
-        if let Some(v) = opt(root, "noise") {
-            let m = as_object(v, "noise")?;
-            check_keys(
-                m,
-                "noise",
-                &[
-                    "wheel_slip",
-                    "wheel_scale_error",
-                    "wheelbase_error",
-                    "sonar_std_m",
-                    "laser_std_m",
-                ],
-            )?;
-            if let Some(v) = m.get("wheel_slip") {
-                noise.wheel_slip = number_in(v, "noise.wheel_slip", 0.0, 0.5)?;
-            }
-            if let Some(v) = m.get("wheel_scale_error") {
-                let e = numbers::<2>(v, "noise.wheel_scale_error", "[left, right]")?;
-                for (k, x) in e.iter().enumerate() {
-                    if x.abs() > 0.2 {
-                        return Err(ScenarioError::new(
-                            format!("noise.wheel_scale_error[{k}]"),
-                            format!("{x} is outside [-0.2, 0.2]"),
-                        ));
-                    }
-                }
-                noise.wheel_scale_error = e;
-            }
-            if let Some(v) = m.get("wheelbase_error") {
-                noise.wheelbase_error = number_in(v, "noise.wheelbase_error", -0.2, 0.2)?;
-            }
-            if let Some(v) = m.get("sonar_std_m") {
-                noise.sonar_std_m = number_in(v, "noise.sonar_std_m", 0.0, 1.0)?;
-            }
-            if let Some(v) = m.get("laser_std_m") {
-                noise.laser_std_m = number_in(v, "noise.laser_std_m", 0.0, 1.0)?;
-            }
-        }
-
-        let mut sensors = SensorSpec::default();
-        if let Some(v) = opt(root, "sensors") {
-            let m = as_object(v, "sensors")?;
-            check_keys(
-                m,
-                "sensors",
-                &["sonar_range_m", "sonar_cone_deg", "laser_range_m"],
-            )?;
-            if let Some(v) = m.get("sonar_range_m") {
-                sensors.sonar_range_m = number_in(v, "sensors.sonar_range_m", 0.5, 10.0)?;
-            }
-            if let Some(v) = m.get("sonar_cone_deg") {
-                sensors.sonar_cone_deg = number_in(v, "sensors.sonar_cone_deg", 0.0, 60.0)?;
-            }
-            if let Some(v) = m.get("laser_range_m") {
-                sensors.laser_range_m = number_in(v, "sensors.laser_range_m", 0.5, 30.0)?;
-            }
-        }
-        let mut camera = CameraSpec::default();
-        if let Some(v) = opt(root, "camera") {
-            let m = as_object(v, "camera")?;
-            check_keys(
-                m,
-                "camera",
-                &[
-                    "width",
-                    "height",
-                    "hfov_deg",
-                    "mount_height_m",
-                    "wall_height_m",
-                    "pixel_noise_std",
-                    "exposure_jitter",
-                    "period_s",
-                ],
-            )?;
-            let whole = |v: &Value, path: &str, lo: u32, hi: u32| -> Result<u32, ScenarioError> {
-                let x = number_in(v, path, lo as f64, hi as f64)?;
-                if x.fract() != 0.0 {
-                    return Err(ScenarioError::new(
-                        path,
-                        format!("{x} is not a whole number of pixels"),
-                    ));
-                }
-                Ok(x as u32)
-            };
-            if let Some(v) = m.get("width") {
-                camera.width = whole(v, "camera.width", 16, 640)?;
-            }
-            if let Some(v) = m.get("height") {
-                camera.height = whole(v, "camera.height", 16, 480)?;
-            }
-            if let Some(v) = m.get("hfov_deg") {
-                camera.hfov_deg = number_in(v, "camera.hfov_deg", 20.0, 150.0)?;
-            }
-            if let Some(v) = m.get("wall_height_m") {
-                camera.wall_height_m = number_in(v, "camera.wall_height_m", 0.5, 10.0)?;
-            }
-            if let Some(v) = m.get("mount_height_m") {
-                camera.mount_height_m = number_in(v, "camera.mount_height_m", 0.05, 5.0)?;
-            }
-            if camera.mount_height_m >= camera.wall_height_m {
-                return Err(ScenarioError::new(
-                    "camera.mount_height_m",
-                    format!(
-                        "{} m is not below the walls' height of {} m",
-                        camera.mount_height_m, camera.wall_height_m
-                    ),
-                ));
-            }
-            if let Some(v) = m.get("pixel_noise_std") {
-                camera.pixel_noise_std = number_in(v, "camera.pixel_noise_std", 0.0, 50.0)?;
-            }
-            if let Some(v) = m.get("exposure_jitter") {
-                camera.exposure_jitter = number_in(v, "camera.exposure_jitter", 0.0, 0.5)?;
-            }
-            if let Some(v) = m.get("period_s") {
-                camera.period_s = number_in(v, "camera.period_s", 0.1, 60.0)?;
-            }
-        }
-
-        for (i, r) in robots.iter().enumerate() {
-            if r.distance + 0.2 > sensors.sonar_range_m {
-                return Err(ScenarioError::new(
-                    format!("robots[{i}].distance"),
-                    format!(
-                        "{} m cannot be held: the side sonar only reaches {} m",
-                        r.distance, sensors.sonar_range_m
-                    ),
-                ));
-            }
-        }
+        let walls = parse_walls(root)?;
+        let robots = parse_robots(root)?;
+        let noise = parse_noise(root)?;
+        let sensors = parse_sensors(root)?;
+        let camera = parse_camera(root)?;
+        check_distances_held(&robots, &sensors)?;
 
         Ok(Scenario {
             name,
@@ -715,4 +466,285 @@ impl Scenario {
         }
         (lo, hi)
     }
+}
+
+/// `walls`: required, at most [`MAX_WALLS`], none of zero length.
+fn parse_walls(root: &Map<String, Value>) -> Result<Vec<WallSpec>, ScenarioError> {
+    let walls_v = opt(root, "walls").ok_or_else(|| ScenarioError::new("walls", "is required"))?;
+    let walls_a = walls_v.as_array().ok_or_else(|| {
+        ScenarioError::new(
+            "walls",
+            format!("expected an array, found {}", type_name(walls_v)),
+        )
+    })?;
+    if walls_a.len() > MAX_WALLS {
+        return Err(ScenarioError::new(
+            "walls",
+            format!("{} walls, at most {MAX_WALLS} allowed", walls_a.len()),
+        ));
+    }
+    let mut walls = Vec::with_capacity(walls_a.len());
+    for (i, w) in walls_a.iter().enumerate() {
+        let path = format!("walls[{i}]");
+        let m = as_object(w, &path)?;
+        check_keys(m, &path, &["from", "to", "texture"])?;
+        let from = numbers::<2>(
+            m.get("from")
+                .ok_or_else(|| ScenarioError::new(join(&path, "from"), "is required"))?,
+            &join(&path, "from"),
+            "[x, y]",
+        )?;
+        let to = numbers::<2>(
+            m.get("to")
+                .ok_or_else(|| ScenarioError::new(join(&path, "to"), "is required"))?,
+            &join(&path, "to"),
+            "[x, y]",
+        )?;
+        let texture = match m.get("texture") {
+            None | Some(Value::Null) => None,
+            Some(v) => Some(string(v, &join(&path, "texture"))?),
+        };
+        let wall = WallSpec { from, to, texture };
+        if wall.segment().length() < 1e-6 {
+            return Err(ScenarioError::new(
+                path,
+                "zero-length wall (from equals to)",
+            ));
+        }
+        walls.push(wall);
+    }
+    Ok(walls)
+}
+
+/// `robots`: required, one to [`MAX_ROBOTS`], names unique.
+fn parse_robots(root: &Map<String, Value>) -> Result<Vec<RobotSpec>, ScenarioError> {
+    let robots_v =
+        opt(root, "robots").ok_or_else(|| ScenarioError::new("robots", "is required"))?;
+    let robots_a = robots_v.as_array().ok_or_else(|| {
+        ScenarioError::new(
+            "robots",
+            format!("expected an array, found {}", type_name(robots_v)),
+        )
+    })?;
+    if robots_a.is_empty() {
+        return Err(ScenarioError::new(
+            "robots",
+            "at least one robot is required",
+        ));
+    }
+    if robots_a.len() > MAX_ROBOTS {
+        return Err(ScenarioError::new(
+            "robots",
+            format!("{} robots, at most {MAX_ROBOTS} allowed", robots_a.len()),
+        ));
+    }
+    let mut robots: Vec<RobotSpec> = Vec::with_capacity(robots_a.len());
+    for (i, r) in robots_a.iter().enumerate() {
+        let path = format!("robots[{i}]");
+        let m = as_object(r, &path)?;
+        check_keys(m, &path, &["name", "start", "follow", "distance", "speed"])?;
+        let name_path = join(&path, "name");
+        let name = string(
+            m.get("name")
+                .ok_or_else(|| ScenarioError::new(&name_path, "is required"))?,
+            &name_path,
+        )?;
+        if name.trim().is_empty() {
+            return Err(ScenarioError::new(name_path, "must not be empty"));
+        }
+        if name.chars().count() > 64 {
+            return Err(ScenarioError::new(name_path, "longer than 64 characters"));
+        }
+        if robots.iter().any(|o| o.name == name) {
+            return Err(ScenarioError::new(
+                name_path,
+                format!("duplicate robot name '{name}'"),
+            ));
+        }
+        let start_path = join(&path, "start");
+        let start = numbers::<3>(
+            m.get("start")
+                .ok_or_else(|| ScenarioError::new(&start_path, "is required"))?,
+            &start_path,
+            "[x, y, theta]",
+        )?;
+        let follow_path = join(&path, "follow");
+        let follow = match m.get("follow") {
+            None => return Err(ScenarioError::new(follow_path, "is required")),
+            Some(Value::String(s)) if s == "left" => FollowSide::Left,
+            Some(Value::String(s)) if s == "right" => FollowSide::Right,
+            Some(v) => {
+                return Err(ScenarioError::new(
+                    follow_path,
+                    format!("expected \"left\" or \"right\", found {v}"),
+                ))
+            }
+        };
+        let distance = match m.get("distance") {
+            Some(v) => number_in(v, &join(&path, "distance"), 0.3, 1.5)?,
+            None => DEFAULT_DISTANCE_M,
+        };
+        let speed = match m.get("speed") {
+            Some(v) => number_in(v, &join(&path, "speed"), 0.05, 0.5)?,
+            None => DEFAULT_SPEED_MPS,
+        };
+        robots.push(RobotSpec {
+            name,
+            start,
+            follow,
+            distance,
+            speed,
+        });
+    }
+    Ok(robots)
+}
+
+/// `noise`: optional, each field defaulted on its own.
+fn parse_noise(root: &Map<String, Value>) -> Result<NoiseSpec, ScenarioError> {
+    let mut noise = NoiseSpec::default();
+    if let Some(v) = opt(root, "noise") {
+        let m = as_object(v, "noise")?;
+        check_keys(
+            m,
+            "noise",
+            &[
+                "wheel_slip",
+                "wheel_scale_error",
+                "wheelbase_error",
+                "sonar_std_m",
+                "laser_std_m",
+            ],
+        )?;
+        if let Some(v) = m.get("wheel_slip") {
+            noise.wheel_slip = number_in(v, "noise.wheel_slip", 0.0, 0.5)?;
+        }
+        if let Some(v) = m.get("wheel_scale_error") {
+            let e = numbers::<2>(v, "noise.wheel_scale_error", "[left, right]")?;
+            for (k, x) in e.iter().enumerate() {
+                if x.abs() > 0.2 {
+                    return Err(ScenarioError::new(
+                        format!("noise.wheel_scale_error[{k}]"),
+                        format!("{x} is outside [-0.2, 0.2]"),
+                    ));
+                }
+            }
+            noise.wheel_scale_error = e;
+        }
+        if let Some(v) = m.get("wheelbase_error") {
+            noise.wheelbase_error = number_in(v, "noise.wheelbase_error", -0.2, 0.2)?;
+        }
+        if let Some(v) = m.get("sonar_std_m") {
+            noise.sonar_std_m = number_in(v, "noise.sonar_std_m", 0.0, 1.0)?;
+        }
+        if let Some(v) = m.get("laser_std_m") {
+            noise.laser_std_m = number_in(v, "noise.laser_std_m", 0.0, 1.0)?;
+        }
+    }
+    Ok(noise)
+}
+
+/// `sensors`: optional, each field defaulted on its own.
+fn parse_sensors(root: &Map<String, Value>) -> Result<SensorSpec, ScenarioError> {
+    let mut sensors = SensorSpec::default();
+    if let Some(v) = opt(root, "sensors") {
+        let m = as_object(v, "sensors")?;
+        check_keys(
+            m,
+            "sensors",
+            &["sonar_range_m", "sonar_cone_deg", "laser_range_m"],
+        )?;
+        if let Some(v) = m.get("sonar_range_m") {
+            sensors.sonar_range_m = number_in(v, "sensors.sonar_range_m", 0.5, 10.0)?;
+        }
+        if let Some(v) = m.get("sonar_cone_deg") {
+            sensors.sonar_cone_deg = number_in(v, "sensors.sonar_cone_deg", 0.0, 60.0)?;
+        }
+        if let Some(v) = m.get("laser_range_m") {
+            sensors.laser_range_m = number_in(v, "sensors.laser_range_m", 0.5, 30.0)?;
+        }
+    }
+    Ok(sensors)
+}
+
+/// `camera`: optional, each field defaulted on its own; the camera must sit
+/// below the walls' top.
+fn parse_camera(root: &Map<String, Value>) -> Result<CameraSpec, ScenarioError> {
+    let mut camera = CameraSpec::default();
+    if let Some(v) = opt(root, "camera") {
+        let m = as_object(v, "camera")?;
+        check_keys(
+            m,
+            "camera",
+            &[
+                "width",
+                "height",
+                "hfov_deg",
+                "mount_height_m",
+                "wall_height_m",
+                "pixel_noise_std",
+                "exposure_jitter",
+                "period_s",
+            ],
+        )?;
+        let whole = |v: &Value, path: &str, lo: u32, hi: u32| -> Result<u32, ScenarioError> {
+            let x = number_in(v, path, lo as f64, hi as f64)?;
+            if x.fract() != 0.0 {
+                return Err(ScenarioError::new(
+                    path,
+                    format!("{x} is not a whole number of pixels"),
+                ));
+            }
+            Ok(x as u32)
+        };
+        if let Some(v) = m.get("width") {
+            camera.width = whole(v, "camera.width", 16, 640)?;
+        }
+        if let Some(v) = m.get("height") {
+            camera.height = whole(v, "camera.height", 16, 480)?;
+        }
+        if let Some(v) = m.get("hfov_deg") {
+            camera.hfov_deg = number_in(v, "camera.hfov_deg", 20.0, 150.0)?;
+        }
+        if let Some(v) = m.get("wall_height_m") {
+            camera.wall_height_m = number_in(v, "camera.wall_height_m", 0.5, 10.0)?;
+        }
+        if let Some(v) = m.get("mount_height_m") {
+            camera.mount_height_m = number_in(v, "camera.mount_height_m", 0.05, 5.0)?;
+        }
+        if camera.mount_height_m >= camera.wall_height_m {
+            return Err(ScenarioError::new(
+                "camera.mount_height_m",
+                format!(
+                    "{} m is not below the walls' height of {} m",
+                    camera.mount_height_m, camera.wall_height_m
+                ),
+            ));
+        }
+        if let Some(v) = m.get("pixel_noise_std") {
+            camera.pixel_noise_std = number_in(v, "camera.pixel_noise_std", 0.0, 50.0)?;
+        }
+        if let Some(v) = m.get("exposure_jitter") {
+            camera.exposure_jitter = number_in(v, "camera.exposure_jitter", 0.0, 0.5)?;
+        }
+        if let Some(v) = m.get("period_s") {
+            camera.period_s = number_in(v, "camera.period_s", 0.1, 60.0)?;
+        }
+    }
+    Ok(camera)
+}
+
+/// Each robot's wall distance must be within its side sonar's reach.
+fn check_distances_held(robots: &[RobotSpec], sensors: &SensorSpec) -> Result<(), ScenarioError> {
+    for (i, r) in robots.iter().enumerate() {
+        if r.distance + 0.2 > sensors.sonar_range_m {
+            return Err(ScenarioError::new(
+                format!("robots[{i}].distance"),
+                format!(
+                    "{} m cannot be held: the side sonar only reaches {} m",
+                    r.distance, sensors.sonar_range_m
+                ),
+            ));
+        }
+    }
+    Ok(())
 }

@@ -206,38 +206,15 @@ pub fn render(
         None => 1.0,
     };
     let origin = pose.position();
-    let cy = h as f64 / 2.0;
-    let ppm = TEXELS_PER_M as f64;
-    // Floor and ceiling depend only on the row: shade them once per frame.
-    let row_shade: Vec<f64> = (0..h)
-        .map(|r| {
-            let yc = r as f64 + 0.5;
-            if yc < cy {
-                ceiling_shade(cam, yc)
-            } else {
-                floor_shade(cam, yc)
-            }
-        })
-        .collect();
-    let row_rgb: Vec<[u8; 3]> = row_shade
-        .iter()
-        .enumerate()
-        .map(|(r, &v)| {
-            if (r as f64 + 0.5) < cy {
-                [v as u8, v as u8, (v + 8.0).min(255.0) as u8]
-            } else {
-                [
-                    (v + 10.0).min(255.0) as u8,
-                    v as u8,
-                    (v - 10.0).max(0.0) as u8,
-                ]
-            }
-        })
-        .collect();
-    let mut memo: Option<(usize, bool, i64, std::sync::Arc<texture::Chunk>)> = None;
+    let (row_shade, row_rgb) = floor_and_ceiling(cam);
+    let mut sampler = WallSampler {
+        cam,
+        walls,
+        bank,
+        memo: None,
+        across: Vec::with_capacity(h as usize + 2),
+    };
     let mut column = vec![0f64; h as usize];
-    // One wall column's texel rows, interpolated across x.
-    let mut across: Vec<f64> = Vec::with_capacity(h as usize + 2);
     let mut column_rgb = vec![[0u8; 3]; if colour { h as usize } else { 0 }];
     for c in 0..w {
         let local = cam.column_ray(c);
@@ -250,103 +227,19 @@ pub fn render(
         // The nearest wall: its span of rows, sampled from the texture.
         let hit = world.cast(origin, dir, MAX_VIEW_M);
         if let Some((hit, wi)) = hit.and_then(|hit| hit.wall.map(|wi| (hit, wi))) {
-            let depth = hit.range_m * cos_a;
-            let seg = world.walls()[wi];
-            let p = origin + dir * hit.range_m;
-            let back = cross(seg.b - seg.a, origin - seg.a) < 0.0;
-            // Measured so that the texture reads left to right for the
-            // viewer: from `b` on the left side of a→b, from `a` on its
-            // right side.
-            let along = if back {
-                (p - seg.a).length()
-            } else {
-                (p - seg.b).length()
+            let ray = WallRay {
+                seg: world.walls()[wi],
+                wi,
+                origin,
+                dir,
+                range_m: hit.range_m,
+                cos_a,
             };
-            // Texels per pixel decides the mip level.
-            let footprint = ppm * depth / cam.f_px;
-            let level = if footprint < 1.6 {
-                0
-            } else if footprint < 3.2 {
-                1
-            } else {
-                2
-            };
-            let k = along.floor() as i64;
-            let lx = (along - k as f64) * ppm;
-            // Neighbouring columns mostly draw from the same chunk: look it
-            // up (a string key and a hash) only when it changes.
-            let chunk = match &memo {
-                Some((w, b, c, chunk)) if (*w, *b, *c) == (wi, back, k) => chunk.clone(),
-                _ => {
-                    let chunk = bank.chunk(&wall_texture_key(walls, wi, back), k);
-                    memo = Some((wi, back, k, chunk.clone()));
-                    chunk
-                }
-            };
-            let (top, bottom) = (cam.row_of(cam.wall_height_m, depth), cam.row_of(0.0, depth));
-            let (r0, r1) = row_span(top, bottom, h);
-            // On the wall, texel row = (h_w - z) * ppm with z linear in the
-            // row: ty(r) = ty0 + r * dty.
-            let scale = (1u32 << level) as f64;
-            let dty = ppm * depth / (cam.f_px * scale);
-            let ty0 = ((cam.wall_height_m - cam.mount_height_m) * ppm
-                + (0.5 - cy) * ppm * depth / cam.f_px)
-                / scale;
-            let (tw, th) = (chunk.width[level], chunk.height[level]);
-            let tex = &chunk.gray[level];
-            let x = (lx / scale - 0.5).clamp(0.0, (tw - 1) as f64);
-            let x0 = x as usize;
-            let x1 = (x0 + 1).min(tw as usize - 1);
-            let fx = x - x0 as f64;
-            let tw = tw as usize;
-            let y_at = |r: u32| (ty0 + r as f64 * dty - 0.5).clamp(0.0, (th - 1) as f64);
-            if r0 < r1 {
-                // The texel rows this span reads (y only grows with r),
-                // interpolated across x once each: close to a wall, many
-                // pixel rows share a texel row.
-                let y_lo = y_at(r0) as usize;
-                let y_hi = (y_at(r1 - 1) as usize + 1).min(th as usize - 1);
-                across.clear();
-                across.extend((y_lo..=y_hi).map(|ty| {
-                    let (a, b) = (tex[ty * tw + x0] as f64, tex[ty * tw + x1] as f64);
-                    a + (b - a) * fx
-                }));
-                for r in r0..r1 {
-                    let y = y_at(r);
-                    let y0 = y as usize;
-                    let y1 = (y0 + 1).min(th as usize - 1);
-                    let fy = y - y0 as f64;
-                    let (top_v, bot_v) = (across[y0 - y_lo], across[y1 - y_lo]);
-                    column[r as usize] = top_v + (bot_v - top_v) * fy;
-                }
-            }
-            if colour {
-                let (tw0, th0) = (chunk.width[0], chunk.height[0]);
-                let tx = (lx as u32).min(tw0 - 1);
-                for r in r0..r1 {
-                    let ty = ((ty0 + r as f64 * dty) * scale).max(0.0) as u32;
-                    let i = ((ty.min(th0 - 1) * tw0 + tx) * 4) as usize;
-                    column_rgb[r as usize] = [chunk.rgba[i], chunk.rgba[i + 1], chunk.rgba[i + 2]];
-                }
-            }
+            sampler.paint(&ray, &mut column, colour.then_some(&mut column_rgb[..]));
         }
         // Other robots in front of the wall hide it up to their height.
         let wall_range = hit.map_or(f64::INFINITY, |h| h.range_m);
-        let mut robot_hit: Option<(f64, [u8; 3], f64)> = None;
-        for rb in robots {
-            let n = rb.corners.len();
-            for k in 0..n {
-                let (a, b) = (rb.corners[k], rb.corners[(k + 1) % n]);
-                if let Some(t) = crate::geom::Segment::new(a, b).ray_hit(origin, dir) {
-                    if t < wall_range && robot_hit.is_none_or(|(tb, _, _)| t < tb) {
-                        // Faces turned away from the light are darker.
-                        let e = (b - a).normalize_or_zero();
-                        robot_hit = Some((t, rb.rgb, 0.65 + 0.35 * e.x.abs()));
-                    }
-                }
-            }
-        }
-        if let Some((t, col, shade)) = robot_hit {
+        if let Some((t, col, shade)) = nearest_robot(robots, origin, dir, wall_range) {
             let depth = t * cos_a;
             let (r0, r1) = row_span(cam.row_of(ROBOT_HEIGHT_M, depth), cam.row_of(0.0, depth), h);
             let v = (0.299 * col[0] as f64 + 0.587 * col[1] as f64 + 0.114 * col[2] as f64) * shade;
@@ -397,5 +290,176 @@ pub fn render(
         height: h,
         gray,
         rgba,
+    }
+}
+
+/// Floor and ceiling depend only on the row: their grey shade and colour
+/// for every row, computed once per frame.
+fn floor_and_ceiling(cam: &PinholeCamera) -> (Vec<f64>, Vec<[u8; 3]>) {
+    let cy = cam.height as f64 / 2.0;
+    let row_shade: Vec<f64> = (0..cam.height)
+        .map(|r| {
+            let yc = r as f64 + 0.5;
+            if yc < cy {
+                ceiling_shade(cam, yc)
+            } else {
+                floor_shade(cam, yc)
+            }
+        })
+        .collect();
+    let row_rgb: Vec<[u8; 3]> = row_shade
+        .iter()
+        .enumerate()
+        .map(|(r, &v)| {
+            if (r as f64 + 0.5) < cy {
+                [v as u8, v as u8, (v + 8.0).min(255.0) as u8]
+            } else {
+                [
+                    (v + 10.0).min(255.0) as u8,
+                    v as u8,
+                    (v - 10.0).max(0.0) as u8,
+                ]
+            }
+        })
+        .collect();
+    (row_shade, row_rgb)
+}
+
+/// The nearest robot face a column's ray meets before the wall at
+/// `wall_range`: its distance along the ray, colour, and shade (faces
+/// turned away from the light are darker).
+fn nearest_robot(
+    robots: &[RobotBox],
+    origin: DVec2,
+    dir: DVec2,
+    wall_range: f64,
+) -> Option<(f64, [u8; 3], f64)> {
+    let mut robot_hit: Option<(f64, [u8; 3], f64)> = None;
+    for rb in robots {
+        let n = rb.corners.len();
+        for k in 0..n {
+            let (a, b) = (rb.corners[k], rb.corners[(k + 1) % n]);
+            if let Some(t) = crate::geom::Segment::new(a, b).ray_hit(origin, dir) {
+                if t < wall_range && robot_hit.is_none_or(|(tb, _, _)| t < tb) {
+                    let e = (b - a).normalize_or_zero();
+                    robot_hit = Some((t, rb.rgb, 0.65 + 0.35 * e.x.abs()));
+                }
+            }
+        }
+    }
+    robot_hit
+}
+
+/// One column's ray meeting wall `wi` (segment `seg`): from `origin` along
+/// `dir`, at `range_m`; `cos_a` is the cosine of the column's angle off the
+/// optical axis.
+struct WallRay {
+    seg: crate::geom::Segment,
+    wi: usize,
+    origin: DVec2,
+    dir: DVec2,
+    range_m: f64,
+    cos_a: f64,
+}
+
+/// Wall sampling across a frame's columns: the textures, the chunk last
+/// looked up, and a scratch buffer of texel rows.
+struct WallSampler<'a> {
+    cam: &'a PinholeCamera,
+    walls: &'a [WallSpec],
+    bank: &'a mut TextureBank,
+    memo: Option<(usize, bool, i64, std::sync::Arc<texture::Chunk>)>,
+    /// One wall column's texel rows, interpolated across x.
+    across: Vec<f64>,
+}
+
+impl WallSampler<'_> {
+    /// Paints the wall's span of rows into `column` (and `column_rgb` when
+    /// the frame is in colour), sampled from the wall face's texture.
+    fn paint(&mut self, ray: &WallRay, column: &mut [f64], column_rgb: Option<&mut [[u8; 3]]>) {
+        let cam = self.cam;
+        let h = cam.height;
+        let cy = h as f64 / 2.0;
+        let ppm = TEXELS_PER_M as f64;
+        let (seg, wi, origin) = (ray.seg, ray.wi, ray.origin);
+        let depth = ray.range_m * ray.cos_a;
+        let p = origin + ray.dir * ray.range_m;
+        let back = cross(seg.b - seg.a, origin - seg.a) < 0.0;
+        // Measured so that the texture reads left to right for the
+        // viewer: from `b` on the left side of a→b, from `a` on its
+        // right side.
+        let along = if back {
+            (p - seg.a).length()
+        } else {
+            (p - seg.b).length()
+        };
+        // Texels per pixel decides the mip level.
+        let footprint = ppm * depth / cam.f_px;
+        let level = if footprint < 1.6 {
+            0
+        } else if footprint < 3.2 {
+            1
+        } else {
+            2
+        };
+        let k = along.floor() as i64;
+        let lx = (along - k as f64) * ppm;
+        // Neighbouring columns mostly draw from the same chunk: look it
+        // up (a string key and a hash) only when it changes.
+        let chunk = match &self.memo {
+            Some((w, b, c, chunk)) if (*w, *b, *c) == (wi, back, k) => chunk.clone(),
+            _ => {
+                let chunk = self.bank.chunk(&wall_texture_key(self.walls, wi, back), k);
+                self.memo = Some((wi, back, k, chunk.clone()));
+                chunk
+            }
+        };
+        let (top, bottom) = (cam.row_of(cam.wall_height_m, depth), cam.row_of(0.0, depth));
+        let (r0, r1) = row_span(top, bottom, h);
+        // On the wall, texel row = (h_w - z) * ppm with z linear in the
+        // row: ty(r) = ty0 + r * dty.
+        let scale = (1u32 << level) as f64;
+        let dty = ppm * depth / (cam.f_px * scale);
+        let ty0 = ((cam.wall_height_m - cam.mount_height_m) * ppm
+            + (0.5 - cy) * ppm * depth / cam.f_px)
+            / scale;
+        let (tw, th) = (chunk.width[level], chunk.height[level]);
+        let tex = &chunk.gray[level];
+        let x = (lx / scale - 0.5).clamp(0.0, (tw - 1) as f64);
+        let x0 = x as usize;
+        let x1 = (x0 + 1).min(tw as usize - 1);
+        let fx = x - x0 as f64;
+        let tw = tw as usize;
+        let y_at = |r: u32| (ty0 + r as f64 * dty - 0.5).clamp(0.0, (th - 1) as f64);
+        if r0 < r1 {
+            // The texel rows this span reads (y only grows with r),
+            // interpolated across x once each: close to a wall, many
+            // pixel rows share a texel row.
+            let y_lo = y_at(r0) as usize;
+            let y_hi = (y_at(r1 - 1) as usize + 1).min(th as usize - 1);
+            let across = &mut self.across;
+            across.clear();
+            across.extend((y_lo..=y_hi).map(|ty| {
+                let (a, b) = (tex[ty * tw + x0] as f64, tex[ty * tw + x1] as f64);
+                a + (b - a) * fx
+            }));
+            for r in r0..r1 {
+                let y = y_at(r);
+                let y0 = y as usize;
+                let y1 = (y0 + 1).min(th as usize - 1);
+                let fy = y - y0 as f64;
+                let (top_v, bot_v) = (across[y0 - y_lo], across[y1 - y_lo]);
+                column[r as usize] = top_v + (bot_v - top_v) * fy;
+            }
+        }
+        if let Some(column_rgb) = column_rgb {
+            let (tw0, th0) = (chunk.width[0], chunk.height[0]);
+            let tx = (lx as u32).min(tw0 - 1);
+            for r in r0..r1 {
+                let ty = ((ty0 + r as f64 * dty) * scale).max(0.0) as u32;
+                let i = ((ty.min(th0 - 1) * tw0 + tx) * 4) as usize;
+                column_rgb[r as usize] = [chunk.rgba[i], chunk.rgba[i + 1], chunk.rgba[i + 2]];
+            }
+        }
     }
 }

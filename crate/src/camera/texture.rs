@@ -523,291 +523,92 @@ impl TextureBank {
         kk: i64,
         x0: f32,
     ) {
-        let w = TEXELS_PER_M as f32;
-        let h = pm.height() as f32;
-        let t = Transform::from_translate(x0, 0.0);
-        let rect =
-            |x: f32, y: f32, rw: f32, rh: f32| Rect::from_xywh(x, y, rw.max(1.0), rh.max(1.0));
-        let disc = |pb: &mut PathBuilder, x: f32, y: f32, r: f32| pb.push_circle(x, y, r.max(1.0));
-        let blob = |rng: &mut Rng, cx: f32, cy: f32, r: f32| {
-            // A wobbly closed curve: a circle with random harmonics.
-            let mut pb = PathBuilder::new();
-            let n = 12;
-            let amp: Vec<f64> = (0..3).map(|_| rng.range(0.0, 0.3)).collect();
-            let ph: Vec<f64> = (0..3)
-                .map(|_| rng.range(0.0, std::f64::consts::TAU))
-                .collect();
-            for i in 0..=n {
-                let a = i as f64 / n as f64 * std::f64::consts::TAU;
-                let rr = r as f64
-                    * (1.0
-                        + amp[0] * (2.0 * a + ph[0]).sin()
-                        + amp[1] * (3.0 * a + ph[1]).sin()
-                        + amp[2] * (5.0 * a + ph[2]).sin());
-                let (px, py) = (cx + (rr * a.cos()) as f32, cy + (rr * a.sin()) as f32);
-                if i == 0 {
-                    pb.move_to(px, py);
-                } else {
-                    pb.line_to(px, py);
-                }
-            }
-            pb.close();
-            pb.finish()
+        let at = Placement {
+            w: TEXELS_PER_M as f32,
+            h: pm.height() as f32,
+            t: Transform::from_translate(x0, 0.0),
+            kk,
         };
         match style {
             Style::Plain => {}
-            Style::Brick => {
-                let bh = grid[0] as f32 * w;
-                let bw = bh * grid[1] as f32;
-                let rows = (h / bh) as i32 + 1;
-                // Bricks are laid in rows along the whole wall; the chunk owns
-                // the bricks whose left edge (in wall coordinates) is in it.
-                let chunk_left = kk as f32 * w;
-                for r in 0..rows {
-                    let off = if r % 2 == 0 { 0.0 } else { bw / 2.0 };
-                    let first = ((chunk_left - off) / bw).ceil() as i64;
-                    let mut j = first;
-                    loop {
-                        let x = off + j as f32 * bw - chunk_left;
-                        if x >= w {
-                            break;
-                        }
-                        let c = colour(rng, hue, 25.0);
-                        if let Some(rc) = rect(x + 1.5, r as f32 * bh + 1.5, bw - 3.0, bh - 3.0) {
-                            fill_rect(pm, rc, &rgb(c, 255), t);
-                        }
-                        j += 1;
-                    }
+            Style::Brick => self.paint_bricks(pm, rng, hue, grid, &at),
+            Style::Posters => self.paint_posters(pm, rng, hue, &at),
+            Style::Signs => paint_signs(pm, rng, hue, &at),
+            Style::Graffiti => paint_graffiti(pm, rng, hue, &at),
+            Style::Tiles => paint_tiles(pm, rng, hue, grid, &at),
+            Style::Wood => paint_wood(pm, rng, hue, grid, &at),
+            Style::Marble => paint_marble(pm, rng, hue, &at),
+        }
+    }
+
+    /// `brick`: rows of bricks laid along the whole wall, stains, and
+    /// sometimes a poster.
+    fn paint_bricks(
+        &self,
+        pm: &mut Pixmap,
+        rng: &mut Rng,
+        hue: f64,
+        grid: &[f64; 4],
+        at: &Placement,
+    ) {
+        let (w, h, t) = (at.w, at.h, at.t);
+        let kk = at.kk;
+        let bh = grid[0] as f32 * w;
+        let bw = bh * grid[1] as f32;
+        let rows = (h / bh) as i32 + 1;
+        // Bricks are laid in rows along the whole wall; the chunk owns
+        // the bricks whose left edge (in wall coordinates) is in it.
+        let chunk_left = kk as f32 * w;
+        for r in 0..rows {
+            let off = if r % 2 == 0 { 0.0 } else { bw / 2.0 };
+            let first = ((chunk_left - off) / bw).ceil() as i64;
+            let mut j = first;
+            loop {
+                let x = off + j as f32 * bw - chunk_left;
+                if x >= w {
+                    break;
                 }
-                // Stains and a few posters.
-                for _ in 0..rng.range(2.0, 6.0) as usize {
-                    let (cx, cy) = (
-                        rng.range(0.0, w as f64) as f32,
-                        rng.range(0.0, h as f64) as f32,
-                    );
-                    if let Some(p) = {
-                        let radius = rng.range(6.0, 30.0) as f32;
-                        blob(rng, cx, cy, radius)
-                    } {
-                        let c = colour(rng, hue + 90.0, 120.0);
-                        fill_path(pm, &p, &rgb(c, 200), FillRule::Winding, t);
-                    }
+                let c = colour(rng, hue, 25.0);
+                if let Some(rc) = texel_rect(x + 1.5, r as f32 * bh + 1.5, bw - 3.0, bh - 3.0) {
+                    fill_rect(pm, rc, &rgb(c, 255), t);
                 }
-                if rng.uniform() < 0.5 {
-                    let pw = rng.range(0.3, 0.6) as f32 * w;
-                    let (px, py) = (
-                        rng.range(0.0, (w - pw) as f64) as f32,
-                        rng.range(0.2, 0.6) as f32 * h,
-                    );
-                    self.poster(pm, rng, hue + 150.0, px, py, pw, pw * 1.3, t);
-                }
+                j += 1;
             }
-            Style::Posters => {
-                for _ in 0..rng.range(2.0, 4.0) as usize {
-                    let pw = rng.range(0.25, 0.7) as f32 * w;
-                    let ph = pw * rng.range(0.7, 1.5) as f32;
-                    let px = rng.range(0.0, w as f64) as f32 - pw / 3.0;
-                    let py = rng.range(0.05 * h as f64, (h - ph).max(1.0) as f64) as f32;
-                    let dh = rng.range(0.0, 360.0);
-                    self.poster(pm, rng, hue + dh, px, py, pw, ph, t);
-                }
+        }
+        // Stains and a few posters.
+        for _ in 0..rng.range(2.0, 6.0) as usize {
+            let (cx, cy) = (
+                rng.range(0.0, w as f64) as f32,
+                rng.range(0.0, h as f64) as f32,
+            );
+            if let Some(p) = {
+                let radius = rng.range(6.0, 30.0) as f32;
+                blob(rng, cx, cy, radius)
+            } {
+                let c = colour(rng, hue + 90.0, 120.0);
+                fill_path(pm, &p, &rgb(c, 200), FillRule::Winding, t);
             }
-            Style::Signs => {
-                for _ in 0..rng.range(3.0, 7.0) as usize {
-                    let r = rng.range(0.05, 0.18) as f32 * w;
-                    let (cx, cy) = (
-                        rng.range(0.0, w as f64) as f32,
-                        rng.range(0.1, 0.9) as f32 * h,
-                    );
-                    let c = {
-                        let dh = rng.range(0.0, 360.0);
-                        colour(rng, hue + dh, 40.0)
-                    };
-                    let mut pb = PathBuilder::new();
-                    match (rng.uniform() * 4.0) as u32 {
-                        0 => disc(&mut pb, cx, cy, r),
-                        1 => {
-                            pb.move_to(cx, cy - r);
-                            pb.line_to(cx + r, cy + r * 0.8);
-                            pb.line_to(cx - r, cy + r * 0.8);
-                            pb.close();
-                        }
-                        2 => {
-                            if let Some(rc) = rect(cx - r, cy - r * 0.6, 2.0 * r, 1.2 * r) {
-                                pb.push_rect(rc);
-                            }
-                        }
-                        _ => {
-                            pb.move_to(cx - r, cy - r * 0.3);
-                            pb.line_to(cx, cy - r * 0.3);
-                            pb.line_to(cx, cy - r);
-                            pb.line_to(cx + r, cy);
-                            pb.line_to(cx, cy + r);
-                            pb.line_to(cx, cy + r * 0.3);
-                            pb.line_to(cx - r, cy + r * 0.3);
-                            pb.close();
-                        }
-                    }
-                    if let Some(p) = pb.finish() {
-                        fill_path(pm, &p, &rgb(c, 255), FillRule::Winding, t);
-                        let inner = colour(rng, hue + 180.0, 60.0);
-                        let mut pb2 = PathBuilder::new();
-                        disc(&mut pb2, cx, cy, r * rng.range(0.2, 0.45) as f32);
-                        if let Some(p2) = pb2.finish() {
-                            fill_path(pm, &p2, &rgb(inner, 255), FillRule::Winding, t);
-                        }
-                    }
-                }
-            }
-            Style::Graffiti => {
-                for _ in 0..rng.range(5.0, 10.0) as usize {
-                    let (cx, cy) = (
-                        rng.range(0.0, w as f64) as f32,
-                        rng.range(0.0, h as f64) as f32,
-                    );
-                    let c = {
-                        let dh = rng.range(-90.0, 90.0);
-                        colour(rng, hue + dh, 30.0)
-                    };
-                    if let Some(p) = {
-                        let radius = rng.range(5.0, 40.0) as f32;
-                        blob(rng, cx, cy, radius)
-                    } {
-                        fill_path(pm, &p, &rgb(c, 230), FillRule::Winding, t);
-                    }
-                }
-                for _ in 0..rng.range(1.0, 3.0) as usize {
-                    let mut pb = PathBuilder::new();
-                    let (mut x, mut y) = (
-                        rng.range(0.0, w as f64) as f32,
-                        rng.range(0.0, h as f64) as f32,
-                    );
-                    pb.move_to(x, y);
-                    for _ in 0..5 {
-                        x += rng.range(-40.0, 40.0) as f32;
-                        y += rng.range(-40.0, 40.0) as f32;
-                        pb.line_to(x, y);
-                    }
-                    if let Some(p) = pb.finish() {
-                        let stroke = Stroke {
-                            width: rng.range(2.0, 7.0) as f32,
-                            ..Stroke::default()
-                        };
-                        stroke_path(
-                            pm,
-                            &p,
-                            &rgb(colour(rng, hue + 180.0, 60.0), 255),
-                            &stroke,
-                            t,
-                        );
-                    }
-                }
-            }
-            Style::Tiles => {
-                let s = grid[2] as f32 * w;
-                let chunk_left = kk as f32 * w;
-                let first = (chunk_left / s).ceil() as i64;
-                let mut j = first;
-                while (j as f32) * s - chunk_left < w {
-                    let tx = j as f32 * s - chunk_left;
-                    j += 1;
-                    for cy in 0..(h / s) as i32 + 1 {
-                        let c = colour(rng, hue, 60.0);
-                        if let Some(rc) = rect(tx + 1.0, cy as f32 * s + 1.0, s - 2.0, s - 2.0) {
-                            fill_rect(pm, rc, &rgb(c, 255), t);
-                        }
-                        if rng.uniform() < 0.35 {
-                            let mut pb = PathBuilder::new();
-                            disc(
-                                &mut pb,
-                                tx + s / 2.0,
-                                cy as f32 * s + s / 2.0,
-                                s * rng.range(0.15, 0.4) as f32,
-                            );
-                            if let Some(p) = pb.finish() {
-                                fill_path(
-                                    pm,
-                                    &p,
-                                    &rgb(colour(rng, hue + 180.0, 90.0), 255),
-                                    FillRule::Winding,
-                                    t,
-                                );
-                            }
-                        }
-                    }
-                }
-            }
-            Style::Wood => {
-                let plank = grid[3] as f32 * w;
-                let chunk_left = kk as f32 * w;
-                let mut x = (chunk_left / plank).ceil() * plank - chunk_left;
-                while x < w {
-                    let c = colour(rng, hue, 15.0);
-                    if let Some(rc) = rect(x + 1.0, 0.0, plank - 2.0, h) {
-                        fill_rect(pm, rc, &rgb(c, 255), t);
-                    }
-                    for _ in 0..rng.range(1.0, 4.0) as usize {
-                        let (kx, ky) = (
-                            x + rng.range(0.2, 0.8) as f32 * plank,
-                            rng.range(0.0, h as f64) as f32,
-                        );
-                        if let Some(p) = {
-                            let radius = rng.range(3.0, 9.0) as f32;
-                            blob(rng, kx, ky, radius)
-                        } {
-                            fill_path(
-                                pm,
-                                &p,
-                                &rgb(colour(rng, hue + 20.0, 20.0), 255),
-                                FillRule::Winding,
-                                t,
-                            );
-                        }
-                    }
-                    x += plank;
-                }
-            }
-            Style::Marble => {
-                for _ in 0..rng.range(8.0, 14.0) as usize {
-                    let (cx, cy) = (
-                        rng.range(0.0, w as f64) as f32,
-                        rng.range(0.0, h as f64) as f32,
-                    );
-                    if let Some(p) = {
-                        let radius = rng.range(4.0, 22.0) as f32;
-                        blob(rng, cx, cy, radius)
-                    } {
-                        fill_path(
-                            pm,
-                            &p,
-                            &rgb(colour(rng, hue, 50.0), 255),
-                            FillRule::Winding,
-                            t,
-                        );
-                    }
-                }
-                let mut pb = PathBuilder::new();
-                let (mut x, mut y) = (rng.range(0.0, w as f64) as f32, 0.0f32);
-                pb.move_to(x, y);
-                while y < h {
-                    x += rng.range(-25.0, 25.0) as f32;
-                    y += rng.range(10.0, 40.0) as f32;
-                    pb.line_to(x, y);
-                }
-                if let Some(p) = pb.finish() {
-                    let stroke = Stroke {
-                        width: 2.5,
-                        ..Stroke::default()
-                    };
-                    stroke_path(
-                        pm,
-                        &p,
-                        &rgb(colour(rng, hue + 180.0, 40.0), 255),
-                        &stroke,
-                        t,
-                    );
-                }
-            }
+        }
+        if rng.uniform() < 0.5 {
+            let pw = rng.range(0.3, 0.6) as f32 * w;
+            let (px, py) = (
+                rng.range(0.0, (w - pw) as f64) as f32,
+                rng.range(0.2, 0.6) as f32 * h,
+            );
+            self.poster(pm, rng, hue + 150.0, px, py, pw, pw * 1.3, t);
+        }
+    }
+
+    /// `posters`: two or three framed posters.
+    fn paint_posters(&self, pm: &mut Pixmap, rng: &mut Rng, hue: f64, at: &Placement) {
+        let (w, h, t) = (at.w, at.h, at.t);
+        for _ in 0..rng.range(2.0, 4.0) as usize {
+            let pw = rng.range(0.25, 0.7) as f32 * w;
+            let ph = pw * rng.range(0.7, 1.5) as f32;
+            let px = rng.range(0.0, w as f64) as f32 - pw / 3.0;
+            let py = rng.range(0.05 * h as f64, (h - ph).max(1.0) as f64) as f32;
+            let dh = rng.range(0.0, 360.0);
+            self.poster(pm, rng, hue + dh, px, py, pw, ph, t);
         }
     }
 
@@ -868,5 +669,263 @@ impl TextureBank {
                 lx += word + 0.04 * w;
             }
         }
+    }
+}
+
+/// Where a chunk's shapes land: `w` texels per chunk, the pixmap's height
+/// `h`, the shift `t` that places chunk `kk` beside the painted one.
+struct Placement {
+    w: f32,
+    h: f32,
+    t: Transform,
+    kk: i64,
+}
+
+/// A rectangle at least one texel on a side.
+fn texel_rect(x: f32, y: f32, rw: f32, rh: f32) -> Option<Rect> {
+    Rect::from_xywh(x, y, rw.max(1.0), rh.max(1.0))
+}
+
+/// A disc of radius at least one texel.
+fn push_disc(pb: &mut PathBuilder, x: f32, y: f32, r: f32) {
+    pb.push_circle(x, y, r.max(1.0))
+}
+
+/// A wobbly closed curve: a circle with random harmonics.
+fn blob(rng: &mut Rng, cx: f32, cy: f32, r: f32) -> Option<Path> {
+    let mut pb = PathBuilder::new();
+    let n = 12;
+    let amp: Vec<f64> = (0..3).map(|_| rng.range(0.0, 0.3)).collect();
+    let ph: Vec<f64> = (0..3)
+        .map(|_| rng.range(0.0, std::f64::consts::TAU))
+        .collect();
+    for i in 0..=n {
+        let a = i as f64 / n as f64 * std::f64::consts::TAU;
+        let rr = r as f64
+            * (1.0
+                + amp[0] * (2.0 * a + ph[0]).sin()
+                + amp[1] * (3.0 * a + ph[1]).sin()
+                + amp[2] * (5.0 * a + ph[2]).sin());
+        let (px, py) = (cx + (rr * a.cos()) as f32, cy + (rr * a.sin()) as f32);
+        if i == 0 {
+            pb.move_to(px, py);
+        } else {
+            pb.line_to(px, py);
+        }
+    }
+    pb.close();
+    pb.finish()
+}
+
+/// `signs`: discs, triangles, boxes and arrows, each with an inner disc.
+fn paint_signs(pm: &mut Pixmap, rng: &mut Rng, hue: f64, at: &Placement) {
+    let (w, h, t) = (at.w, at.h, at.t);
+    for _ in 0..rng.range(3.0, 7.0) as usize {
+        let r = rng.range(0.05, 0.18) as f32 * w;
+        let (cx, cy) = (
+            rng.range(0.0, w as f64) as f32,
+            rng.range(0.1, 0.9) as f32 * h,
+        );
+        let c = {
+            let dh = rng.range(0.0, 360.0);
+            colour(rng, hue + dh, 40.0)
+        };
+        let mut pb = PathBuilder::new();
+        match (rng.uniform() * 4.0) as u32 {
+            0 => push_disc(&mut pb, cx, cy, r),
+            1 => {
+                pb.move_to(cx, cy - r);
+                pb.line_to(cx + r, cy + r * 0.8);
+                pb.line_to(cx - r, cy + r * 0.8);
+                pb.close();
+            }
+            2 => {
+                if let Some(rc) = texel_rect(cx - r, cy - r * 0.6, 2.0 * r, 1.2 * r) {
+                    pb.push_rect(rc);
+                }
+            }
+            _ => {
+                pb.move_to(cx - r, cy - r * 0.3);
+                pb.line_to(cx, cy - r * 0.3);
+                pb.line_to(cx, cy - r);
+                pb.line_to(cx + r, cy);
+                pb.line_to(cx, cy + r);
+                pb.line_to(cx, cy + r * 0.3);
+                pb.line_to(cx - r, cy + r * 0.3);
+                pb.close();
+            }
+        }
+        if let Some(p) = pb.finish() {
+            fill_path(pm, &p, &rgb(c, 255), FillRule::Winding, t);
+            let inner = colour(rng, hue + 180.0, 60.0);
+            let mut pb2 = PathBuilder::new();
+            push_disc(&mut pb2, cx, cy, r * rng.range(0.2, 0.45) as f32);
+            if let Some(p2) = pb2.finish() {
+                fill_path(pm, &p2, &rgb(inner, 255), FillRule::Winding, t);
+            }
+        }
+    }
+}
+
+/// `graffiti`: overlapping blobs and a few jagged strokes.
+fn paint_graffiti(pm: &mut Pixmap, rng: &mut Rng, hue: f64, at: &Placement) {
+    let (w, h, t) = (at.w, at.h, at.t);
+    for _ in 0..rng.range(5.0, 10.0) as usize {
+        let (cx, cy) = (
+            rng.range(0.0, w as f64) as f32,
+            rng.range(0.0, h as f64) as f32,
+        );
+        let c = {
+            let dh = rng.range(-90.0, 90.0);
+            colour(rng, hue + dh, 30.0)
+        };
+        if let Some(p) = {
+            let radius = rng.range(5.0, 40.0) as f32;
+            blob(rng, cx, cy, radius)
+        } {
+            fill_path(pm, &p, &rgb(c, 230), FillRule::Winding, t);
+        }
+    }
+    for _ in 0..rng.range(1.0, 3.0) as usize {
+        let mut pb = PathBuilder::new();
+        let (mut x, mut y) = (
+            rng.range(0.0, w as f64) as f32,
+            rng.range(0.0, h as f64) as f32,
+        );
+        pb.move_to(x, y);
+        for _ in 0..5 {
+            x += rng.range(-40.0, 40.0) as f32;
+            y += rng.range(-40.0, 40.0) as f32;
+            pb.line_to(x, y);
+        }
+        if let Some(p) = pb.finish() {
+            let stroke = Stroke {
+                width: rng.range(2.0, 7.0) as f32,
+                ..Stroke::default()
+            };
+            stroke_path(
+                pm,
+                &p,
+                &rgb(colour(rng, hue + 180.0, 60.0), 255),
+                &stroke,
+                t,
+            );
+        }
+    }
+}
+
+/// `tiles`: square tiles on the wall's grid, some with a disc.
+fn paint_tiles(pm: &mut Pixmap, rng: &mut Rng, hue: f64, grid: &[f64; 4], at: &Placement) {
+    let (w, h, t) = (at.w, at.h, at.t);
+    let kk = at.kk;
+    let s = grid[2] as f32 * w;
+    let chunk_left = kk as f32 * w;
+    let first = (chunk_left / s).ceil() as i64;
+    let mut j = first;
+    while (j as f32) * s - chunk_left < w {
+        let tx = j as f32 * s - chunk_left;
+        j += 1;
+        for cy in 0..(h / s) as i32 + 1 {
+            let c = colour(rng, hue, 60.0);
+            if let Some(rc) = texel_rect(tx + 1.0, cy as f32 * s + 1.0, s - 2.0, s - 2.0) {
+                fill_rect(pm, rc, &rgb(c, 255), t);
+            }
+            if rng.uniform() < 0.35 {
+                let mut pb = PathBuilder::new();
+                push_disc(
+                    &mut pb,
+                    tx + s / 2.0,
+                    cy as f32 * s + s / 2.0,
+                    s * rng.range(0.15, 0.4) as f32,
+                );
+                if let Some(p) = pb.finish() {
+                    fill_path(
+                        pm,
+                        &p,
+                        &rgb(colour(rng, hue + 180.0, 90.0), 255),
+                        FillRule::Winding,
+                        t,
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// `wood`: planks on the wall's grid, with knots.
+fn paint_wood(pm: &mut Pixmap, rng: &mut Rng, hue: f64, grid: &[f64; 4], at: &Placement) {
+    let (w, h, t) = (at.w, at.h, at.t);
+    let kk = at.kk;
+    let plank = grid[3] as f32 * w;
+    let chunk_left = kk as f32 * w;
+    let mut x = (chunk_left / plank).ceil() * plank - chunk_left;
+    while x < w {
+        let c = colour(rng, hue, 15.0);
+        if let Some(rc) = texel_rect(x + 1.0, 0.0, plank - 2.0, h) {
+            fill_rect(pm, rc, &rgb(c, 255), t);
+        }
+        for _ in 0..rng.range(1.0, 4.0) as usize {
+            let (kx, ky) = (
+                x + rng.range(0.2, 0.8) as f32 * plank,
+                rng.range(0.0, h as f64) as f32,
+            );
+            if let Some(p) = {
+                let radius = rng.range(3.0, 9.0) as f32;
+                blob(rng, kx, ky, radius)
+            } {
+                fill_path(
+                    pm,
+                    &p,
+                    &rgb(colour(rng, hue + 20.0, 20.0), 255),
+                    FillRule::Winding,
+                    t,
+                );
+            }
+        }
+        x += plank;
+    }
+}
+
+/// `marble`: soft blobs and one vein from top to bottom.
+fn paint_marble(pm: &mut Pixmap, rng: &mut Rng, hue: f64, at: &Placement) {
+    let (w, h, t) = (at.w, at.h, at.t);
+    for _ in 0..rng.range(8.0, 14.0) as usize {
+        let (cx, cy) = (
+            rng.range(0.0, w as f64) as f32,
+            rng.range(0.0, h as f64) as f32,
+        );
+        if let Some(p) = {
+            let radius = rng.range(4.0, 22.0) as f32;
+            blob(rng, cx, cy, radius)
+        } {
+            fill_path(
+                pm,
+                &p,
+                &rgb(colour(rng, hue, 50.0), 255),
+                FillRule::Winding,
+                t,
+            );
+        }
+    }
+    let mut pb = PathBuilder::new();
+    let (mut x, mut y) = (rng.range(0.0, w as f64) as f32, 0.0f32);
+    pb.move_to(x, y);
+    while y < h {
+        x += rng.range(-25.0, 25.0) as f32;
+        y += rng.range(10.0, 40.0) as f32;
+        pb.line_to(x, y);
+    }
+    if let Some(p) = pb.finish() {
+        let stroke = Stroke {
+            width: 2.5,
+            ..Stroke::default()
+        };
+        stroke_path(
+            pm,
+            &p,
+            &rgb(colour(rng, hue + 180.0, 40.0), 255),
+            &stroke,
+            t,
+        );
     }
 }

@@ -150,10 +150,3 @@ pub fn constraint_of(normals: &[Option<DVec2>], counts: &[bool]) -> ScanConstrai
         weak_direction,
     }
 }
-
-/// Analyses the end points of a scan, given in beam order (robot frame).
-/// Only points with `counts[i]` contribute a normal (all serve as
-/// neighbours).
-pub fn analyse(points: &[DVec2], counts: &[bool]) -> ScanConstraint {
-    constraint_of(&scan_normals(points), counts)
-}

@@ -293,12 +293,6 @@ impl OccupancyGrid {
             .map_or(0.0, |(x, y)| self.units(x, y) as f32 * LOG_ODDS_UNIT)
     }
 
-    /// Probability of occupancy of local cell `(ix, iy)`.
-    pub fn probability(&self, ix: usize, iy: usize) -> f32 {
-        let l = self.units(ix, iy) as f32 * LOG_ODDS_UNIT;
-        1.0 - 1.0 / (1.0 + l.exp())
-    }
-
     pub fn state(&self, ix: usize, iy: usize) -> CellState {
         state_of(self.units(ix, iy))
     }
