@@ -57,7 +57,6 @@ const guard = makeGuard(() => {
 });
 
 const store = new Store(wasm, 'thesis');
-const refreshPanels = () => refreshAll();
 const refreshControls = () => toolbar.refresh();
 const invalidate = () => view.invalidate();
 const editable = () => runner.editable();
@@ -75,7 +74,7 @@ const editor = new Editor(store, {
   center: () => view.view.center,
   robotsChanged: () => {
     robotsPanel.key = '';
-    refreshAll();
+    refreshPanels();
   },
 });
 const wallPanel = new WallPanel(store, editor, { guard, editable });
@@ -85,7 +84,7 @@ const persistence = new Persistence(store, { validate: (text) => wasm.validateSc
 const robotsPanel = new RobotsPanel($('robots'), {
   select: (i) => {
     store.select({ kind: 'robot', index: i });
-    refreshAll();
+    refreshPanels();
     view.invalidate();
   },
   rename: (i, name) => editor.editRobot(i, (r) => (r.name = name.trim()), 'renamed'),
@@ -152,7 +151,7 @@ const keys = new Keys({
 });
 
 /** Every panel in step with the scenario, the selection and the run. */
-function refreshAll() {
+function refreshPanels() {
   const scenario = store.scenario;
   if (!scenario) return;
   cameraPanel.sync(scenario);
@@ -179,7 +178,7 @@ function onChange(kind) {
     toolbar.readouts(true);
     return;
   }
-  refreshAll();
+  refreshPanels();
   toolbar.refresh();
   view.invalidate();
   if (kind === 'load') view.fit();
