@@ -23,10 +23,10 @@
 
 import init, * as wasm from './pkg/slamlab.js';
 import { buildInfo } from './lab.js';
-import { clone, Store } from './page/state.js';
+import { clone, MAX_ROBOTS, Store } from './page/state.js';
 import { RunController } from './page/run.js';
 import { WorldView } from './page/world-view.js';
-import { Editor, MAX_ROBOTS } from './page/editor.js';
+import { Editor } from './page/editor.js';
 import { WallPanel } from './page/wall-panel.js';
 import { PointerInput } from './page/pointer.js';
 import { Keys } from './page/keys.js';

@@ -8,8 +8,7 @@
 import { snap, snapAngle } from './geometry.js';
 import { fmt } from './dom.js';
 import { setStatus } from './status.js';
-
-export const MAX_ROBOTS = 16;
+import { MAX_ROBOTS } from './state.js';
 
 export class Editor {
   /**

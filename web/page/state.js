@@ -16,6 +16,9 @@ import { Lab } from '../lab.js';
 
 const UNDO_DEPTH = 100;
 
+/** The scenario format's limit (crate/src/scenario.rs, MAX_ROBOTS). */
+export const MAX_ROBOTS = 16;
+
 export const clone = (o) => JSON.parse(JSON.stringify(o));
 
 export class Store {

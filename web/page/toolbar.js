@@ -6,7 +6,7 @@
 // call the controllers (web/page/run.js, editor.js, persistence.js); this
 // module holds no state of the run or the scenario.
 import { fmt } from './dom.js';
-import { MAX_ROBOTS } from './editor.js';
+import { MAX_ROBOTS } from './state.js';
 import { message, setStatus } from './status.js';
 
 const READOUT_INTERVAL_MS = 100;
