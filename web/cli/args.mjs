@@ -1,7 +1,9 @@
 // Shared by every command module: argument parsing, the input-error type,
-// and opening a scenario file into a Lab with the common --seed/--duration.
+// and opening a scenario file into a Lab (the facade of web/lab.js) with
+// the common --seed/--duration.
 // (Command modules import from here, not from ../cli.mjs, which imports them.)
 import { readFile } from 'node:fs/promises';
+import { Lab } from '../lab.js';
 
 /** An input error: exit status 2 with this message. */
 export class UsageError extends Error {}
@@ -43,7 +45,8 @@ export function wasmCall(f) {
 }
 
 /**
- * Reads a scenario file into a new `wasm.Lab`, applies `options.seed` and
+ * Reads a scenario file into a new Lab (web/lab.js) on the wasm-bindgen
+ * module `wasm`, applies `options.seed` and
  * `options.duration` (strings from the command line) and refuses badly
  * placed robots, each with a message naming the problem.
  */
@@ -54,7 +57,7 @@ export async function openScenario(file, options, wasm) {
   } catch (e) {
     throw new UsageError(`cannot read scenario '${file}': ${e.code ?? e.message}`);
   }
-  const lab = wasmCall(() => new wasm.Lab(text));
+  const lab = wasmCall(() => Lab.open(wasm, text));
   if (options.seed !== undefined) {
     if (!/^\d+$/.test(options.seed) || !Number.isSafeInteger(Number(options.seed))) {
       throw new UsageError(`--seed: '${options.seed}' is not a whole number from 0 to 2^53`);
@@ -68,7 +71,7 @@ export async function openScenario(file, options, wasm) {
     }
     wasmCall(() => lab.setDuration(d));
   }
-  const problems = JSON.parse(lab.problemsJson());
+  const problems = lab.problems();
   if (problems.length > 0) throw new UsageError(problems[0].text);
   return lab;
 }

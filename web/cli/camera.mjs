@@ -8,7 +8,8 @@
 // for scoring only) and the PNG's file name.
 import { mkdir, writeFile } from 'node:fs/promises';
 import path from 'node:path';
-import { UsageError, parseArgs, wasmCall, openScenario } from './args.mjs';
+import { UsageError, parseArgs, openScenario } from './args.mjs';
+import { simulate } from './run-loop.mjs';
 
 export const usage = `  node web/cli.mjs frames SCENARIO.json --out DIR [--duration S] [--seed N]
       write every captured camera frame as PNG plus DIR/index.json`;
@@ -23,11 +24,11 @@ async function frames(argv, wasm) {
   } catch (e) {
     throw new UsageError(`cannot create '${options.out}': ${e.code ?? e.message}`);
   }
-  wasmCall(() => lab.runToEnd());
-  const scenario = JSON.parse(lab.scenarioJson());
+  await simulate(lab, { progress: false });
+  const scenario = lab.scenario();
   const index = [];
   for (const [r, robot] of scenario.robots.entries()) {
-    const metas = JSON.parse(lab.framesJson(r));
+    const metas = lab.frames(r);
     for (const m of metas) {
       const file = `${robot.name.replace(/[^\w.-]+/g, '_')}_${String(m.index).padStart(4, '0')}.png`;
       await writeFile(path.join(options.out, file), lab.framePng(r, m.index));
@@ -35,7 +36,7 @@ async function frames(argv, wasm) {
     }
     process.stderr.write(`${robot.name}: ${metas.length} frames\n`);
   }
-  const info = JSON.parse(lab.cameraInfo());
+  const info = lab.camera();
   await writeFile(
     path.join(options.out, 'index.json'),
     JSON.stringify({ scenario: scenario.name, seed: scenario.seed, camera: info, frames: index }, null, 1) + '\n',

@@ -15,8 +15,7 @@ import { Worker } from 'node:worker_threads';
 import os from 'node:os';
 import path from 'node:path';
 import { compiledModule, pkgDir } from './wasm.mjs';
-import { performance } from 'node:perf_hooks';
-import { UsageError, wasmCall } from './args.mjs';
+import { UsageError } from './args.mjs';
 
 /**
  * Workers when --workers is not given: one per core but the main thread's,
@@ -68,7 +67,7 @@ export class DescribePool {
     const workerData = {
       module: compiledModule(),
       pkgJs: path.join(pkgDir(), 'slamlab.js'),
-      scenarioJson: lab.scenarioJson(),
+      scenarioJson: lab.scenarioText(),
       method,
     };
     this.workers = Array.from({ length: count }, () => {
@@ -114,9 +113,7 @@ export class DescribePool {
 
   /** Queues the frames the lab wants described that nobody has yet, and hands them out. */
   dispatch(lab) {
-    const flat = lab.framesToDescribe(this.method);
-    for (let k = 0; k < flat.length; k += 2) {
-      const [robot, index] = [flat[k], flat[k + 1]];
+    for (const { robot, index } of lab.framesToDescribe(this.method)) {
       const key = `${robot}/${index}`;
       if (this.sent.has(key)) continue;
       this.sent.add(key);
@@ -130,7 +127,7 @@ export class DescribePool {
     for (const w of this.workers) {
       while (w.alive && w.pending < this.ahead && this.queue.length > 0) {
         const { robot, index } = this.queue.shift();
-        w.thread.postMessage({ robot, index, spec: lab.frameSpecJson(robot, index), render: this.render });
+        w.thread.postMessage({ robot, index, spec: lab.frameSpec(robot, index), render: this.render });
         w.pending += 1;
       }
     }
@@ -175,7 +172,7 @@ export class DescribePool {
         }
       } else if (this.queue.length > 0 && live.length === 0) {
         const { robot, index } = this.queue.pop();
-        const packed = lab.describeFrameSpec(lab.frameSpecJson(robot, index), this.method);
+        const packed = lab.describeFrameSpec(lab.frameSpec(robot, index), this.method);
         lab.storeDescribed(robot, index, this.method, packed);
       } else if (live.some((w) => w.pending > 0)) {
         await new Promise((resolve) => {
@@ -192,46 +189,5 @@ export class DescribePool {
 
   close() {
     for (const w of this.workers) w.thread.terminate();
-  }
-}
-
-/**
- * Runs `lab` to the end of its scenario with `workers` worker threads
- * describing, meanwhile, the frames a merge with `method` will use; with 0
- * it only runs. Returns the run's time and the wait for the last frames
- * after it (ms). Progress goes to stderr when `progress` is set.
- */
-export async function simulate(lab, method, workers, progress) {
-  const total = JSON.parse(lab.stateJson()).total_steps;
-  const pool = workers > 0 ? new DescribePool(lab, method, workers) : null;
-  try {
-    const tSim = performance.now();
-    let done = 0;
-    let lastReport = tSim;
-    // Small slices keep the workers fed; without them, large ones.
-    const slice = pool ? 100 : 500;
-    while (done < total) {
-      const n = wasmCall(() => lab.step(Math.min(slice, total - done)));
-      if (n === 0) break;
-      done += n;
-      if (pool) {
-        pool.collect(lab);
-        pool.pace(done, total);
-        pool.dispatch(lab);
-        await pool.breathe();
-      }
-      const now = performance.now();
-      if (progress && (now - lastReport > 1000 || done === total)) {
-        process.stderr.write(`simulated ${(done / 10).toFixed(1)} / ${(total / 10).toFixed(1)} s\n`);
-        lastReport = now;
-      }
-    }
-    const simulateMs = performance.now() - tSim;
-    const tWait = performance.now();
-    if (pool) await pool.finish(lab);
-    return { simulateMs, waitMs: pool ? performance.now() - tWait : 0 };
-  } finally {
-    // Also when the run throws: live workers would keep node from exiting.
-    pool?.close();
   }
 }

@@ -1,9 +1,10 @@
-// Map merging from the command line: `run` merges after simulating (see
-// cli.mjs), and `merge` writes the merged map as ROS map_server files.
+// Map merging from the command line: `run` merges after simulating
+// (web/cli/run.mjs), and `merge` writes the merged map as ROS map_server files.
 import { writeFile } from 'node:fs/promises';
 import path from 'node:path';
 import { parseArgs, UsageError, wasmCall, openScenario } from './args.mjs';
-import { simulate, workersOf } from './describe-pool.mjs';
+import { workersOf } from './describe-pool.mjs';
+import { simulate, mergeMaps } from './run-loop.mjs';
 
 export const METHODS = ['auto', 'thesis', 'map-only'];
 
@@ -17,28 +18,6 @@ export function methodOf(options) {
     throw new UsageError(`--method: '${method}' is not one of ${METHODS.join(', ')}`);
   }
   return method;
-}
-
-/**
- * Merges the maps of the lab's run with `method`, reporting progress on
- * stderr once a second. Returns the merge view (tables and report).
- */
-export function mergeLab(lab, method) {
-  let progress = JSON.parse(wasmCall(() => lab.mergeStart(method)));
-  let last = 0;
-  let lastStage = '';
-  while (!progress.finished) {
-    progress = JSON.parse(wasmCall(() => lab.mergeAdvance(64)));
-    const now = Date.now();
-    if (progress.stage !== lastStage || now - last > 1000) {
-      if (progress.total > 1) {
-        process.stderr.write(`merge (${method}): ${progress.stage} ${progress.done} / ${progress.total}\n`);
-      }
-      last = now;
-      lastStage = progress.stage;
-    }
-  }
-  return JSON.parse(wasmCall(() => lab.mergeViewJson()));
 }
 
 /** One-paragraph summary of a merge report for people. */
@@ -66,8 +45,8 @@ async function merge(argv, wasm) {
   const method = methodOf(options);
   const workers = method === 'map-only' ? 0 : workersOf(options);
   const lab = await openScenario(positional[0], options, wasm);
-  await simulate(lab, method, workers, false);
-  const view = mergeLab(lab, method);
+  await simulate(lab, { method, workers, progress: false });
+  const view = mergeMaps(lab, method);
   const report = view.report;
   console.log(describeMerge(report));
   if (!report || report.status !== 'merged') {

@@ -4,22 +4,17 @@ import { writeFile } from 'node:fs/promises';
 import path from 'node:path';
 import { performance } from 'node:perf_hooks';
 import { parseArgs, UsageError, wasmCall, openScenario } from './args.mjs';
+import { simulate } from './run-loop.mjs';
 
 export const usage = `  node web/cli.mjs map SCENARIO.json --robot NAME --out FILE.yaml [--seed N] [--duration S] [--mapper slam|odometry]
       run the scenario and write the robot's map as ROS map_server PGM + YAML (and a PNG beside them)
   node web/cli.mjs bench-slam SCENARIO.json [--robot NAME] [--duration S] [--runs N] [--json]
       time the scan matcher (one scan against the robot's map) in this wasm build`;
 
+/** Opens the scenario file and runs it to its end (progress on stderr). */
 async function runScenario(file, options, wasm) {
   const lab = await openScenario(file, options, wasm);
-  const total = JSON.parse(lab.stateJson()).total_steps;
-  let done = 0;
-  while (done < total) {
-    const n = wasmCall(() => lab.step(Math.min(500, total - done)));
-    if (n === 0) break;
-    done += n;
-  }
-  process.stderr.write(`simulated ${(done / 10).toFixed(1)} s\n`);
+  await simulate(lab, { progress: true });
   return lab;
 }
 
@@ -50,8 +45,8 @@ async function map(argv, wasm) {
   } catch (e) {
     throw new UsageError(`cannot write '${options.out}': ${e.code ?? e.message}`);
   }
-  const info = JSON.parse(lab.mapInfoJson(robot, mapper));
-  const f = JSON.parse(lab.slamFiguresJson(robot));
+  const info = lab.mapInfo(robot, mapper);
+  const f = lab.slamFigures(robot);
   console.log(`${options.robot}: ${mapper} map ${info.width} x ${info.height} cells at ${info.resolution_m} m -> ${options.out}, ${pgmPath}, ${pngPath}`);
   console.log(`  ATE: SLAM ${f.ate_m.toFixed(3)} m, odometry ${f.odometry_ate_m.toFixed(3)} m; ` +
     `occupied cells on a wall: SLAM ${(100 * f.occupied_precision).toFixed(1)} %, odometry ${(100 * f.odometry_occupied_precision).toFixed(1)} %`);

@@ -8,34 +8,12 @@
 // after the command name and `wasm` the loaded wasm-bindgen module
 // (web/cli/wasm.mjs). Images are read here and decoded inside wasm, so node
 // and the page see the same pixels. Progress and errors go to stderr; with
-// --json the JSON is the only thing on stdout. Bad input: a message and exit 2.
+// --json the JSON is the only thing on stdout. Bad input: a message and exit 2
+// (web/cli/args.mjs's UsageError; an error thrown by the decoder in wasm is
+// bad input too, a wasm trap is a bug).
 import { readFile } from 'node:fs/promises';
 import { performance } from 'node:perf_hooks';
-
-class UsageError extends Error {}
-
-// Splits argv into positional words and --flags (with values for `valued`).
-function parseArgs(args, valued = []) {
-  const positional = [];
-  const flags = {};
-  for (let i = 0; i < args.length; i++) {
-    const a = args[i];
-    if (a.startsWith('--')) {
-      const name = a.slice(2);
-      if (valued.includes(name)) {
-        if (i + 1 >= args.length) throw new UsageError(`--${name} needs a value`);
-        flags[name] = args[++i];
-      } else if (name === 'json') {
-        flags.json = true;
-      } else {
-        throw new UsageError(`unknown option ${a}`);
-      }
-    } else {
-      positional.push(a);
-    }
-  }
-  return { positional, flags };
-}
+import { UsageError, parseArgs, wasmCall } from './args.mjs';
 
 async function readImage(path) {
   try {
@@ -45,67 +23,48 @@ async function readImage(path) {
   }
 }
 
-// Runs `body`, mapping bad input (usage errors and errors thrown by wasm,
-// which are JsError messages) to exit status 2.
-async function guarded(usage, body) {
-  try {
-    return await body();
-  } catch (e) {
-    const msg = e instanceof Error ? e.message : String(e);
-    process.stderr.write(`error: ${msg}\n`);
-    if (e instanceof UsageError) process.stderr.write(`usage: ${usage}\n`);
-    return 2;
-  }
-}
-
 async function features(args, wasm) {
-  const usage = 'node web/cli.mjs features IMAGE [--json]';
-  return guarded(usage, async () => {
-    const { positional, flags } = parseArgs(args);
-    if (positional.length !== 1) throw new UsageError('expected one image');
-    const bytes = await readImage(positional[0]);
-    const json = wasm.surf_features(bytes);
-    if (flags.json) {
-      process.stdout.write(json + '\n');
-    } else {
-      const r = JSON.parse(json);
-      console.log(`${positional[0]}: ${r.width} x ${r.height}, ${r.keypoints.length} SURF keypoints`);
-      for (const k of r.keypoints.slice(0, 10)) {
-        console.log(
-          `  x ${k.x.toFixed(2)}  y ${k.y.toFixed(2)}  scale ${k.scale.toFixed(2)}  ` +
-            `orientation ${k.orientation.toFixed(3)} rad  laplacian ${k.laplacian > 0 ? '+1' : '-1'}`,
-        );
-      }
-      if (r.keypoints.length > 10) console.log(`  … (--json for all, with descriptors)`);
+  const { positional, options } = parseArgs(args, { json: 'flag' });
+  if (positional.length !== 1) throw new UsageError('features: expected one image');
+  const bytes = await readImage(positional[0]);
+  const json = wasmCall(() => wasm.surf_features(bytes));
+  if (options.json) {
+    process.stdout.write(json + '\n');
+  } else {
+    const r = JSON.parse(json);
+    console.log(`${positional[0]}: ${r.width} x ${r.height}, ${r.keypoints.length} SURF keypoints`);
+    for (const k of r.keypoints.slice(0, 10)) {
+      console.log(
+        `  x ${k.x.toFixed(2)}  y ${k.y.toFixed(2)}  scale ${k.scale.toFixed(2)}  ` +
+          `orientation ${k.orientation.toFixed(3)} rad  laplacian ${k.laplacian > 0 ? '+1' : '-1'}`,
+      );
     }
-    return 0;
-  });
+    if (r.keypoints.length > 10) console.log(`  … (--json for all, with descriptors)`);
+  }
+  return 0;
 }
 
 async function match(args, wasm) {
-  const usage = 'node web/cli.mjs match IMAGE1 IMAGE2 [--json]';
-  return guarded(usage, async () => {
-    const { positional, flags } = parseArgs(args);
-    if (positional.length !== 2) throw new UsageError('expected two images');
-    const [a, b] = await Promise.all(positional.map(readImage));
-    const json = wasm.surf_match(a, b);
-    if (flags.json) {
-      process.stdout.write(json + '\n');
+  const { positional, options } = parseArgs(args, { json: 'flag' });
+  if (positional.length !== 2) throw new UsageError('match: expected two images');
+  const [a, b] = await Promise.all(positional.map(readImage));
+  const json = wasmCall(() => wasm.surf_match(a, b));
+  if (options.json) {
+    process.stdout.write(json + '\n');
+  } else {
+    const r = JSON.parse(json);
+    console.log(`${r.keypoints[0]} and ${r.keypoints[1]} keypoints, ${r.matches} matches, ${r.inliers} MSAC inliers`);
+    if (r.homography) {
+      const f = (v) => v.toFixed(5).padStart(12);
+      console.log('homography (image 1 pixels -> image 2 pixels):');
+      for (const row of r.homography) console.log('  ' + row.map(f).join(' '));
+      console.log('matched region (image 1 corners in image 2): ' + r.quad.map(([x, y]) => `(${x.toFixed(1)}, ${y.toFixed(1)})`).join(' '));
+      console.log(`shrinkage ${r.shrinkage.toFixed(3)}, shift (${r.shift[0].toFixed(1)}, ${r.shift[1].toFixed(1)}) px`);
     } else {
-      const r = JSON.parse(json);
-      console.log(`${r.keypoints[0]} and ${r.keypoints[1]} keypoints, ${r.matches} matches, ${r.inliers} MSAC inliers`);
-      if (r.homography) {
-        const f = (v) => v.toFixed(5).padStart(12);
-        console.log('homography (image 1 pixels -> image 2 pixels):');
-        for (const row of r.homography) console.log('  ' + row.map(f).join(' '));
-        console.log('matched region (image 1 corners in image 2): ' + r.quad.map(([x, y]) => `(${x.toFixed(1)}, ${y.toFixed(1)})`).join(' '));
-        console.log(`shrinkage ${r.shrinkage.toFixed(3)}, shift (${r.shift[0].toFixed(1)}, ${r.shift[1].toFixed(1)}) px`);
-      } else {
-        console.log('no homography found');
-      }
+      console.log('no homography found');
     }
-    return 0;
-  });
+  }
+  return 0;
 }
 
 function stats(times) {
@@ -137,68 +96,65 @@ function timeRuns(run, runs) {
 }
 
 async function benchSurf(args, wasm) {
-  const usage = 'node web/cli.mjs bench-surf IMAGE [--runs N] [--pair IMAGE2] [--json]';
-  return guarded(usage, async () => {
-    const { positional, flags } = parseArgs(args, ['runs', 'pair']);
-    if (positional.length !== 1) throw new UsageError('expected one image');
-    const runs = flags.runs === undefined ? 30 : Number(flags.runs);
-    if (!Number.isInteger(runs) || runs < 1 || runs > 100000) throw new UsageError('--runs must be a whole number from 1');
-    const bytes = await readImage(positional[0]);
-    const simd = wasm.surf_simd();
-    const bench = new wasm.SurfBench(bytes);
-    let report;
+  const { positional, options } = parseArgs(args, { json: 'flag', runs: 'value', pair: 'value' });
+  if (positional.length !== 1) throw new UsageError('bench-surf: expected one image');
+  const runs = options.runs === undefined ? 30 : Number(options.runs);
+  if (!Number.isInteger(runs) || runs < 1 || runs > 100000) throw new UsageError('--runs must be a whole number from 1');
+  const bytes = await readImage(positional[0]);
+  const simd = wasm.surf_simd();
+  const bench = wasmCall(() => new wasm.SurfBench(bytes));
+  let report;
+  try {
+    process.stderr.write(`bench-surf: ${bench.width()} x ${bench.height()}, ${runs} runs, ${simd ? 'SIMD128' : 'scalar'} build\n`);
+    const t = timeRuns(() => bench.run(), runs);
+    report = { median_ms: t.median, min_ms: t.min, keypoints: t.result, simd, cpu_median_ms: t.cpuMedian };
+    // Per-stage medians (each stage alone, on the previous stage's output).
+    const stages = {};
+    for (const [name, fn] of [
+      ['integral', () => bench.stage_integral()],
+      ['detect', () => bench.stage_detect()],
+      ['orientation', () => bench.stage_orientation()],
+      ['describe', () => bench.stage_describe()],
+    ]) {
+      stages[name] = timeRuns(fn, runs).median;
+    }
+    report.stages_ms = stages;
+  } finally {
+    bench.free();
+  }
+  if (options.pair !== undefined) {
+    const other = await readImage(options.pair);
+    const pair = wasmCall(() => new wasm.SurfMatchBench(bytes, other));
     try {
-      process.stderr.write(`bench-surf: ${bench.width()} x ${bench.height()}, ${runs} runs, ${simd ? 'SIMD128' : 'scalar'} build\n`);
-      const t = timeRuns(() => bench.run(), runs);
-      report = { median_ms: t.median, min_ms: t.min, keypoints: t.result, simd, cpu_median_ms: t.cpuMedian };
-      // Per-stage medians (each stage alone, on the previous stage's output).
-      const stages = {};
-      for (const [name, fn] of [
-        ['integral', () => bench.stage_integral()],
-        ['detect', () => bench.stage_detect()],
-        ['orientation', () => bench.stage_orientation()],
-        ['describe', () => bench.stage_describe()],
-      ]) {
-        stages[name] = timeRuns(fn, runs).median;
-      }
-      report.stages_ms = stages;
+      const t = timeRuns(() => pair.run(), runs);
+      Object.assign(report, {
+        match_median_ms: t.median,
+        match_min_ms: t.min,
+        match_cpu_median_ms: t.cpuMedian,
+        inliers: t.result,
+      });
     } finally {
-      bench.free();
+      pair.free();
     }
-    if (flags.pair !== undefined) {
-      const other = await readImage(flags.pair);
-      const pair = new wasm.SurfMatchBench(bytes, other);
-      try {
-        const t = timeRuns(() => pair.run(), runs);
-        Object.assign(report, {
-          match_median_ms: t.median,
-          match_min_ms: t.min,
-          match_cpu_median_ms: t.cpuMedian,
-          inliers: t.result,
-        });
-      } finally {
-        pair.free();
-      }
+  }
+  if (options.json) {
+    process.stdout.write(JSON.stringify(report) + '\n');
+  } else {
+    console.log(
+      `detect + describe: median ${report.median_ms.toFixed(2)} ms, min ${report.min_ms.toFixed(2)} ms ` +
+        `(CPU time median ${report.cpu_median_ms.toFixed(2)} ms), ` +
+        `${report.keypoints} keypoints (${simd ? 'SIMD128' : 'scalar'} wasm)`,
+    );
+    const st = report.stages_ms;
+    console.log(
+      `  stages (median ms): integral ${st.integral.toFixed(2)}, detect ${st.detect.toFixed(2)}, ` +
+        `orientation ${st.orientation.toFixed(2)}, describe ${st.describe.toFixed(2)}`,
+    );
+    if (report.match_median_ms !== undefined) {
+      console.log(`match + MSAC: median ${report.match_median_ms.toFixed(2)} ms, min ${report.match_min_ms.toFixed(2)} ms, ${report.inliers} inliers`);
     }
-    if (flags.json) {
-      process.stdout.write(JSON.stringify(report) + '\n');
-    } else {
-      console.log(
-        `detect + describe: median ${report.median_ms.toFixed(2)} ms, min ${report.min_ms.toFixed(2)} ms ` +
-          `(CPU time median ${report.cpu_median_ms.toFixed(2)} ms), ` +
-          `${report.keypoints} keypoints (${simd ? 'SIMD128' : 'scalar'} wasm)`,
-      );
-      const st = report.stages_ms;
-      console.log(
-        `  stages (median ms): integral ${st.integral.toFixed(2)}, detect ${st.detect.toFixed(2)}, ` +
-          `orientation ${st.orientation.toFixed(2)}, describe ${st.describe.toFixed(2)}`,
-      );
-      if (report.match_median_ms !== undefined) {
-        console.log(`match + MSAC: median ${report.match_median_ms.toFixed(2)} ms, min ${report.match_min_ms.toFixed(2)} ms, ${report.inliers} inliers`);
-      }
-    }
-    return 0;
-  });
+  }
+  return 0;
 }
 
 export const usage = `  node web/cli.mjs features IMAGE [--json]

@@ -278,7 +278,7 @@ export class GuidedTour {
 
   view() {
     const lab = this.lab();
-    return lab?.hasMerge() ? JSON.parse(lab.mergeViewJson()) : null;
+    return lab?.hasMerge() ? lab.mergeView() : null;
   }
 
   /** The lab's merge, when it is one with the thesis method. */
@@ -297,7 +297,7 @@ export class GuidedTour {
     }
     if (!this.frameCache.has(robot)) {
       const m = new Map();
-      for (const f of JSON.parse(lab.framesJson(robot))) m.set(f.index, f.truth);
+      for (const f of lab.frames(robot)) m.set(f.index, f.truth);
       this.frameCache.set(robot, m);
     }
     return this.frameCache.get(robot);
@@ -307,7 +307,7 @@ export class GuidedTour {
   markSelection(letters = []) {
     const lab = this.lab();
     if (!lab?.hasMerge()) return;
-    const sel = JSON.parse(lab.mergeSelectionJson());
+    const sel = lab.mergeSelection();
     const marks = [];
     sel.robots.forEach((r, i) => {
       const poses = this.framePoses(i);
@@ -418,7 +418,7 @@ export class GuidedTour {
     }
     lines.push(`Run finished at t = ${fmt(run.time_s, 1)} s. Pictures: ${frames}.`);
     const ate = run.robots.map((name, i) => {
-      const f = JSON.parse(lab.slamFiguresJson(i));
+      const f = lab.slamFigures(i);
       return `${name} ${fmt(f.ate_m)} m (odometry alone ${fmt(f.odometry_ate_m)} m)`;
     });
     lines.push(`How far each robot\u2019s own position estimate was from the truth (RMS): ${ate.join('; ')}. ` +

@@ -6,7 +6,7 @@
 // plot shows both robots' position error over time for both mappers (against
 // the ground truth, which the mappers never see).
 
-import { robotColour } from './robots-panel.js';
+import { robotColour } from './palette.js';
 
 const REFRESH_MS = 500;
 const MAP_W = 300;
@@ -102,6 +102,11 @@ export class MapsPanel {
     return { el, ctx: canvas.getContext('2d'), figures, plot, robot: i, name };
   }
 
+  /** The position-error plots shown now, for the run summary: `[{name, src}]` (PNG data URLs). */
+  plots() {
+    return this.blocks.filter((b) => !b.el.hidden).map((b) => ({ name: b.name, src: b.plot.toDataURL('image/png') }));
+  }
+
   update(nowMs, changed) {
     if (changed && nowMs - this.lastMs >= REFRESH_MS) {
       this.lastMs = nowMs;
@@ -119,12 +124,12 @@ export class MapsPanel {
         b.el.hidden = !started;
         if (!started) continue;
         lab.drawMap(b.ctx, b.robot, this.mapper, MAP_W, MAP_H);
-        const f = JSON.parse(lab.slamFiguresJson(b.robot));
+        const f = lab.slamFigures(b.robot);
         const pct = (x) => `${(100 * x).toFixed(0)} %`;
         b.figures.innerHTML =
           `<span>position error (ATE): <b>SLAM ${f.ate_m.toFixed(2)} m</b> · odometry ${f.odometry_ate_m.toFixed(2)} m</span>` +
           `<span>cells on a real wall: SLAM ${pct(f.occupied_precision)} · odometry ${pct(f.odometry_occupied_precision)}</span>`;
-        this.plot(b, JSON.parse(lab.slamErrorsJson(b.robot, 150)).rows);
+        this.plot(b, lab.slamErrors(b.robot, 150).rows);
       }
     } catch (e) {
       this.hooks.onError(e);

@@ -1,7 +1,7 @@
 // The side panel's robot cards: one per robot, in the robot's colour.
 //
 // Each card has the robot's settings (name, follow side, wall distance; only
-// editable at t = 0) and its live readouts from `lab.stateJson()`: mode,
+// editable at t = 0) and its live readouts from `lab.state()` (web/lab.js): mode,
 // true pose (world frame), odometry pose (the robot's own frame, origin at
 // its start), odometry error, bumps, the 8 sonars (numbered 1..8 from the
 // robot's left to its right, as in the thesis), the nearest laser return,
@@ -12,18 +12,7 @@
 // interrupted by the running simulation.
 
 import { deg, el, fmt } from './dom.js';
-
-/** Robot colours by index: the renderer's own list, set once the wasm is up. */
-export const ROBOT_COLOURS = [[80, 80, 80]];
-
-export function setRobotColours(list) {
-  ROBOT_COLOURS.splice(0, ROBOT_COLOURS.length, ...list);
-}
-
-export function robotColour(i, alpha = 1) {
-  const [r, g, b] = ROBOT_COLOURS[i % ROBOT_COLOURS.length];
-  return alpha === 1 ? `rgb(${r},${g},${b})` : `rgba(${r},${g},${b},${alpha})`;
-}
+import { robotColour } from './palette.js';
 
 const SONAR_COUNT = 8;
 

@@ -17,7 +17,7 @@
 // clears it. The guided mode (web/guided.js) drives the same panel: it
 // starts a thesis merge and may hold it before the matching starts.
 
-import { robotColour } from './robots-panel.js';
+import { robotColour } from './palette.js';
 import { deg, el, fmt } from './dom.js';
 
 const SLICE_MS = 12;
@@ -48,7 +48,7 @@ export class MergePanel {
     this.hooks = hooks;
     this.method = 'auto';
     this.active = false; // a merge is being computed
-    this.view = null; // last mergeViewJson
+    this.view = null; // the last lab.mergeView()
     this.hold = false; // started but not advanced (the guided mode's step 6.2.2)
     /** Per method, the result on the current run: {status, error_m, error_deg, robot, reason}. */
     this.results = {};
@@ -139,6 +139,35 @@ export class MergePanel {
     return this.hooks.lab();
   }
 
+  /** Is a frame pair's view open over the page? */
+  get pairOpen() {
+    return !this.pairHost.hidden;
+  }
+
+  /**
+   * What the run summary (web/page/summary.js) shows of the merge: the
+   * report (null before a merge), the matched-pair table and the merged map
+   * as PNG data URLs, and every method's result on this run.
+   */
+  summary() {
+    const view = this.view;
+    if (!view) return { report: null, results: this.results };
+    let mergedImage = null;
+    if (view.report?.status === 'merged') {
+      const c = document.createElement('canvas');
+      c.width = 480;
+      c.height = 350;
+      this.lab().drawMerged(c.getContext('2d'), c.width, c.height);
+      mergedImage = c.toDataURL('image/png');
+    }
+    return {
+      report: view.report,
+      tableImage: this.tableBox.hidden ? null : this.table.toDataURL('image/png'),
+      mergedImage,
+      results: this.results,
+    };
+  }
+
   /** Called when the run changed: any merge of the old maps is gone. */
   invalidate() {
     this.active = false;
@@ -213,9 +242,9 @@ export class MergePanel {
     const t0 = performance.now();
     try {
       do {
-        p = JSON.parse(lab.mergeAdvance(2));
+        p = lab.mergeAdvance(2);
       } while (!p.finished && performance.now() - t0 < SLICE_MS);
-      this.view = JSON.parse(lab.mergeViewJson());
+      this.view = lab.mergeView();
     } catch (e) {
       this.active = false;
       this.hooks.onError(e);
@@ -343,7 +372,7 @@ export class MergePanel {
     let pv;
     const t = this.table0();
     try {
-      pv = JSON.parse(this.lab().mergePairJson(t.pair, row, col));
+      pv = this.lab().mergePair(t.pair, row, col);
     } catch (e) {
       this.hooks.onError(e);
       return;
@@ -351,7 +380,7 @@ export class MergePanel {
     const lab = this.lab();
     const ia = t.a;
     const ib = t.b;
-    const meta = JSON.parse(lab.cameraInfo());
+    const meta = lab.camera();
     const w = meta.width;
     const h = meta.height;
     const gap = 12;

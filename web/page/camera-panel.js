@@ -7,7 +7,7 @@
 // vision pipeline uses) and marks on the map where it was taken; "live"
 // returns to the live view.
 
-import { robotColour } from './robots-panel.js';
+import { robotColour } from './palette.js';
 
 const LIVE_INTERVAL_MS = 120; // live views refresh at about 8 per second
 const THUMB_W = 64;
@@ -33,7 +33,7 @@ export class CameraPanel {
   sync(scenario) {
     const lab = this.hooks.lab();
     if (!lab) return;
-    this.camera = JSON.parse(lab.cameraInfo());
+    this.camera = lab.camera();
     const key = JSON.stringify([scenario.robots.map((r) => r.name), this.camera]);
     if (key === this.key) return;
     this.key = key;
@@ -97,7 +97,7 @@ export class CameraPanel {
         t.classList.toggle('selected', mine && Number(t.dataset.index) === choice.index);
       }
       if (mine && lab) {
-        const m = JSON.parse(lab.frameJson(b.robot, choice.index));
+        const m = lab.frame(b.robot, choice.index);
         lab.drawFrame(b.robot, choice.index, b.ctx);
         b.what.textContent = `frame ${m.index} · t = ${m.time_s.toFixed(1)} s (grey, as the vision pipeline sees it)`;
         this.hooks.onMarker({ robot: b.robot, pose: m.truth, fovDeg: this.camera.hfov_deg });
@@ -134,7 +134,7 @@ export class CameraPanel {
   syncStrip(lab, b, force) {
     const count = lab.frameCount(b.robot);
     if (!force && count === b.shown.length) return;
-    const metas = JSON.parse(lab.framesJson(b.robot));
+    const metas = lab.frames(b.robot);
     const have = new Set(metas.map((m) => m.index));
     // Frames can vanish (a reset, or thinning at the memory cap).
     if (b.shown.some((k) => !have.has(k))) {

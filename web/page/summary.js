@@ -8,11 +8,15 @@
 // that method ran, the matched-pair table, the merged map, and the transform
 // error of every method merged on this run. The page's print stylesheet
 // (web/style.css, `@media print`) prints only this view, so Ctrl+P anywhere
-// prints it too (app.js rebuilds it on `beforeprint`).
+// prints it too (`Summary` rebuilds it on `beforeprint`).
 //
-// Images are snapshots of the page's canvases (PNG data URLs) taken when the
-// summary is built; nothing here reads the Lab directly.
+// `Summary` gathers the data: the run's figures from the Lab, and from each
+// panel what it shows, through the panel's own method (the world view's
+// `snapshot`, the maps panel's `plots`, the merge panel's `summary`), as
+// PNG data URLs taken when the summary is built. `buildSummary` only lays
+// the data out.
 import { deg, el, fmt } from './dom.js';
+import { message, setStatus } from './status.js';
 
 const pct = (x) => (Number.isFinite(x) ? `${(100 * x).toFixed(0)} %` : '–');
 
@@ -118,4 +122,100 @@ export function buildSummary(host, data, { onPrint, onClose }) {
       })));
   }
   host.replaceChildren(...parts);
+}
+
+/** The summary view: opens over the page, gathers its data, keeps the focus while open. */
+export class Summary {
+  /**
+   * @param {HTMLElement} box     the summary's element (hidden while closed)
+   * @param {HTMLElement} opener  the button that opens it (focus returns there)
+   * @param {{lab: () => any, scenario: () => any, state: () => any, link: () => string,
+   *          shareLink: () => Promise<string>, pause: () => void, world: (w: number, h: number) => string,
+   *          maps: {plots: () => any[]}, merge: {summary: () => any}}} hooks
+   */
+  constructor(box, opener, hooks) {
+    this.box = box;
+    this.opener = opener;
+    this.hooks = hooks;
+    opener.addEventListener('click', () =>
+      this.open().catch((e) => setStatus(`Could not build the summary: ${message(e)}`, 'error')));
+    // Ctrl+P anywhere prints the summary (the print stylesheet shows only it).
+    window.addEventListener('beforeprint', () => {
+      if (!this.hooks.lab() || !this.box.hidden) return;
+      try {
+        this.build();
+      } catch (e) {
+        setStatus(`Could not build the summary: ${message(e)}`, 'error');
+      }
+    });
+  }
+
+  get isOpen() {
+    return !this.box.hidden;
+  }
+
+  /** Builds the summary from what the page shows now; `link` restores the scenario. */
+  build(link = this.hooks.link() || location.href) {
+    const h = this.hooks;
+    const lab = h.lab();
+    const scenario = h.scenario();
+    const st = h.state();
+    const started = st.steps > 0;
+    const robots = scenario.robots.map((r, i) => ({
+      name: r.name,
+      follow: r.follow,
+      distance: r.distance ?? 0.6,
+      frames: started ? lab.frameCount(i) : 0,
+      bumps: st.robots[i]?.bumps ?? 0,
+      figures: started ? lab.slamFigures(i) : null,
+    }));
+    const plots = started ? h.maps.plots() : [];
+    const merge = h.merge.summary();
+    buildSummary(
+      this.box,
+      {
+        scenario,
+        link,
+        when: new Date(),
+        run: { time_s: st.time_s, finished: st.finished, steps: st.steps },
+        robots,
+        worldImage: h.world(720, 540),
+        plots,
+        merge,
+      },
+      { onPrint: () => window.print(), onClose: () => this.close() },
+    );
+  }
+
+  async open() {
+    this.hooks.pause();
+    this.build(await this.hooks.shareLink());
+    this.box.hidden = false;
+    this.box.querySelector('#summary-print').focus();
+  }
+
+  close() {
+    this.box.hidden = true;
+    this.opener.focus({ preventScroll: true });
+  }
+
+  /** A key while open: Escape closes, Tab stays inside (the summary is modal). */
+  key(e) {
+    if (e.key === 'Escape') this.close();
+    else if (e.key === 'Tab') this.trapFocus(e);
+  }
+
+  trapFocus(e) {
+    const items = [...this.box.querySelectorAll('button, a[href]')].filter((x) => !x.hidden);
+    if (!items.length) return;
+    const first = items[0];
+    const last = items[items.length - 1];
+    if (e.shiftKey && document.activeElement === first) {
+      e.preventDefault();
+      last.focus();
+    } else if (!e.shiftKey && document.activeElement === last) {
+      e.preventDefault();
+      first.focus();
+    }
+  }
 }

@@ -1,0 +1,53 @@
+// `run`: simulate a scenario headless, merge the robots' maps and print the
+// report (the `run --json` document of docs/interfaces.md, as the binding
+// writes it, byte for byte).
+import { performance } from 'node:perf_hooks';
+import { UsageError, parseArgs, wasmCall, openScenario } from './args.mjs';
+import { workersOf } from './describe-pool.mjs';
+import { methodOf, describeMerge } from './merge.mjs';
+import { simulate, mergeMaps } from './run-loop.mjs';
+
+export const usage = `usage:
+  node web/cli.mjs run SCENARIO.json [--seed N] [--duration S] [--method auto|thesis|map-only] [--json]
+      [--workers N]
+      run the scenario headless, merge the robots' maps (default method: auto)
+      and print a report (JSON with --json); N worker threads (default: one
+      per core but the main thread's, at most 4) describe camera frames while
+      the robots run`;
+
+async function run(argv, wasm) {
+  const { positional, options } = parseArgs(argv, {
+    seed: 'value', duration: 'value', json: 'flag', method: 'value', workers: 'value',
+  });
+  if (positional.length !== 1) throw new UsageError('run: expected exactly one SCENARIO.json');
+  const method = methodOf(options);
+  const workers = method === 'map-only' ? 0 : workersOf(options);
+  const t0 = performance.now();
+  const lab = await openScenario(positional[0], options, wasm);
+  const { simulateMs, waitMs } = await simulate(lab, { method, workers, progress: true });
+  mergeMaps(lab, method);
+  const totalMs = performance.now() - t0;
+  const timings = { simulate: simulateMs, features: waitMs, total: totalMs };
+  if (options.json) {
+    process.stdout.write(wasmCall(() => lab.reportText(timings)) + '\n');
+  } else {
+    printSummary(wasmCall(() => lab.report(timings)), simulateMs);
+  }
+  return 0;
+}
+
+/** The report for people. */
+function printSummary(r, simulateMs) {
+  console.log(`scenario ${r.scenario}, seed ${r.seed}: ${r.steps} steps (${r.duration_s.toFixed(1)} s simulated) in ${simulateMs.toFixed(0)} ms`);
+  for (const robot of r.robots) {
+    const e = robot.odometry_final_error;
+    console.log(`  ${robot.name} (follows ${robot.follow} wall): path ${robot.path_length_m.toFixed(1)} m, ` +
+      `bumps ${robot.bumps}, odometry off by ${e.position_m.toFixed(2)} m and ${e.heading_deg.toFixed(1)} deg at the end`);
+  }
+  console.log(describeMerge(r.merge));
+  const t = r.timings_ms;
+  console.log(`timings (ms): simulate ${t.simulate.toFixed(0)} (camera ${t.camera.toFixed(0)}, slam ${t.slam.toFixed(0)}), ` +
+    `features ${t.features.toFixed(0)}, matching ${t.matching.toFixed(0)}, merge ${t.merge.toFixed(0)}, total ${t.total.toFixed(0)}`);
+}
+
+export const commands = { run };
