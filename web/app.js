@@ -1,7 +1,8 @@
 // The lab page's composition root: it loads the wasm build, makes the
 // page's modules and connects them. Nothing else lives here.
 //
-// The modules (web/page/, one concern each; ARCHITECTURE.md, "The page"):
+// The modules (web/page/, one concern each; ARCHITECTURE.md, "The page and
+// the command line"):
 //   state.js        the store: the scenario being edited, with commit and undo
 //   run.js          the run controller: Run, Pause, Step, Reset and the pace
 //   world-view.js   the map canvas: what the Lab draws, and the overlay on it
@@ -12,7 +13,8 @@
 //   toolbar.js      the controls around the map and what they show
 //   summary.js      the printable summary, read from each panel's method
 //   palette.js      the robots' colours; status.js the status line and guard
-//   *-panel.js, guided.js  the side and bottom panels, the guided mode
+//   *-panel.js, guided.js  the side and bottom panels, the guided mode;
+//                   pair-view.js the merge's frame pair over the page
 // and web/lab.js, the facade over the wasm `Lab` the command line uses too.
 //
 // Data flows one way: input handlers call the store or a controller; the

@@ -6,7 +6,8 @@
 // matched-pair table fills in: one row per frame of the first robot, one
 // column per frame of the second, each checked pair a cell coloured by its
 // inlier count (the thesis's Table 1). Clicking a cell opens the two frames
-// with their matches and the matched-region quad (thesis Figure 8). At the
+// with their matches and the matched-region quad (thesis Figure 8;
+// web/page/pair-view.js). At the
 // end the verdict appears with its reason, the transform of each robot's map
 // frame, its error against the ground truth, and the merged map with
 // downloads (PNG, ROS map_server PGM + YAML, report JSON).
@@ -14,11 +15,12 @@
 // The panel remembers each method's result on the current run, and a small
 // chart compares their transform errors (position and heading against the
 // ground truth) as the user merges with one method after another; a new run
-// clears it. The guided mode (web/guided.js) drives the same panel: it
+// clears it. The guided mode (web/page/guided.js) drives the same panel: it
 // starts a thesis merge and may hold it before the matching starts.
 
 import { robotColour } from './palette.js';
 import { deg, el, fmt } from './dom.js';
+import { PairView } from './pair-view.js';
 
 const SLICE_MS = 12;
 const TABLE_W = 330;
@@ -44,7 +46,7 @@ export class MergePanel {
    */
   constructor(host, pairHost, hooks) {
     this.host = host;
-    this.pairHost = pairHost;
+    this.pair = new PairView(pairHost);
     this.hooks = hooks;
     this.method = 'auto';
     this.active = false; // a merge is being computed
@@ -141,7 +143,7 @@ export class MergePanel {
 
   /** Is a frame pair's view open over the page? */
   get pairOpen() {
-    return !this.pairHost.hidden;
+    return this.pair.isOpen;
   }
 
   /**
@@ -367,81 +369,18 @@ export class MergePanel {
     if (c?.found) this.openPair(c.row, c.col);
   }
 
-  /** The two frames side by side with their matches and the quad. */
+  /** Opens the two frames of a table cell with their matches and the quad (web/page/pair-view.js). */
   openPair(row, col) {
-    let pv;
     const t = this.table0();
     try {
-      pv = this.lab().mergePair(t.pair, row, col);
+      this.pair.open(this.lab(), t, this.view.method, row, col);
     } catch (e) {
       this.hooks.onError(e);
-      return;
     }
-    const lab = this.lab();
-    const ia = t.a;
-    const ib = t.b;
-    const meta = lab.camera();
-    const w = meta.width;
-    const h = meta.height;
-    const gap = 12;
-    const canvas = el('canvas', { width: String(2 * w + gap), height: String(h), class: 'pair-canvas', role: 'img',
-      'aria-label': `Frame ${pv.a_frame} of ${pv.a} and frame ${pv.b_frame} of ${pv.b} with their matches` });
-    const ctx = canvas.getContext('2d');
-    ctx.fillStyle = '#fff';
-    ctx.fillRect(0, 0, canvas.width, canvas.height);
-    const tmp = document.createElement('canvas');
-    tmp.width = w;
-    tmp.height = h;
-    const tctx = tmp.getContext('2d');
-    lab.drawFrame(ia, pv.a_frame, tctx);
-    ctx.drawImage(tmp, 0, 0);
-    lab.drawFrame(ib, pv.b_frame, tctx);
-    ctx.drawImage(tmp, w + gap, 0);
-    // matches: grey outliers, green rigid inliers (auto) / homography inliers (thesis)
-    const useRigid = this.view.method !== 'thesis';
-    for (const [x1, y1, x2, y2, hIn, rIn] of pv.matches) {
-      const inl = useRigid ? rIn : hIn;
-      ctx.strokeStyle = inl ? 'rgba(20,170,60,0.85)' : 'rgba(220,40,40,0.35)';
-      ctx.lineWidth = inl ? 1.2 : 0.8;
-      ctx.beginPath();
-      ctx.moveTo(x1 + 0.5, y1 + 0.5);
-      ctx.lineTo(x2 + 0.5 + w + gap, y2 + 0.5);
-      ctx.stroke();
-    }
-    if (pv.quad) {
-      ctx.strokeStyle = '#ffb000';
-      ctx.lineWidth = 2;
-      ctx.beginPath();
-      pv.quad.forEach(([x, y], k) => {
-        const px = x + 0.5 + w + gap;
-        const py = y + 0.5;
-        if (k === 0) ctx.moveTo(px, py);
-        else ctx.lineTo(px, py);
-      });
-      ctx.closePath();
-      ctx.stroke();
-    }
-    const inliers = useRigid ? pv.rigid_inliers : pv.homography_inliers;
-    const cand = pv.candidate
-      ? `This pair alone puts ${pv.b}\u2019s map frame at x ${fmt(pv.candidate[0])} m, y ${fmt(pv.candidate[1])} m, ` +
-        `θ ${fmt(deg(pv.candidate[2]), 1)}° in ${pv.a}\u2019s.`
-      : 'This pair gives no transform on its own.';
-    const close = el('button', { type: 'button', text: 'Close', 'aria-label': 'Close the pair view' });
-    close.addEventListener('click', () => this.closePair());
-    this.pairHost.replaceChildren(
-      el('h2', { text: `${pv.a} frame ${pv.a_frame} ↔ ${pv.b} frame ${pv.b_frame}` }),
-      canvas,
-      el('p', { text: `${pv.matches.length} ratio-test matches, ${inliers} inliers (green; red: rejected). ` +
-        (pv.quad ? 'Yellow: the first image\u2019s outline mapped into the second by the homography (thesis Figure 8). ' : '') + cand }),
-      close,
-    );
-    this.pairHost.hidden = false;
-    close.focus({ preventScroll: true });
   }
 
   closePair() {
-    this.pairHost.hidden = true;
-    this.pairHost.replaceChildren();
+    this.pair.close();
   }
 
   /** Thesis §6.2.4: the two equations with the measured numbers. */
