@@ -941,14 +941,17 @@ fn bench_automatic_merge_stages() {
     assert_eq!(job.stage(), Stage::Done);
     let pair = &job.pairs[0];
     let outcome = pair.outcome.as_ref().expect("decided");
-    let ms: Vec<String> = times.iter().map(|(s, t)| format!("{s} {t:.1}")).collect();
-    let verify_ms = times
+    let checked = pair.todo.len().max(1) as f64;
+    let ms: Vec<String> = times
         .iter()
-        .find(|(s, _)| *s == "matching")
-        .map_or(0.0, |t| t.1);
+        .map(|&(s, t)| match s {
+            "matching" => format!("{s} {t:.1} ({:.2}/pair)", t / checked),
+            _ => format!("{s} {t:.1}"),
+        })
+        .collect();
     let report = format!(
         "frames {}+{} (of {}+{}), {} proposals, {} candidates: {}\n\
-         ms: {} ({:.2}/pair), merged map {} cells",
+         ms: {}; merged map {} cells",
         job.robots[0].selected.len(),
         job.robots[1].selected.len(),
         job.robots[0].infos.len(),
@@ -957,7 +960,6 @@ fn bench_automatic_merge_stages() {
         outcome.candidates,
         outcome.reason,
         ms.join(", "),
-        verify_ms / pair.todo.len().max(1) as f64,
         job.merged_map().map_or(0, |m| m.width() * m.height())
     );
     #[cfg(target_arch = "wasm32")]

@@ -19,7 +19,7 @@ use crate::merge::verdict::{decide_pair_after_search, SearchSummary};
 use crate::merge::verify::{PairCheck, VerifyConfig};
 use crate::merge::vocabulary::{propose_pairs, Bag, Vocabulary};
 use crate::merge::work::{PairOutcome, PairWork, RobotFrames};
-use crate::merge::{Candidate, FrameInfo, MergeMethod, MergeStatus};
+use crate::merge::{Candidate, FrameInfo, MergeStatus};
 use crate::surf::Features;
 
 /// The `auto` method.
@@ -47,10 +47,6 @@ pub fn thin_by_motion(infos: &[FrameInfo], min_m: f64, min_rad: f64) -> Vec<usiz
 }
 
 impl MethodStages for Auto {
-    fn method(&self) -> MergeMethod {
-        MergeMethod::Auto
-    }
-
     fn select(&self, infos: &[FrameInfo], config: &MergeConfig) -> Vec<usize> {
         thin_by_motion(infos, config.min_motion_m, config.min_turn_rad)
     }

@@ -10,16 +10,12 @@ use crate::merge::baseline::map_only_merge;
 use crate::merge::config::MergeConfig;
 use crate::merge::verify::PairCheck;
 use crate::merge::work::PairOutcome;
-use crate::merge::{FrameInfo, MergeMethod};
+use crate::merge::FrameInfo;
 
 /// The `map-only` method.
 pub struct MapOnly;
 
 impl MethodStages for MapOnly {
-    fn method(&self) -> MergeMethod {
-        MergeMethod::MapOnly
-    }
-
     fn uses_frames(&self) -> bool {
         false
     }

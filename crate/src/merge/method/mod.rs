@@ -45,9 +45,6 @@ pub struct PairInput<'a> {
 
 /// The stages of one merge method, as [`super::job::MergeJob`] calls them.
 pub trait MethodStages: Sync {
-    /// The method's name (`run --method`).
-    fn method(&self) -> MergeMethod;
-
     /// Whether the method looks at camera frames. One that does not reads
     /// the maps only: the job skips the features, proposals and matching
     /// stages.

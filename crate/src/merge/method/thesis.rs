@@ -12,16 +12,12 @@ use crate::merge::selection::select_frames;
 use crate::merge::thesis::{thesis_merge, PairMatch};
 use crate::merge::verify::PairCheck;
 use crate::merge::work::{PairOutcome, PairWork, RobotFrames};
-use crate::merge::{FrameInfo, MergeMethod};
+use crate::merge::FrameInfo;
 
 /// The `thesis` method.
 pub struct Thesis;
 
 impl MethodStages for Thesis {
-    fn method(&self) -> MergeMethod {
-        MergeMethod::Thesis
-    }
-
     fn select(&self, infos: &[FrameInfo], config: &MergeConfig) -> Vec<usize> {
         select_frames(infos, &config.selection)
     }
