@@ -19,13 +19,16 @@
 //! 5. **log** — one row per robot, as the thesis recorded them (§6.2.1):
 //!    time, odometry pose, 8 sonar ranges, 181 laser ranges; the true pose is
 //!    kept beside it, for scoring only.
-//! 6. **map** — each robot's two mappers ([`crate::slam`]) take the
-//!    odometry pose and the scan: the thesis's grid at raw odometry poses,
-//!    and online SLAM. Never the truth.
-//! 7. **camera** — once per capture period, each robot stores a frame: its
-//!    pose, the other robots' bodies and a noise seed, from which the
-//!    picture is rendered on demand ([`crate::camera::capture`]), with the
-//!    readings it took beside it.
+//! 6. **map** — each robot's two mappers ([`crate::slam::RobotMapping`])
+//!    take the odometry pose and the laser scan (never the truth): SLAM
+//!    matches the scan to its map and integrates it at the matched pose; the
+//!    odometry-only map, the thesis's baseline, at the odometry pose.
+//!    Off with [`Simulation::set_mapping`].
+//! 7. **capture** — once per camera period, each robot stores a camera frame
+//!    ([`crate::camera::capture`]): the instant's odometry and true poses,
+//!    sensor row, the other robots' bodies and a noise seed, from which the
+//!    picture is rendered on demand ([`Simulation::frame_image`]). Off with
+//!    [`Simulation::set_capture`].
 //!
 //! Row 0 is the start (time 0); a run of `n` steps has `n + 1` rows.
 
@@ -463,7 +466,7 @@ impl Simulation {
                 r.mapping.observe(&r.odometry.pose(), &r.last_scan);
             }
         }
-        // 7. camera frames, once per capture period
+        // 7. capture: camera frames, once per capture period
         let t1 = self.clock.map_or(0.0, |now| now());
         self.capture_due_frames();
         if let Some(now) = self.clock {
