@@ -18,13 +18,15 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// The layers, bottom first. A module may name modules of lower layers
-/// only.
+/// only. (`carmen` and `rosmap`, readers of real robots' files, come with
+/// the real-data work: `carmen` needs only `geom`, `rosmap` the grids of
+/// `slam`.)
 const LAYERS: &[&[&str]] = &[
     &["geom", "rng", "palette"],
-    &["kinematics", "world", "maze"],
+    &["kinematics", "world", "maze", "carmen"],
     &["scenario", "sensors"],
     &["odometry", "follower", "camera", "surf", "slam"],
-    &["sim"],
+    &["sim", "rosmap"],
     &["render", "merge"],
     &["lab"],
     &["bindings"],

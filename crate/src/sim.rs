@@ -466,7 +466,7 @@ impl Simulation {
                 r.mapping.observe(&r.odometry.pose(), &r.last_scan);
             }
         }
-        // 7. camera frames, once per capture period
+        // 7. capture: camera frames, once per capture period
         let t1 = self.clock.map_or(0.0, |now| now());
         self.capture_due_frames();
         if let Some(now) = self.clock {

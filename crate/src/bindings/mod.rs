@@ -6,10 +6,13 @@
 //! function returns `Result<_, JsError>` so bad input reaches JavaScript as
 //! an exception with a message, never as a panic or a trap.
 
-mod convert;
 mod merge;
 mod slam;
 pub mod surf;
+
+/// The one error conversion, JSON serialisation and pixel copy every
+/// binding block uses.
+mod convert;
 
 use crate::lab;
 use crate::lab::report::Timings;
