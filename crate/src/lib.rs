@@ -26,6 +26,7 @@
 //! | [`report`] | the JSON report of a run (`web/cli.mjs run --json`) |
 //! | [`surf`] | SURF features, matching and MSAC (Bay et al. 2008) |
 //! | [`lab`] | the session object the page and the CLI drive |
+//! | [`rosmap`] | ROS map_server maps on disk: reading, classifying, writing |
 //!
 //! Conventions everywhere: metres, radians, seconds; world frame x right,
 //! y up, θ counter-clockwise from +x. Only the renderer flips y.
@@ -42,6 +43,7 @@ pub mod odometry;
 pub mod render;
 pub mod report;
 pub mod rng;
+pub mod rosmap;
 pub mod scenario;
 pub mod sensors;
 pub mod sim;

@@ -33,24 +33,32 @@
 //! small increments so the page can show the matched-pair table filling in;
 //! [`described`] lets other threads describe the frames ahead of it.
 //!
+//! Saved maps without robots (ROS `map_server` files, [`crate::rosmap`])
+//! are merged offline by [`offline`], with its own search
+//! ([`offline_search`]) and verdict ([`evidence`]) made for real maps.
+//!
 //! Ground truth is never read here; [`crate::lab`] scores the result.
 
 pub mod align;
 pub mod baseline;
 pub mod consistency;
 pub mod described;
+pub mod evidence;
 pub mod fuse;
 pub mod graph;
 pub mod job;
 pub mod lab;
 pub mod lift;
 pub mod mapsearch;
+pub mod offline;
+pub mod offline_search;
 pub mod rigid;
 pub mod selection;
 pub mod thesis;
 pub mod verdict;
 pub mod verify;
 pub mod vocabulary;
+pub mod wallmap;
 
 use crate::geom::Pose2;
 use crate::sensors::laser::LASER_BEAMS;
