@@ -169,17 +169,19 @@ fn three_maps_join_along_the_spanning_tree() {
         |p| (8.0..=30.0).contains(&p.x),
         oa,
     );
-    let fc = turned_frame(18.0, 37.0, h, 2.5, 32.0);
+    let fc = turned_frame(10.0, 37.0, h, 2.5, 38.0);
     let c = cut(
         "c.yaml",
         &walls,
         (w, h),
         fc,
-        DVec2::new(32.0, 32.0),
-        |p| p.x >= 18.0,
+        DVec2::new(38.0, 38.0),
+        |p| p.x >= 10.0,
         oa,
     );
-    let r = merge_all(&[a, b, c], &OfflineConfig::default(), &mut |_| {});
+    let r = merge_all(&[a, b, c], &OfflineConfig::default(), &mut |line| {
+        println!("{line}")
+    });
     assert_eq!(r.status, MergeStatus::Merged, "{}", r.reason);
     assert!(r.unjoined.is_empty());
     for (k, f) in [(1, fb), (2, fc)] {

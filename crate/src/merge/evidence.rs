@@ -28,10 +28,11 @@
 //!    wall agree (a point is a cell of wall face, so points × resolution);
 //! 2. **agreement dominates**: the acceptance index of the two directions
 //!    pooled is at least `min_index`;
-//! 3. **a clear winner**: every *different* overlay the search found (its
-//!    transform moves B's walls by `distinct_m` or turns them by
-//!    `distinct_rad`) has at most `1 / min_margin` of the winner's agreeing
-//!    wall. A symmetric building turned by 180° lies on itself in part,
+//! 3. **a clear winner**: overlays are ranked by their *net support*,
+//!    agreeing wall minus twice the disagreeing wall (metres), and every
+//!    *different* overlay the search found (its transform moves B's walls
+//!    by `distinct_m` or turns them by `distinct_rad`) has at most
+//!    `1 / min_margin` of the winner's net support. A symmetric building turned by 180° lies on itself in part,
 //!    never as well as the truth, so the margin is a ratio of agreement
 //!    measured this tightly, not the lab's 2.5.
 //!
@@ -54,6 +55,9 @@ pub struct EvidenceConfig {
     pub min_agree_m: f64,
     pub min_index: f64,
     pub min_margin: f64,
+    /// What a disagreeing wall point costs in the net support, in
+    /// agreeing points. Default 2.
+    pub disagree_weight: f64,
     pub distinct_m: f64,
     pub distinct_rad: f64,
 }
@@ -64,8 +68,9 @@ impl Default for EvidenceConfig {
             agree_m: 0.15,
             band_m: 0.5,
             min_agree_m: 20.0,
-            min_index: 0.6,
+            min_index: 0.7,
             min_margin: 1.5,
+            disagree_weight: 2.0,
             distinct_m: 1.0,
             distinct_rad: 3f64.to_radians(),
         }
@@ -82,8 +87,9 @@ pub struct Evidence {
     pub agree_m: f64,
     /// Pooled acceptance index `agree / (agree + disagree)` (0 with none).
     pub index: f64,
-    /// Net support, metres of wall: agreeing minus disagreeing wall, the
-    /// mean of the two directions. What overlays are ranked by.
+    /// Net support, metres of wall: agreeing wall minus `disagree_weight`
+    /// times disagreeing wall, the mean of the two directions. What
+    /// overlays are ranked by, and what the margin compares.
     pub support_m: f64,
 }
 

@@ -54,9 +54,9 @@ pub struct SearchConfig {
     /// Peaks of the spectra's correlation kept (each also turned by 180°).
     /// Default 4.
     pub rotation_peaks: usize,
-    /// Translation peaks kept per rotation. Default 3.
+    /// Translation peaks kept per rotation. Default 6.
     pub peaks_per_rotation: usize,
-    /// Overlays refined, best coarse score first. Default 16.
+    /// Overlays refined, best coarse score first. Default 32.
     pub max_hypotheses: usize,
     /// Peaks closer than this are one. Default 1.5 m.
     pub distinct_m: f64,
@@ -71,8 +71,8 @@ impl Default for SearchConfig {
             coarse_m: 0.3,
             coarse_side: 200.0,
             rotation_peaks: 4,
-            peaks_per_rotation: 3,
-            max_hypotheses: 16,
+            peaks_per_rotation: 6,
+            max_hypotheses: 32,
             distinct_m: 1.5,
             tau_wide_m: 0.5,
             tau_narrow_m: 0.15,
@@ -145,7 +145,21 @@ pub fn rotation_candidates(a: &WallMap, b: &WallMap, peaks: usize) -> Vec<f64> {
     maxima.sort_by(|&p, &q| c[q].total_cmp(&c[p]).then(p.cmp(&q)));
     let step = PI / n as f64;
     let mut out = Vec::new();
-    for s in maxima.into_iter().take(peaks.max(1)) {
+    // Peaks at least 5° apart (a broad peak has shoulders).
+    let apart = (5.0 / 0.25) as usize;
+    let mut kept: Vec<usize> = Vec::new();
+    for s in maxima {
+        if kept.len() >= peaks.max(1) {
+            break;
+        }
+        if kept.iter().all(|&k| {
+            let d = s.abs_diff(k);
+            d.min(n - d) >= apart
+        }) {
+            kept.push(s);
+        }
+    }
+    for s in kept {
         let (l, m, r) = (c[(s + n - 1) % n], c[s], c[(s + 1) % n]);
         let denom = l - 2.0 * m + r;
         let offset = if denom < 0.0 {
