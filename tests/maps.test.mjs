@@ -32,9 +32,12 @@ function plan(variant) {
   const w = variant ? 22 : 24, h = variant ? 15 : 16;
   const walls = [[[0, 0], [w, 0]], [[w, 0], [w, h]], [[w, h], [0, h]], [[0, h], [0, 0]],
     [[0, 6], [2, 6]], [[3, 6], [9, 6]], [[10, 6], [w, 6]], [[0, 8.5], [5, 8.5]], [[6, 8.5], [w, 8.5]]];
-  const rooms = variant ? [4, 11, 17] : [5, 9.5, 15, 19];
-  for (const x of rooms) { walls.push([[x, 0], [x, 6]]); walls.push([[x + (variant ? 1 : 0.5), 8.5], [x + (variant ? 1 : 0.5), h]]); }
+  const below = variant ? [4, 11, 17] : [4.2, 10.1, 13.3, 19.6];
+  const above = variant ? [5, 12, 18] : [6.5, 8.2, 14.9, 21.1];
+  for (const x of below) walls.push([[x, 0], [x, 6]]);
+  for (const x of above) walls.push([[x, 8.5], [x, h]]);
   walls.push(variant ? [[3, 11], [8, 13]] : [[12, 10], [14.5, 12.5]]);
+  if (!variant) walls.push([[1, 10], [3.5, 14]], [[20, 2], [22.5, 4.5]], [[16.5, 13], [18.5, 15.2]]);
   for (const [x, y] of variant ? [[2, 2], [14, 3]] : [[7, 2], [12.5, 3.5], [21, 1.5]]) {
     walls.push([[x, y], [x + 0.4, y]], [[x + 0.4, y], [x + 0.4, y + 0.4]], [[x + 0.4, y + 0.4], [x, y + 0.4]], [[x, y + 0.4], [x, y]]);
   }
@@ -62,13 +65,13 @@ function writeMap(name, fp, frame, nx, ny, seen, origin = [0, 0, 0], ext = 'pgm'
   return yaml;
 }
 
-// A sees x <= 16, B sees x >= 7 in a frame turned by 0.9 rad; C is another plan.
+// A sees x <= 18, B sees x >= 5 in a frame turned by 0.9 rad; C is another plan.
 const fp = plan(false);
 const frameA = [-0.5, -0.5, 0];
-const A = writeMap('a', fp, frameA, 340, 340, (p) => p[0] <= 16, [-2, 1, 0]);
+const A = writeMap('a', fp, frameA, 400, 340, (p) => p[0] <= 18, [-2, 1, 0]);
 const theta = 0.9, cx = 16, cy = 8, half = 12;
 const frameB = [cx - (Math.cos(theta) * half - Math.sin(theta) * half), cy - (Math.sin(theta) * half + Math.cos(theta) * half), theta];
-const B = writeMap('b', fp, frameB, 480, 480, (p) => p[0] >= 7);
+const B = writeMap('b', fp, frameB, 480, 480, (p) => p[0] >= 5);
 const C = writeMap('c', plan(true), [-0.5, -0.5, 0.3], 480, 480, () => true);
 
 /** B's map frame in A's map frame: (frameA ⊕ originA⁻¹)⁻¹ ⊕ frameB. */
@@ -83,7 +86,7 @@ test('two maps of one floor merge to the known transform, JSON on stdout only', 
   const r = run(A, B, '--json', '--out', out);
   assert.equal(r.code, 0, r.stderr);
   const report = JSON.parse(r.stdout);
-  assert.deepEqual(report.maps.map((m) => [m.name, m.width, m.height, m.resolution]), [[A, 340, 340, 0.05], [B, 480, 480, 0.05]]);
+  assert.deepEqual(report.maps.map((m) => [m.name, m.width, m.height, m.resolution]), [[A, 400, 340, 0.05], [B, 480, 480, 0.05]]);
   const m = report.merge;
   assert.equal(m.status, 'merged', m.reason);
   assert.match(m.reason, /\d/);

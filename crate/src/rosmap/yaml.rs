@@ -112,8 +112,8 @@ impl MapYaml {
             None => false,
             Some(Value::Bool(b)) => *b,
             Some(v) => match number(v) {
-                Some(x) if x == 0.0 => false,
-                Some(x) if x == 1.0 => true,
+                Some(0.0) => false,
+                Some(1.0) => true,
                 _ => return Err(err("negate", "expected 0 or 1".into())),
             },
         };
