@@ -20,6 +20,7 @@ import * as camera from './cli/camera.mjs';
 import * as surf from './cli/surf.mjs';
 import * as slam from './cli/slam.mjs';
 import * as merge from './cli/merge.mjs';
+import * as mergeMaps from './cli/merge-maps.mjs';
 
 export { UsageError, parseArgs };
 
@@ -34,6 +35,7 @@ const MODULES = [
   surf,
   slam,
   merge,
+  mergeMaps,
 ];
 
 const commands = {};

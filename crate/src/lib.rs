@@ -26,6 +26,7 @@
 //! | [`slam`] | per-robot occupancy grids, scan matching, map scoring and export |
 //! | [`sim`] | the fixed-step simulation and its per-robot logs |
 //! | [`render`] | tiny-skia drawing of the world, robots and sensors |
+//! | [`rosmap`] | ROS map_server maps on disk: reading, classifying, writing |
 //! | [`merge`] | map merging: the thesis's method, the automatic one, a map-only baseline |
 //! | [`lab`] | the session the page and the CLI drive, its views and the report |
 //! | [`bindings`] | the wasm-bindgen boundary |
@@ -51,6 +52,7 @@ pub mod odometry;
 pub mod palette;
 pub mod render;
 pub mod rng;
+pub mod rosmap;
 pub mod scenario;
 pub mod sensors;
 pub mod sim;

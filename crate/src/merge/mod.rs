@@ -40,6 +40,10 @@
 //! every setting; [`described`] lets other threads describe the frames
 //! ahead of the job.
 //!
+//! Saved maps without robots (ROS `map_server` files, [`crate::rosmap`])
+//! are merged offline by [`offline`], with its own search
+//! ([`offline_search`]) and verdict ([`evidence`]) made for real maps.
+//!
 //! Ground truth is never read here: the session layer (`crate::lab`) scores
 //! the result.
 
@@ -48,6 +52,7 @@ pub mod baseline;
 pub mod config;
 pub mod consistency;
 pub mod described;
+pub mod evidence;
 pub mod frames;
 pub mod fuse;
 pub mod graph;
@@ -55,12 +60,15 @@ pub mod job;
 pub mod lift;
 pub mod mapsearch;
 pub mod method;
+pub mod offline;
+pub mod offline_search;
 pub mod rigid;
 pub mod selection;
 pub mod thesis;
 pub mod verdict;
 pub mod verify;
 pub mod vocabulary;
+pub mod wallmap;
 pub mod work;
 
 use crate::geom::Pose2;

@@ -42,43 +42,57 @@ pub fn grey_rows_top_first(grid: &OccupancyGrid) -> Vec<u8> {
 /// The grid as a binary PGM (P5). An empty grid (nothing mapped yet) is
 /// written as one unknown pixel, since an image cannot be 0 × 0.
 pub fn to_pgm(grid: &OccupancyGrid) -> Vec<u8> {
-    let (w, h, pixels) = if grid.width() == 0 {
+    let (w, h, pixels) = grid_pixels(grid);
+    pgm_bytes(w, h, &pixels, grid.resolution_m())
+}
+
+/// Size and grey pixels (top row first) of a grid; one unknown pixel for
+/// an empty grid.
+fn grid_pixels(grid: &OccupancyGrid) -> (usize, usize, Vec<u8>) {
+    if grid.width() == 0 {
         (1, 1, vec![PGM_UNKNOWN])
     } else {
         (grid.width(), grid.height(), grey_rows_top_first(grid))
-    };
-    let mut out = format!(
-        "P5\n# slamlab occupancy grid, {} m/cell\n{w} {h}\n255\n",
-        grid.resolution_m()
-    )
-    .into_bytes();
-    out.extend(pixels);
+    }
+}
+
+/// A binary PGM (P5) of `w × h` grey `pixels` (top row first), with a
+/// comment giving the resolution. Shared by the lab's grids and the
+/// merged real maps ([`crate::rosmap::write`]).
+pub fn pgm_bytes(w: usize, h: usize, pixels: &[u8], resolution_m: f64) -> Vec<u8> {
+    let mut out =
+        format!("P5\n# slamlab occupancy grid, {resolution_m} m/cell\n{w} {h}\n255\n").into_bytes();
+    out.extend_from_slice(pixels);
     out
 }
 
 /// The map_server YAML for an image called `image`.
 pub fn to_yaml(grid: &OccupancyGrid, image: &str) -> String {
-    let o = grid.origin_m();
+    yaml_text(image, grid.resolution_m(), grid.origin_m())
+}
+
+/// The map_server YAML for an image called `image` whose lower-left
+/// corner lies at `origin` (yaw 0), `resolution_m` metres a pixel.
+pub fn yaml_text(image: &str, resolution_m: f64, origin: DVec2) -> String {
     let quoted = serde_json::to_string(image).unwrap_or_else(|_| "\"map.pgm\"".into());
     format!(
         "image: {quoted}\nresolution: {}\norigin: [{}, {}, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n",
-        grid.resolution_m(),
-        o.x,
-        o.y
+        resolution_m, origin.x, origin.y
     )
 }
 
 /// The grid as a grey PNG (same pixels as the PGM).
 pub fn to_png(grid: &OccupancyGrid) -> Result<Vec<u8>, String> {
+    let (w, h, pixels) = grid_pixels(grid);
+    png_bytes(w, h, &pixels)
+}
+
+/// A grey PNG of `w × h` `pixels` (top row first).
+pub fn png_bytes(w: usize, h: usize, pixels: &[u8]) -> Result<Vec<u8>, String> {
     use image::ImageEncoder;
-    let (w, h, pixels) = if grid.width() == 0 {
-        (1, 1, vec![PGM_UNKNOWN])
-    } else {
-        (grid.width(), grid.height(), grey_rows_top_first(grid))
-    };
     let mut out = Vec::new();
     image::codecs::png::PngEncoder::new(&mut out)
-        .write_image(&pixels, w as u32, h as u32, image::ExtendedColorType::L8)
+        .write_image(pixels, w as u32, h as u32, image::ExtendedColorType::L8)
         .map_err(|e| format!("PNG encoding failed: {e}"))?;
     Ok(out)
 }

@@ -1,0 +1,127 @@
+//! # JavaScript boundary of the offline map merge
+//!
+//! `MapMerge` holds the saved maps a user brought (ROS `map_server` YAML
+//! text and image bytes, read by the caller: node from disk, the page from
+//! a file picker), merges them ([`crate::merge::offline`]) and hands back
+//! the report as JSON and the merged map as PGM, PNG and YAML. A thin
+//! converting layer: every error is a `JsError` whose message names the
+//! file and the field.
+
+use crate::merge::offline::{merge_all, OfflineConfig, OfflineMerge};
+use crate::rosmap::{self, write::MergedMap, MapYaml, RosMap};
+use wasm_bindgen::prelude::*;
+
+fn err(e: impl std::fmt::Display) -> JsError {
+    JsError::new(&e.to_string())
+}
+
+/// Saved maps and, after `merge`, the result.
+#[wasm_bindgen]
+#[derive(Default)]
+pub struct MapMerge {
+    maps: Vec<RosMap>,
+    result: Option<OfflineMerge>,
+    merged: Option<MergedMap>,
+}
+
+/// The `image` field of a map YAML (the path of its image, relative to the
+/// YAML's folder), so the caller knows which file to read.
+#[wasm_bindgen(js_name = mapImagePath)]
+pub fn map_image_path(name: &str, yaml_text: &str) -> Result<String, JsError> {
+    Ok(MapYaml::parse(name, yaml_text).map_err(err)?.image)
+}
+
+/// The most cells a map may hold.
+#[wasm_bindgen(js_name = mapMaxCells)]
+pub fn map_max_cells() -> u32 {
+    rosmap::MAX_CELLS as u32
+}
+
+#[wasm_bindgen]
+impl MapMerge {
+    #[wasm_bindgen(constructor)]
+    pub fn new() -> MapMerge {
+        MapMerge::default()
+    }
+
+    /// Reads one map (`name`: the YAML's path as given; `image_name`: the
+    /// image's path, for messages). Returns its index.
+    #[wasm_bindgen(js_name = addMap)]
+    pub fn add_map(
+        &mut self,
+        name: &str,
+        yaml_text: &str,
+        image_name: &str,
+        image: &[u8],
+    ) -> Result<u32, JsError> {
+        if self.maps.len() >= 16 {
+            return Err(JsError::new(&format!(
+                "{name}: at most 16 maps can be merged at once"
+            )));
+        }
+        let map = rosmap::load(name, yaml_text, image_name, image).map_err(err)?;
+        self.maps.push(map);
+        self.result = None;
+        self.merged = None;
+        Ok(self.maps.len() as u32 - 1)
+    }
+
+    /// Size and resolution of map `i` (JSON `{name, width, height, resolution}`).
+    #[wasm_bindgen(js_name = mapInfoJson)]
+    pub fn map_info_json(&self, i: u32) -> Result<String, JsError> {
+        let m = self
+            .maps
+            .get(i as usize)
+            .ok_or_else(|| JsError::new("no such map"))?;
+        Ok(serde_json::json!({"name": m.name, "width": m.width, "height": m.height, "resolution": m.resolution}).to_string())
+    }
+
+    /// Merges the maps; returns the report's `maps` and `merge` as JSON.
+    pub fn merge(&mut self) -> Result<String, JsError> {
+        if self.maps.len() < 2 {
+            return Err(JsError::new("merge-maps needs at least two maps"));
+        }
+        let result = merge_all(&self.maps, &OfflineConfig::default(), &mut |_| {});
+        let report = result.report(&self.maps).to_string();
+        self.result = Some(result);
+        self.merged = None;
+        Ok(report)
+    }
+
+    fn merged(&mut self) -> Result<&MergedMap, JsError> {
+        if self.merged.is_none() {
+            let r = self
+                .result
+                .as_ref()
+                .ok_or_else(|| JsError::new("merge first"))?;
+            let joined: Vec<(&RosMap, crate::geom::Pose2)> = r
+                .poses
+                .iter()
+                .zip(&self.maps)
+                .filter_map(|(p, m)| p.map(|p| (m, p)))
+                .collect();
+            self.merged = Some(rosmap::write::merge_maps(&joined).map_err(err)?);
+        }
+        self.merged
+            .as_ref()
+            .ok_or_else(|| JsError::new("no merged map"))
+    }
+
+    /// The merged map (the maps joined to the first) as a binary PGM.
+    #[wasm_bindgen(js_name = mergedPgm)]
+    pub fn merged_pgm(&mut self) -> Result<Vec<u8>, JsError> {
+        Ok(self.merged()?.pgm())
+    }
+
+    /// The same pixels as a PNG.
+    #[wasm_bindgen(js_name = mergedPng)]
+    pub fn merged_png(&mut self) -> Result<Vec<u8>, JsError> {
+        self.merged()?.png().map_err(err)
+    }
+
+    /// The map_server YAML naming `image`.
+    #[wasm_bindgen(js_name = mergedYaml)]
+    pub fn merged_yaml(&mut self, image: &str) -> Result<String, JsError> {
+        Ok(self.merged()?.yaml(image))
+    }
+}

@@ -1,0 +1,294 @@
+//! # Merging saved maps offline: two to sixteen ROS maps, no robots
+//!
+//! Everything else in [`crate::merge`] merges the maps of robots the lab
+//! simulated, with their camera frames and laser scans at hand. Here only
+//! the maps are: ROS `map_server` files from GMapping, slam_toolbox,
+//! Cartographer or Hector, made on different runs ([`crate::rosmap`]
+//! reads them). The stages, one file each:
+//!
+//! | stage | file | what |
+//! |---|---|---|
+//! | prepare | [`super::wallmap`] | wall-surface points and a distance field per map |
+//! | search | [`super::offline_search`] | rotations from Hough spectra, coarse correlation, refinement |
+//! | judge | [`super::evidence`] | agreement within a tolerance band, acceptance index, margin |
+//! | join | [`super::graph`] | with three or more maps, the most confident spanning tree |
+//! | write | [`crate::rosmap::write`] | the merged map as PGM + PNG + YAML |
+//!
+//! Each pair of maps is searched and judged on its own; a pair is an edge
+//! when its verdict is "merged", weighted by its confidence, and the maps
+//! are joined along the maximum spanning tree from the first map, as the
+//! lab joins three or more robots. The first map's frame is the merged
+//! frame. A transform is reported as the pose of a map's own frame (the
+//! frame its YAML `origin` is written in) in the first map's frame:
+//! the search works in image frames (the image's lower-left corner), so a
+//! pair's image-frame overlay `P` becomes `origin_A ⊕ P ⊕ origin_B⁻¹`.
+//!
+//! Nothing here changes the lab's own pipeline: the simulated robots'
+//! merge keeps its own search ([`super::mapsearch`]) and verdict.
+
+use super::evidence::{distinct, evidence, judge, Evidence, EvidenceConfig};
+use super::graph::{spanning_tree, PairEdge};
+use super::offline_search::{propose, SearchConfig};
+use super::wallmap::WallMap;
+use super::MergeStatus;
+use crate::geom::Pose2;
+use crate::rosmap::RosMap;
+use glam::DVec2;
+use serde_json::json;
+
+/// Settings of the offline merge.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct OfflineConfig {
+    pub search: SearchConfig,
+    pub evidence: EvidenceConfig,
+}
+
+/// The verdict on one pair of maps.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PairResult {
+    pub a: usize,
+    pub b: usize,
+    pub status: MergeStatus,
+    pub reason: String,
+    pub confidence: f64,
+    /// B's map frame in A's map frame: the merge when merged, else the
+    /// best overlay found (for display; not to be trusted).
+    pub pose: Option<Pose2>,
+    pub evidence: Option<Evidence>,
+    /// Net support (m) of the best different overlay.
+    pub rival_support_m: f64,
+    /// Overlays refined and judged.
+    pub overlays: usize,
+}
+
+/// The merge of all maps.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OfflineMerge {
+    pub status: MergeStatus,
+    pub reason: String,
+    pub confidence: f64,
+    /// Each map's frame in the first map's; `None` where not joined.
+    pub poses: Vec<Option<Pose2>>,
+    pub unjoined: Vec<usize>,
+    pub pairs: Vec<PairResult>,
+}
+
+/// Searches and judges one pair (maps A and B, prepared as `wa`, `wb`).
+pub fn merge_pair(
+    (ia, a, wa): (usize, &RosMap, &WallMap),
+    (ib, b, wb): (usize, &RosMap, &WallMap),
+    cfg: &OfflineConfig,
+) -> PairResult {
+    let mut out = PairResult {
+        a: ia,
+        b: ib,
+        status: MergeStatus::NoMerge,
+        reason: String::new(),
+        confidence: 0.0,
+        pose: None,
+        evidence: None,
+        rival_support_m: 0.0,
+        overlays: 0,
+    };
+    if wa.walls.len() < 10 || wb.walls.len() < 10 {
+        out.reason = "a map has (almost) no walls to align".into();
+        return out;
+    }
+    let proposals = propose(wa, wb, &cfg.search);
+    out.overlays = proposals.len();
+    let judged: Vec<(Pose2, Evidence)> = proposals
+        .iter()
+        .map(|p| (p.pose, evidence(wa, wb, &p.pose, &cfg.evidence)))
+        .collect();
+    // The overlay with the most net support (ties: the better search score).
+    let Some(w) = (0..judged.len()).reduce(|best, i| {
+        if judged[i].1.support_m > judged[best].1.support_m {
+            i
+        } else {
+            best
+        }
+    }) else {
+        out.reason = "no overlay of the walls scores above zero".into();
+        return out;
+    };
+    let (wpose, e) = judged[w];
+    let centre = wb.walls.iter().copied().sum::<DVec2>() / wb.walls.len() as f64;
+    out.rival_support_m = judged
+        .iter()
+        .filter(|(p, _)| distinct(p, &wpose, centre, &cfg.evidence))
+        .map(|(_, r)| r.support_m)
+        .fold(0.0, f64::max);
+    out.evidence = Some(e);
+    out.pose = Some(a.origin.compose(&wpose).compose(&b.origin.inverse()));
+    match judge(&e, out.rival_support_m, &cfg.evidence) {
+        Ok(confidence) => {
+            out.status = MergeStatus::Merged;
+            out.confidence = confidence;
+            out.reason = format!(
+                "the maps agree: {:.1} m of wall of each on the other's within {:.2} m, acceptance index {:.2} ({} points agree, {} in the band, {} in free space), {:.1} m of net support, {:.1} times that of any other overlay",
+                e.agree_m,
+                cfg.evidence.agree_m,
+                e.index,
+                e.agree[0] + e.agree[1],
+                e.band[0] + e.band[1],
+                e.disagree[0] + e.disagree[1],
+                e.support_m,
+                if out.rival_support_m > 0.0 { e.support_m / out.rival_support_m } else { f64::INFINITY }
+            );
+        }
+        Err(reason) => out.reason = reason,
+    }
+    out
+}
+
+/// Merges all `maps` (see the module doc). `progress` hears a line per
+/// pair.
+pub fn merge_all(
+    maps: &[RosMap],
+    cfg: &OfflineConfig,
+    progress: &mut dyn FnMut(&str),
+) -> OfflineMerge {
+    let prepared: Vec<WallMap> = maps.iter().map(WallMap::new).collect();
+    let mut pairs = Vec::new();
+    for i in 0..maps.len() {
+        for j in i + 1..maps.len() {
+            let r = merge_pair(
+                (i, &maps[i], &prepared[i]),
+                (j, &maps[j], &prepared[j]),
+                cfg,
+            );
+            progress(&format!(
+                "{} + {}: {} ({})",
+                maps[i].name,
+                maps[j].name,
+                if r.status == MergeStatus::Merged {
+                    "merged"
+                } else {
+                    "no merge"
+                },
+                r.reason
+            ));
+            pairs.push(r);
+        }
+    }
+    let edges: Vec<PairEdge> = pairs
+        .iter()
+        .filter(|p| p.status == MergeStatus::Merged)
+        .filter_map(|p| {
+            p.pose.map(|pose| PairEdge {
+                a: p.a,
+                b: p.b,
+                pose,
+                confidence: p.confidence,
+            })
+        })
+        .collect();
+    let joined = spanning_tree(maps.len(), &edges);
+    let unjoined = joined.unjoined();
+    let used: Vec<&PairEdge> = joined.edges_used.iter().map(|&k| &edges[k]).collect();
+    let confidence = used
+        .iter()
+        .map(|e| e.confidence)
+        .reduce(f64::min)
+        .unwrap_or(0.0);
+    let (status, reason) = if maps.len() < 2 {
+        (
+            MergeStatus::NoMerge,
+            "one map: nothing to merge".to_string(),
+        )
+    } else if unjoined.is_empty() {
+        let reason = if pairs.len() == 1 {
+            pairs[0].reason.clone()
+        } else {
+            format!(
+                "all {} maps joined along the most confident of {} merged pairs (weakest edge confidence {:.2})",
+                maps.len(),
+                edges.len(),
+                confidence
+            )
+        };
+        (MergeStatus::Merged, reason)
+    } else if pairs.len() == 1 {
+        (MergeStatus::NoMerge, pairs[0].reason.clone())
+    } else {
+        let names: Vec<&str> = unjoined.iter().map(|&i| maps[i].name.as_str()).collect();
+        (
+            MergeStatus::NoMerge,
+            format!(
+                "{} of {} maps joined ({} of {} pairs merged); not joined: {}",
+                maps.len() - unjoined.len(),
+                maps.len(),
+                edges.len(),
+                pairs.len(),
+                names.join(", ")
+            ),
+        )
+    };
+    OfflineMerge {
+        status,
+        reason,
+        confidence: if status == MergeStatus::Merged {
+            confidence
+        } else {
+            0.0
+        },
+        poses: joined.poses,
+        unjoined,
+        pairs,
+    }
+}
+
+fn pose_json(p: &Pose2) -> serde_json::Value {
+    json!([p.x, p.y, p.theta])
+}
+
+fn status_name(s: MergeStatus) -> &'static str {
+    match s {
+        MergeStatus::Merged => "merged",
+        MergeStatus::NoMerge => "no_merge",
+    }
+}
+
+impl OfflineMerge {
+    /// The report's `maps` and `merge` (docs/interfaces.md, "Real maps:
+    /// merge-maps"); the caller adds `timings_ms`.
+    pub fn report(&self, maps: &[RosMap]) -> serde_json::Value {
+        let name = |i: usize| maps.get(i).map_or("", |m| m.name.as_str());
+        let transforms: Vec<_> = self
+            .poses
+            .iter()
+            .enumerate()
+            .filter_map(|(i, p)| p.map(|p| json!({ "map": name(i), "pose": pose_json(&p) })))
+            .collect();
+        let pairs: Vec<_> = self
+            .pairs
+            .iter()
+            .map(|p| {
+                json!({
+                    "a": name(p.a),
+                    "b": name(p.b),
+                    "status": status_name(p.status),
+                    "reason": p.reason,
+                    "confidence": p.confidence,
+                    "pose": p.pose.map(|q| pose_json(&q)),
+                    "evidence": p.evidence,
+                    "rival_support_m": p.rival_support_m,
+                    "overlays": p.overlays,
+                })
+            })
+            .collect();
+        json!({
+            "maps": maps.iter().map(|m| json!({
+                "name": m.name, "width": m.width, "height": m.height, "resolution": m.resolution,
+            })).collect::<Vec<_>>(),
+            "merge": {
+                "status": status_name(self.status),
+                "reason": self.reason,
+                "confidence": self.confidence,
+                "transforms": transforms,
+                "unjoined": self.unjoined.iter().map(|&i| name(i)).collect::<Vec<_>>(),
+                "pairs": pairs,
+            },
+        })
+    }
+}

@@ -1,0 +1,281 @@
+//! The offline merge of saved maps (crate/src/merge/offline.rs) on maps cut
+//! from generated buildings with known transforms: a pair merges to the
+//! truth, three maps join along the spanning tree, two different buildings
+//! are refused, and the merged map is written as ROS map_server files.
+
+use glam::DVec2;
+use slamlab::geom::{wrap_angle, Pose2, Segment};
+use slamlab::merge::offline::{merge_all, OfflineConfig};
+use slamlab::merge::MergeStatus;
+use slamlab::rng::Rng;
+use slamlab::rosmap::{self, RosMap};
+
+/// A floor plan: an outer `w × h` rectangle, rooms along two sides of a
+/// corridor, doors, a slanted wall and pillars, placed by `seed`.
+fn building(seed: u64, w: f64, h: f64) -> Vec<Segment> {
+    let mut rng = Rng::new(seed);
+    let s = |a: (f64, f64), b: (f64, f64)| Segment::new(DVec2::new(a.0, a.1), DVec2::new(b.0, b.1));
+    let mut walls = vec![
+        s((0.0, 0.0), (w, 0.0)),
+        s((w, 0.0), (w, h)),
+        s((w, h), (0.0, h)),
+        s((0.0, h), (0.0, 0.0)),
+    ];
+    let (c0, c1) = (h * 0.42, h * 0.42 + 2.4);
+    // Corridor walls with a door into each room.
+    let mut x = 0.0;
+    while x < w - 3.0 {
+        let room = rng.range(3.5, 7.0).min(w - x);
+        let (d0, d1) = (rng.range(0.5, room - 1.5), rng.range(0.5, room - 1.5));
+        walls.push(s((x, c0), (x + d0, c0)));
+        walls.push(s((x + d0 + 1.0, c0), (x + room, c0)));
+        walls.push(s((x, c1), (x + d1, c1)));
+        walls.push(s((x + d1 + 1.0, c1), (x + room, c1)));
+        if x + room < w - 0.5 {
+            walls.push(s((x + room, 0.0), (x + room, c0)));
+            let up = rng.range(0.0, 1.0) < 0.7;
+            if up {
+                walls.push(s((x + room, c1), (x + room, h)));
+            }
+        }
+        x += room;
+    }
+    // A slanted wall and a few pillars (0.4 m squares) break symmetries.
+    let (px, py) = (rng.range(2.0, w - 6.0), rng.range(c1 + 1.0, h - 3.0));
+    walls.push(s((px, py), (px + 3.0, py + 1.5)));
+    for _ in 0..4 {
+        let (qx, qy) = (rng.range(1.0, w - 1.0), rng.range(1.0, c0 - 1.0));
+        walls.push(s((qx, qy), (qx + 0.4, qy)));
+        walls.push(s((qx + 0.4, qy), (qx + 0.4, qy + 0.4)));
+        walls.push(s((qx + 0.4, qy + 0.4), (qx, qy + 0.4)));
+        walls.push(s((qx, qy + 0.4), (qx, qy)));
+    }
+    walls
+}
+
+/// A map of `walls` whose image's lower-left corner is at `frame` (world),
+/// `size` metres, showing only the part of the building with
+/// `seen(x, y)`, and written with YAML origin `origin`.
+fn cut(
+    name: &str,
+    walls: &[Segment],
+    (w, h): (f64, f64),
+    frame: Pose2,
+    size: DVec2,
+    seen: impl Fn(DVec2) -> bool,
+    origin: Pose2,
+) -> RosMap {
+    let r = 0.05;
+    let (nx, ny) = ((size.x / r) as usize, (size.y / r) as usize);
+    let mut data = vec![-1i8; nx * ny];
+    for iy in 0..ny {
+        for ix in 0..nx {
+            let p = frame.transform_point(DVec2::new(ix as f64 + 0.5, iy as f64 + 0.5) * r);
+            let inside = p.x > -0.1 && p.y > -0.1 && p.x < w + 0.1 && p.y < h + 0.1;
+            if !inside || !seen(p) {
+                continue;
+            }
+            let near = walls.iter().any(|s| s.distance_to_point(p) <= 0.04);
+            data[iy * nx + ix] = if near { 100 } else { 0 };
+        }
+    }
+    RosMap::from_values(name, nx, ny, r, origin, data).unwrap()
+}
+
+/// The map frame of a map whose image frame is `frame` (world) and whose
+/// YAML origin is `origin`: `frame ⊕ origin⁻¹`.
+fn map_frame(frame: &Pose2, origin: &Pose2) -> Pose2 {
+    frame.compose(&origin.inverse())
+}
+
+fn error(est: &Pose2, truth: &Pose2) -> (f64, f64) {
+    (
+        (est.position() - truth.position()).length(),
+        wrap_angle(est.theta - truth.theta).abs().to_degrees(),
+    )
+}
+
+/// B's image frame turned by `theta` about the middle of the window x0..x1.
+fn turned_frame(x0: f64, x1: f64, h: f64, theta: f64, size: f64) -> Pose2 {
+    let centre = DVec2::new(0.5 * (x0 + x1), 0.5 * h);
+    let (s, c) = theta.sin_cos();
+    let half = DVec2::splat(0.5 * size);
+    let corner = centre - DVec2::new(c * half.x - s * half.y, s * half.x + c * half.y);
+    Pose2::new(corner.x, corner.y, theta)
+}
+
+#[test]
+fn a_pair_cut_from_one_building_merges_to_the_known_transform() {
+    let (w, h) = (36.0, 24.0);
+    let walls = building(11, w, h);
+    let fa = Pose2::new(-1.0, -1.0, 0.0);
+    let oa = Pose2::new(-3.0, 2.0, 0.0);
+    let a = cut(
+        "a.yaml",
+        &walls,
+        (w, h),
+        fa,
+        DVec2::new(26.0, 26.0),
+        |p| p.x <= 24.0,
+        oa,
+    );
+    let fb = turned_frame(12.0, 37.0, h, 0.7, 36.0);
+    let ob = Pose2::new(1.0, -2.0, 0.3);
+    let b = cut(
+        "b.yaml",
+        &walls,
+        (w, h),
+        fb,
+        DVec2::new(36.0, 36.0),
+        |p| p.x >= 12.0,
+        ob,
+    );
+    let truth = map_frame(&fa, &oa).between(&map_frame(&fb, &ob));
+    let r = merge_all(&[a, b], &OfflineConfig::default(), &mut |_| {});
+    assert_eq!(r.status, MergeStatus::Merged, "{}", r.reason);
+    let est = r.poses[1].unwrap();
+    let (dm, dd) = error(&est, &truth);
+    println!(
+        "synthetic pair: off by {dm:.4} m, {dd:.3} deg; {}",
+        r.reason
+    );
+    assert!(dm < 0.05 && dd < 0.2, "off by {dm} m {dd} deg");
+    assert!(r.confidence > 0.0 && r.confidence <= 1.0);
+    assert_eq!(r.poses[0], Some(Pose2::IDENTITY));
+}
+
+#[test]
+fn three_maps_join_along_the_spanning_tree() {
+    let (w, h) = (36.0, 24.0);
+    let walls = building(5, w, h);
+    let fa = Pose2::new(-1.0, -1.0, 0.0);
+    let oa = Pose2::IDENTITY;
+    let a = cut(
+        "a.yaml",
+        &walls,
+        (w, h),
+        fa,
+        DVec2::new(22.0, 26.0),
+        |p| p.x <= 20.0,
+        oa,
+    );
+    let fb = turned_frame(8.0, 30.0, h, -1.2, 34.0);
+    let b = cut(
+        "b.yaml",
+        &walls,
+        (w, h),
+        fb,
+        DVec2::new(34.0, 34.0),
+        |p| (8.0..=30.0).contains(&p.x),
+        oa,
+    );
+    let fc = turned_frame(10.0, 37.0, h, 2.5, 38.0);
+    let c = cut(
+        "c.yaml",
+        &walls,
+        (w, h),
+        fc,
+        DVec2::new(38.0, 38.0),
+        |p| p.x >= 10.0,
+        oa,
+    );
+    let r = merge_all(&[a, b, c], &OfflineConfig::default(), &mut |line| {
+        println!("{line}")
+    });
+    assert_eq!(r.status, MergeStatus::Merged, "{}", r.reason);
+    assert!(r.unjoined.is_empty());
+    for (k, f) in [(1, fb), (2, fc)] {
+        let (dm, dd) = error(&r.poses[k].unwrap(), &fa.between(&f));
+        println!("map {k}: off by {dm:.4} m, {dd:.3} deg");
+        assert!(dm < 0.08 && dd < 0.3, "map {k} off by {dm} m {dd} deg");
+    }
+    assert_eq!(r.pairs.len(), 3);
+}
+
+#[test]
+fn two_different_buildings_are_not_merged() {
+    let fa = Pose2::new(-1.0, -1.0, 0.0);
+    let a = cut(
+        "a.yaml",
+        &building(3, 36.0, 24.0),
+        (36.0, 24.0),
+        fa,
+        DVec2::new(38.0, 26.0),
+        |_| true,
+        Pose2::IDENTITY,
+    );
+    let fb = turned_frame(0.0, 30.0, 20.0, 0.4, 38.0);
+    let b = cut(
+        "b.yaml",
+        &building(8, 30.0, 20.0),
+        (30.0, 20.0),
+        fb,
+        DVec2::new(38.0, 38.0),
+        |_| true,
+        Pose2::IDENTITY,
+    );
+    let r = merge_all(&[a, b], &OfflineConfig::default(), &mut |_| {});
+    println!("different buildings: {}", r.reason);
+    assert_eq!(r.status, MergeStatus::NoMerge, "{}", r.reason);
+    assert_eq!(r.unjoined, vec![1]);
+    assert_eq!(r.pairs[0].status, MergeStatus::NoMerge);
+}
+
+#[test]
+fn the_merged_map_is_written_as_map_server_files() {
+    let (w, h) = (36.0, 24.0);
+    let walls = building(11, w, h);
+    let fa = Pose2::new(-1.0, -1.0, 0.0);
+    let a = cut(
+        "a.yaml",
+        &walls,
+        (w, h),
+        fa,
+        DVec2::new(26.0, 26.0),
+        |p| p.x <= 24.0,
+        Pose2::IDENTITY,
+    );
+    let fb = turned_frame(12.0, 37.0, h, 0.7, 36.0);
+    let b = cut(
+        "b.yaml",
+        &walls,
+        (w, h),
+        fb,
+        DVec2::new(36.0, 36.0),
+        |p| p.x >= 12.0,
+        Pose2::IDENTITY,
+    );
+    let merged =
+        rosmap::write::merge_maps(&[(&a, Pose2::IDENTITY), (&b, fa.between(&fb))]).unwrap();
+    // It covers both maps: A's 26 m and B's turned square reach x = 37 m.
+    assert!(merged.width as f64 * 0.05 > 38.0, "{}", merged.width);
+    let yaml = merged.yaml("m.pgm");
+    let back = rosmap::load("m.yaml", &yaml, "m.pgm", &merged.pgm()).unwrap();
+    assert_eq!((back.width, back.height), (merged.width, merged.height));
+    // World point (33, 5) is only in B: free there (no wall within 0.5 m?).
+    let at = |m: &RosMap, world: DVec2| {
+        let p = fa.inverse().transform_point(world);
+        let q = m.origin.inverse().transform_point(p);
+        let (ix, iy) = m.cell_at_image(q).unwrap();
+        m.data[iy * m.width + ix]
+    };
+    let free_spot = DVec2::new(30.0, 0.5 * (h * 0.42 + h * 0.42 + 2.4));
+    assert_eq!(
+        at(&back, free_spot),
+        0,
+        "corridor middle at x = 30 (only B saw it) is free"
+    );
+    assert_eq!(
+        at(&back, DVec2::new(36.0, 12.0)),
+        100,
+        "the east outer wall (only in B) is a wall"
+    );
+    assert_eq!(
+        at(&back, DVec2::new(0.0, 12.0)),
+        100,
+        "the west outer wall (only in A) is a wall"
+    );
+    let png = merged.png().unwrap();
+    let from_png = rosmap::load("m.yaml", &yaml.replace("m.pgm", "m.png"), "m.png", &png).unwrap();
+    assert_eq!(from_png.data, back.data);
+}
