@@ -9,11 +9,8 @@
 
 use crate::merge::offline::{merge_all, OfflineConfig, OfflineMerge};
 use crate::rosmap::{self, write::MergedMap, MapYaml, RosMap};
+use super::convert::js_err as err;
 use wasm_bindgen::prelude::*;
-
-fn err(e: impl std::fmt::Display) -> JsError {
-    JsError::new(&e.to_string())
-}
 
 /// Saved maps and, after `merge`, the result.
 #[wasm_bindgen]
