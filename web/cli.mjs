@@ -63,7 +63,7 @@ const usages = [USAGE];
 
 // Commands contributed by other capabilities (each module exports `commands`
 // and optionally `usage`).
-for (const mod of ['./cli/camera.mjs', './cli/surf.mjs', './cli/slam.mjs', './cli/merge.mjs']) {
+for (const mod of ['./cli/camera.mjs', './cli/surf.mjs', './cli/slam.mjs', './cli/merge.mjs', './cli/run-log.mjs']) {
   try {
     const m = await import(mod);
     Object.assign(commands, m.commands);

@@ -18,6 +18,7 @@
 //! | [`kinematics`] | differential-drive motion of a P2DX |
 //! | [`odometry`] | wheel encoders with slip and bias: what the robot believes |
 //! | [`sensors`] | the sonar ring and the laser range finder |
+//! | [`carmen`] | reading CARMEN laser logs (real data: FLASER, ROBOTLASER1, ODOM) |
 //! | [`camera`] | the pinhole camera, wall textures, frame capture |
 //! | [`follower`] | the thesis's wall-following controller |
 //! | [`sim`] | the fixed-step simulation and its per-robot logs |
@@ -32,6 +33,7 @@
 
 pub mod bindings;
 pub mod camera;
+pub mod carmen;
 pub mod follower;
 pub mod geom;
 pub mod kinematics;
