@@ -6,6 +6,7 @@
 use slamlab::carmen::{parse_bytes, parse_str};
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::io::Write;
+use wasm_bindgen_test::wasm_bindgen_test;
 
 fn flaser(ranges: &[f64], pose: [f64; 3], odom: [f64; 3], t: f64) -> String {
     let r: Vec<String> = ranges.iter().map(|v| v.to_string()).collect();
@@ -22,7 +23,7 @@ fn flaser(ranges: &[f64], pose: [f64; 3], odom: [f64; 3], t: f64) -> String {
     )
 }
 
-#[test]
+#[wasm_bindgen_test(unsupported = test)]
 fn flaser_geometry_poses_and_no_return() {
     let text = [
         "# a comment".to_string(),
@@ -73,7 +74,7 @@ fn flaser_geometry_poses_and_no_return() {
     );
 }
 
-#[test]
+#[wasm_bindgen_test(unsupported = test)]
 fn robotlaser1_geometry_and_laser_offset() {
     // type start fov res maxrange accuracy remission n r.. m e.. laser pose, robot pose,
     // tv rv fwd side turn ts host ts
@@ -101,7 +102,7 @@ fn robotlaser1_geometry_and_laser_offset() {
     assert!((o.theta - 0.1).abs() < 1e-12);
 }
 
-#[test]
+#[wasm_bindgen_test(unsupported = test)]
 fn rawlaser1_odometry_interpolated_between_odom_records() {
     let text = "ODOM 0 0 0 0 0 0 10.0 host 10.0\n\
                 RAWLASER1 0 -1.5708 3.1416 1.5708 20 0.01 0 3 1 2 3 0 12.5 host 12.5\n\
@@ -119,7 +120,7 @@ fn rawlaser1_odometry_interpolated_between_odom_records() {
     assert!(log.scans[0].logged_pose.is_none());
 }
 
-#[test]
+#[wasm_bindgen_test(unsupported = test)]
 fn gzip_compressed_logs_read_like_plain_ones() {
     let text = format!(
         "{}\n{}\n",
@@ -136,7 +137,7 @@ fn gzip_compressed_logs_read_like_plain_ones() {
     assert!(e.to_string().contains("gzip"), "{e}");
 }
 
-#[test]
+#[wasm_bindgen_test(unsupported = test)]
 fn bad_and_truncated_lines_name_their_line() {
     let good = flaser(&[1.0, 2.0, 3.0], [0.0; 3], [0.0; 3], 1.0);
     let cases = [

@@ -5,12 +5,13 @@ use slamlab::geom::Pose2;
 use slamlab::slam::posegraph::{Edge, PoseGraph};
 use slamlab::slam::relations::{drift_odometry, relation_errors, DriftModel};
 use std::f64::consts::FRAC_PI_2;
+use wasm_bindgen_test::wasm_bindgen_test;
 
 fn close(a: f64, b: f64, tol: f64) -> bool {
     (a - b).abs() <= tol
 }
 
-#[test]
+#[wasm_bindgen_test(unsupported = test)]
 fn a_corridor_loop_spreads_its_error_evenly() {
     // Three steps of 1 m measured, and a closure saying the end is 2.7 m
     // from the start: all four edges alike, so each takes a quarter of the
@@ -52,7 +53,7 @@ fn square_truth() -> Vec<Pose2> {
     ]
 }
 
-#[test]
+#[wasm_bindgen_test(unsupported = test)]
 fn a_square_loop_with_a_closure_comes_back_to_the_square() {
     // Exact measurements of a 2 m square (turning left at each corner) and
     // the closure from the last corner back to the first; the start guess is
@@ -81,7 +82,7 @@ fn a_square_loop_with_a_closure_comes_back_to_the_square() {
     assert!(g.total_chi2() < 1e-10);
 }
 
-#[test]
+#[wasm_bindgen_test(unsupported = test)]
 fn a_closure_pulls_drifted_poses_back_and_node_zero_stays() {
     // Odometry edges measured 5 % long around the square, a closure that
     // is exact and much more certain: the optimum honours the closure, the
@@ -118,7 +119,7 @@ fn a_closure_pulls_drifted_poses_back_and_node_zero_stays() {
     assert!(close(seen.x, 2.0, 0.01) && close(seen.y, 0.0, 0.01));
 }
 
-#[test]
+#[wasm_bindgen_test(unsupported = test)]
 fn relation_errors_by_hand() {
     // Estimate = reference with node 2 shifted 0.1 m sideways: relations
     // (1,2) and (2,3) are off by 0.1 m, (0,1) not at all.
@@ -138,7 +139,7 @@ fn relation_errors_by_hand() {
     }
 }
 
-#[test]
+#[wasm_bindgen_test(unsupported = test)]
 fn drifting_odometry_follows_its_model() {
     // A straight 100 m drive in 0.5 m steps: with only the bias switched
     // on, the heading turns by exactly bias · distance.
