@@ -123,7 +123,7 @@ test('run-log --from/--to replays a stretch; --out writes PGM, YAML and PNG', ()
   assert.equal(r.code, 0, r.stderr);
   assert.match(r.stdout, /31 of 160 laser records replayed \(10\.\.40\)/);
   assert.ok(existsSync(path.join(tmp, 'room.pgm')) && existsSync(path.join(tmp, 'room.png')));
-  assert.match(readFileSync(out, 'utf8'), /image: room\.pgm/);
+  assert.match(readFileSync(out, 'utf8'), /image: "room\.pgm"/);
   const j = JSON.parse(run('run-log', plain, '--from', '10', '--to', '40', '--json').stdout);
   assert.equal(j.scans[0].index, 10);
   assert.equal(j.scans.at(-1).index, 40);
