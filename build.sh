@@ -20,7 +20,7 @@ ROOT=$(pwd)
 export PATH="$HOME/.cargo/bin:$PATH"
 SIMD_FLAGS='-C target-feature=+simd128'
 # The real-data suite's test files (each fails loudly without ../shared/data).
-REAL_RUST_TESTS='--test real_maps'
+REAL_RUST_TESTS='--test real_maps --test real_logs'
 REAL_NODE_TESTS=''
 
 log() { printf '\033[1;34m==>\033[0m %s\n' "$*" >&2; }
@@ -112,7 +112,7 @@ cmd_test() {
   cmd_build
   log "command-line and browser end-to-end tests (node --test)"
   mkdir -p test-artifacts
-  node --test --test-concurrency=1 tests/imports.test.mjs tests/lab.test.mjs tests/cli.test.mjs tests/maps.test.mjs tests/reports.test.mjs tests/exercises.test.mjs tests/page.test.mjs tests/classroom.test.mjs
+  node --test --test-concurrency=1 tests/imports.test.mjs tests/lab.test.mjs tests/cli.test.mjs tests/maps.test.mjs tests/run-log.test.mjs tests/reports.test.mjs tests/exercises.test.mjs tests/page.test.mjs tests/classroom.test.mjs
 }
 
 # The real-data suite reads third-party data from ../shared/data (or

@@ -21,6 +21,7 @@ import * as surf from './cli/surf.mjs';
 import * as slam from './cli/slam.mjs';
 import * as merge from './cli/merge.mjs';
 import * as mergeMaps from './cli/merge-maps.mjs';
+import * as runLog from './cli/run-log.mjs';
 
 export { UsageError, parseArgs };
 
@@ -36,6 +37,7 @@ const MODULES = [
   slam,
   merge,
   mergeMaps,
+  runLog,
 ];
 
 const commands = {};

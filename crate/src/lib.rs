@@ -26,6 +26,7 @@
 //! | [`slam`] | per-robot occupancy grids, scan matching, map scoring and export |
 //! | [`sim`] | the fixed-step simulation and its per-robot logs |
 //! | [`render`] | tiny-skia drawing of the world, robots and sensors |
+//! | [`carmen`] | reading CARMEN laser logs (real data: FLASER, ROBOTLASER1, ODOM) |
 //! | [`rosmap`] | ROS map_server maps on disk: reading, classifying, writing |
 //! | [`merge`] | map merging: the thesis's method, the automatic one, a map-only baseline |
 //! | [`lab`] | the session the page and the CLI drive, its views and the report |
@@ -42,6 +43,7 @@
 
 pub mod bindings;
 pub mod camera;
+pub mod carmen;
 pub mod follower;
 pub mod geom;
 pub mod kinematics;

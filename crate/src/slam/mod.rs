@@ -17,6 +17,11 @@
 //! | the two mappers, online | [`mapper`] | thesis §4.3 (online SLAM) |
 //! | scoring against ground truth | [`scoring`] | Sturm et al., IROS 2012 (ATE) |
 //! | drawing and ROS map export | [`export`] | ROS `map_server` format |
+//! | tables of scans for real lasers | [`multires`] | Olson, ICRA 2009 |
+//! | pose graph, sparse least squares | [`posegraph`] | Lu & Milios 1997; Grisetti et al. 2010 |
+//! | loop closure by correlative matching | [`loop_closure`] | Konolige et al. 2010; Hess et al. 2016 |
+//! | SLAM for real laser logs | [`logslam`] | Karto / slam_toolbox, Cartographer |
+//! | relation errors against a reference | [`relations`] | Kümmerle et al., Auton. Robots 2009 |
 //!
 //! The simulation feeds every robot's [`RobotMapping`] once per step with
 //! the odometry pose and the laser scan (never the truth).
@@ -28,7 +33,13 @@ pub mod filter;
 pub mod gauss_newton;
 pub mod grid;
 pub mod likelihood;
+pub mod log_replay;
+pub mod logslam;
+pub mod loop_closure;
 pub mod mapper;
+pub mod multires;
+pub mod posegraph;
+pub mod relations;
 pub mod scoring;
 pub mod surface;
 

@@ -1,0 +1,441 @@
+//! # SLAM for real laser logs: scan-to-map matching, a pose graph, loop closures
+//!
+//! The driver that replays a CARMEN log ([`crate::carmen`]) in file order,
+//! in the manner of Karto / slam_toolbox (Konolige et al., IROS 2010) and
+//! Cartographer (Hess et al., ICRA 2016):
+//!
+//! 1. **Predict** each scan's pose from the previous one and the odometry
+//!    increment between them (`x̂_t = x_{t−1} ⊕ (u_{t−1}⁻¹ ⊕ u_t)`).
+//! 2. **Match** the scan against the local map — the points of the last
+//!    `local_keys` key scans at their current estimates — with Olson's
+//!    multi-resolution correlative search and a Gauss–Newton refinement
+//!    ([`super::multires`]). A narrow window first; if its best pose lies
+//!    on the window's edge or scores poorly, a wide window (real wheel
+//!    odometry slips: the raw MIT CSAIL log's heading jumps by 10–30°).
+//!    A scan whose best match still scores poorly keeps the prediction.
+//! 3. **Key scans** (every `key_distance_m` or `key_angle_rad` of motion)
+//!    become nodes of the pose graph ([`super::posegraph`]), linked to the
+//!    previous key by the matched relative pose (or, where no match held,
+//!    by odometry with a looser covariance). Other scans are stored relative
+//!    to their key, so they follow it when the graph moves.
+//! 4. **Loop closures** ([`super::loop_closure`]): every `loop_every` keys
+//!    the new key is matched against older keys near its estimate.
+//! 5. **Consistency**: a single match can be wrong (two alike corridors).
+//!    Following Olson's pairwise consistency idea ("Recognizing places using
+//!    spectrally clustered local matches", RAS 2009), a closure is only
+//!    accepted once a second closure found within `confirm_keys` keys
+//!    agrees with it: the cycle *old₁ → new₁ → new₂ → old₂ → old₁*, made of
+//!    the two closures and the graph's current relative poses along the two
+//!    stretches (each locally accurate), must compose to nearly the
+//!    identity. Accepted closures go into the graph, which is optimised; an
+//!    optimisation that leaves a closure badly unsatisfied (χ² over
+//!    `max_closure_chi2`) is undone.
+//!
+//! The poses are in the log's odometry frame: the first scan's pose is its
+//! odometry pose, and the graph's first node stays fixed there.
+
+use super::grid::{GridConfig, OccupancyGrid};
+use super::likelihood::LikelihoodField;
+use super::loop_closure::{find_closure, Closure, LoopConfig};
+use super::multires::{field_from_points, match_scan, ScanMatch, Window};
+use super::posegraph::{Edge, PoseGraph};
+use crate::carmen::LogScan;
+use crate::geom::{wrap_angle, Pose2};
+use glam::DVec2;
+
+/// Settings of the log SLAM.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LogSlamConfig {
+    pub resolution_m: f64,
+    /// Beams longer than this are not matched (nor drawn as walls).
+    pub match_range_m: f64,
+    /// A beam without a return clears free space this far.
+    pub free_range_m: f64,
+    /// Scan points closer than this to the previous kept one are dropped.
+    pub point_spacing_m: f64,
+    pub key_distance_m: f64,
+    pub key_angle_rad: f64,
+    pub local_keys: usize,
+    pub narrow: Window,
+    pub wide: Window,
+    /// Below this mean field value a match is not trusted.
+    pub min_match_score: f64,
+    pub close_loops: bool,
+    pub loops: LoopConfig,
+    pub loop_every: usize,
+    pub confirm_keys: usize,
+    /// Largest disagreement of two closures' cycle (m, rad).
+    pub confirm_m: f64,
+    pub confirm_rad: f64,
+    pub max_closure_chi2: f64,
+}
+
+impl Default for LogSlamConfig {
+    fn default() -> Self {
+        LogSlamConfig {
+            resolution_m: 0.05,
+            match_range_m: 20.0,
+            free_range_m: 10.0,
+            point_spacing_m: 0.1,
+            key_distance_m: 0.3,
+            key_angle_rad: 10f64.to_radians(),
+            local_keys: 20,
+            narrow: Window {
+                linear_m: 0.3,
+                angular_rad: 6f64.to_radians(),
+            },
+            wide: Window {
+                linear_m: 1.0,
+                angular_rad: 35f64.to_radians(),
+            },
+            min_match_score: 0.35,
+            close_loops: true,
+            loops: LoopConfig::default(),
+            loop_every: 2,
+            confirm_keys: 12,
+            confirm_m: 0.3,
+            confirm_rad: 3f64.to_radians(),
+            max_closure_chi2: 50.0,
+        }
+    }
+}
+
+/// Where one scan ended up: its key node and its pose relative to it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScanEntry {
+    pub index: usize,
+    pub time: f64,
+    pub odometry: Pose2,
+    pub key: usize,
+    pub relative: Pose2,
+}
+
+/// An accepted loop closure (key and scan indices, match score).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct ClosureInfo {
+    pub from_key: usize,
+    pub to_key: usize,
+    pub from_scan: usize,
+    pub to_scan: usize,
+    pub score: f64,
+}
+
+/// Counts of what the matcher did.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct LogSlamStats {
+    pub scans: usize,
+    pub keys: usize,
+    pub matched: usize,
+    pub wide_searches: usize,
+    pub unmatched: usize,
+    pub closures_tried: usize,
+    pub closures_found: usize,
+    pub closures_rejected: usize,
+}
+
+/// The SLAM state of one log replay.
+#[derive(Clone, Debug)]
+pub struct LogSlam {
+    pub config: LogSlamConfig,
+    pub graph: PoseGraph,
+    key_points: Vec<Vec<DVec2>>,
+    key_scan: Vec<usize>,
+    pub scans: Vec<ScanEntry>,
+    local: Option<LikelihoodField>,
+    last: Option<(Pose2, Pose2)>,
+    unmatched_since_key: bool,
+    pending: Vec<Closure>,
+    pub closures: Vec<ClosureInfo>,
+    pub stats: LogSlamStats,
+}
+
+/// The local match of [`LogSlam::match_local`]: the best pose and whether
+/// the wide window was searched.
+fn local_match(
+    field: &LikelihoodField,
+    cfg: &LogSlamConfig,
+    points: &[DVec2],
+    predicted: &Pose2,
+) -> (Option<ScanMatch>, bool) {
+    let on_edge = |m: &ScanMatch, w: &Window| {
+        let d = predicted.between(&m.pose);
+        d.x.abs() > w.linear_m - 2.0 * cfg.resolution_m
+            || d.y.abs() > w.linear_m - 2.0 * cfg.resolution_m
+            || d.theta.abs() > w.angular_rad - 0.5f64.to_radians()
+    };
+    let good = |m: &ScanMatch| m.score >= cfg.min_match_score;
+    let narrow = match_scan(field, points, predicted, &cfg.narrow);
+    if let Some(m) = &narrow {
+        if good(m) && !on_edge(m, &cfg.narrow) {
+            return (narrow, false);
+        }
+    }
+    let wide = match_scan(field, points, predicted, &cfg.wide);
+    let best = match (narrow, wide) {
+        (Some(a), Some(b)) => Some(if b.score > a.score { b } else { a }),
+        (a, b) => a.or(b),
+    };
+    (best.filter(good), true)
+}
+
+/// The points of a scan worth matching, in the robot frame: returns within
+/// `match_range_m`, through the laser's offset, thinned to one per
+/// `point_spacing_m` along the scan.
+pub fn scan_points(scan: &LogScan, cfg: &LogSlamConfig) -> Vec<DVec2> {
+    let mut out: Vec<DVec2> = Vec::with_capacity(scan.ranges.len());
+    let offset = scan.laser_offset.frame();
+    for (i, &r) in scan.ranges.iter().enumerate() {
+        if scan.no_return(i) || r > cfg.match_range_m {
+            continue;
+        }
+        let b = scan.bearing(i);
+        let p = offset.to_parent(DVec2::new(b.cos(), b.sin()) * r);
+        if out
+            .last()
+            .is_none_or(|q| q.distance(p) >= cfg.point_spacing_m)
+        {
+            out.push(p);
+        }
+    }
+    out
+}
+
+impl LogSlam {
+    pub fn new(config: LogSlamConfig) -> LogSlam {
+        LogSlam {
+            config,
+            graph: PoseGraph::default(),
+            key_points: Vec::new(),
+            key_scan: Vec::new(),
+            scans: Vec::new(),
+            local: None,
+            last: None,
+            unmatched_since_key: false,
+            pending: Vec::new(),
+            closures: Vec::new(),
+            stats: LogSlamStats::default(),
+        }
+    }
+
+    /// Adds the next scan of the log (file order).
+    pub fn add_scan(&mut self, scan: &LogScan) {
+        let points = scan_points(scan, &self.config);
+        self.stats.scans += 1;
+        let Some((last_pose, last_odom)) = self.last else {
+            self.add_key(scan, scan.odometry, points, None);
+            self.last = Some((scan.odometry, scan.odometry));
+            return;
+        };
+        let predicted = last_pose.compose(&last_odom.between(&scan.odometry));
+        let pose = match self.match_local(&points, &predicted) {
+            Some(m) => {
+                self.stats.matched += 1;
+                m.pose
+            }
+            None => {
+                self.stats.unmatched += 1;
+                self.unmatched_since_key = true;
+                predicted
+            }
+        };
+        let key = self.graph.nodes.len() - 1;
+        let rel = self.graph.nodes[key].between(&pose);
+        let is_key = rel.position().length() >= self.config.key_distance_m
+            || rel.theta.abs() >= self.config.key_angle_rad;
+        if is_key {
+            self.add_key(scan, pose, points, Some(key));
+        } else {
+            self.scans.push(ScanEntry {
+                index: scan.index,
+                time: scan.time,
+                odometry: scan.odometry,
+                key,
+                relative: rel,
+            });
+        }
+        let now = self.scan_pose(self.scans.len() - 1);
+        self.last = Some((now, scan.odometry));
+    }
+
+    /// The local match: narrow window, then wide if needed.
+    fn match_local(&mut self, points: &[DVec2], predicted: &Pose2) -> Option<ScanMatch> {
+        let (found, wide) = local_match(self.local.as_ref()?, &self.config, points, predicted);
+        if wide {
+            self.stats.wide_searches += 1;
+        }
+        found
+    }
+
+    fn add_key(&mut self, scan: &LogScan, pose: Pose2, points: Vec<DVec2>, prev: Option<usize>) {
+        let id = self.graph.nodes.len();
+        self.graph.nodes.push(pose);
+        if let Some(p) = prev {
+            let z = self.graph.nodes[p].between(&pose);
+            let (sm, sr) = if self.unmatched_since_key {
+                (0.3, 5f64.to_radians())
+            } else {
+                (0.05, 1f64.to_radians())
+            };
+            self.graph.edges.push(Edge::new(p, id, z, sm, sr));
+        }
+        self.unmatched_since_key = false;
+        self.key_points.push(points);
+        self.key_scan.push(scan.index);
+        self.scans.push(ScanEntry {
+            index: scan.index,
+            time: scan.time,
+            odometry: scan.odometry,
+            key: id,
+            relative: Pose2::IDENTITY,
+        });
+        self.stats.keys += 1;
+        if self.config.close_loops && id % self.config.loop_every.max(1) == 0 {
+            self.try_close(id);
+        }
+        self.rebuild_local();
+    }
+
+    /// Rasterises the last `local_keys` key scans into the local map.
+    fn rebuild_local(&mut self) {
+        let n = self.graph.nodes.len();
+        let from = n.saturating_sub(self.config.local_keys);
+        let mut world = Vec::new();
+        for k in from..n {
+            let f = self.graph.nodes[k].frame();
+            world.extend(self.key_points[k].iter().map(|&p| f.to_parent(p)));
+        }
+        self.local = Some(field_from_points(
+            &world,
+            self.config.resolution_m,
+            4,
+            self.config.wide.linear_m + 1.0,
+        ));
+    }
+
+    /// Looks for a closure of key `id`; accepts it (and a pending one) when
+    /// two agree.
+    fn try_close(&mut self, id: usize) {
+        self.stats.closures_tried += 1;
+        let Some(found) = find_closure(
+            &self.graph.nodes,
+            &self.key_points,
+            id,
+            self.config.resolution_m,
+            &self.config.loops,
+        ) else {
+            return;
+        };
+        self.stats.closures_found += 1;
+        let cfg = &self.config;
+        self.pending
+            .retain(|c| c.edge.to + cfg.confirm_keys >= id && c.edge.to != id);
+        let agreeing = self
+            .pending
+            .iter()
+            .position(|c| self.cycle_agrees(c, &found));
+        match agreeing {
+            Some(k) => {
+                let other = self.pending.remove(k);
+                self.accept(vec![other, found]);
+            }
+            None => self.pending.push(found),
+        }
+    }
+
+    /// Pairwise consistency: does the cycle through the two closures and
+    /// the graph's stretches between their ends close?
+    fn cycle_agrees(&self, a: &Closure, b: &Closure) -> bool {
+        let n = &self.graph.nodes;
+        // old_a → new_a (closure a), new_a → new_b (graph), new_b → old_b
+        // (closure b inverted), old_b → old_a (graph).
+        let cycle = a
+            .edge
+            .measurement
+            .compose(&n[a.edge.to].between(&n[b.edge.to]))
+            .compose(&b.edge.measurement.inverse())
+            .compose(&n[b.edge.from].between(&n[a.edge.from]));
+        cycle.position().length() <= self.config.confirm_m
+            && cycle.theta.abs() <= self.config.confirm_rad
+    }
+
+    /// Adds confirmed closures, optimises, and undoes it all if a closure
+    /// stays badly unsatisfied.
+    fn accept(&mut self, closures: Vec<Closure>) {
+        let saved_nodes = self.graph.nodes.clone();
+        let saved_edges = self.graph.edges.len();
+        for c in &closures {
+            self.graph.edges.push(c.edge.clone());
+        }
+        let ok = self.graph.optimise(10).is_ok()
+            && closures
+                .iter()
+                .all(|c| self.graph.chi2(&c.edge) <= self.config.max_closure_chi2);
+        if !ok {
+            self.graph.nodes = saved_nodes;
+            self.graph.edges.truncate(saved_edges);
+            self.stats.closures_rejected += closures.len();
+            return;
+        }
+        for c in closures {
+            self.closures.push(ClosureInfo {
+                from_key: c.edge.from,
+                to_key: c.edge.to,
+                from_scan: self.key_scan[c.edge.from],
+                to_scan: self.key_scan[c.edge.to],
+                score: c.score,
+            });
+        }
+        // The last scan's pose moved with its key.
+        if let Some((_, odom)) = self.last {
+            let now = self.scan_pose(self.scans.len() - 1);
+            self.last = Some((now, odom));
+        }
+    }
+
+    /// Final optimisation (the graph is already optimised after each
+    /// accepted closure; this settles it).
+    pub fn finish(&mut self) -> Result<(), String> {
+        if self.closures.is_empty() {
+            return Ok(());
+        }
+        self.graph.optimise(20).map(|_| ())
+    }
+
+    /// The current estimate of scan `k` (position in [`LogSlam::scans`]).
+    pub fn scan_pose(&self, k: usize) -> Pose2 {
+        let s = &self.scans[k];
+        self.graph.nodes[s.key].compose(&s.relative)
+    }
+
+    /// Every scan's current estimate, in the order added.
+    pub fn poses(&self) -> Vec<Pose2> {
+        (0..self.scans.len()).map(|k| self.scan_pose(k)).collect()
+    }
+
+    /// Draws the occupancy grid of `scans` (the same scans, in the same
+    /// order, as were added) at the current estimates.
+    pub fn build_map(&self, scans: &[LogScan]) -> OccupancyGrid {
+        let mut grid = OccupancyGrid::new(GridConfig {
+            resolution_m: self.config.resolution_m,
+            max_cells: 1 << 24,
+            ..GridConfig::default()
+        });
+        let reach = self.config.match_range_m.max(self.config.free_range_m);
+        for (k, scan) in scans.iter().enumerate().take(self.scans.len()) {
+            let pose = self.scan_pose(k);
+            let c = pose.position();
+            grid.ensure_contains(c - reach, c + reach);
+            let laser = pose.compose(&scan.laser_offset);
+            let from = laser.position();
+            for (i, &r) in scan.ranges.iter().enumerate() {
+                let dir = DVec2::from_angle(wrap_angle(laser.theta + scan.bearing(i)));
+                if scan.no_return(i) || r > self.config.match_range_m {
+                    grid.integrate_beam(from, from + dir * self.config.free_range_m, false);
+                } else {
+                    grid.integrate_beam(from, from + dir * r, true);
+                }
+            }
+        }
+        grid
+    }
+}

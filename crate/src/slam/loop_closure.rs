@@ -1,0 +1,112 @@
+//! # Loop closure: matching a scan against an older part of the map
+//!
+//! Scan-to-map matching against the last few key scans keeps a trajectory
+//! locally straight, but its small errors add up: after a tour of a
+//! building the robot comes back to a corridor it mapped long ago with its
+//! estimate off by a metre and a few degrees, and mapping on would draw the
+//! corridor twice. A *loop closure* notices the return and says how the new
+//! scan lies relative to the old ones; the pose graph ([`super::posegraph`])
+//! then spreads the accumulated error over the whole loop.
+//!
+//! This follows Karto / slam_toolbox (Konolige et al., "Efficient sparse pose
+//! adjustment for 2D mapping", IROS 2010) and Cartographer (Hess, Kohler,
+//! Rapp, Andor, "Real-time loop closure in 2D LIDAR SLAM", ICRA 2016):
+//!
+//! 1. **Candidates**: key scans older than the local map (at least
+//!    `min_key_gap` keys back) whose estimated position lies within
+//!    `search_radius_m` of the new key scan's. The nearest one is the centre
+//!    of the candidate region.
+//! 2. **Match**: the key scans around that centre (`submap_half` either side,
+//!    consecutive, so they are consistent among themselves) are rasterised
+//!    into Olson's tables ([`super::multires`]), and the new scan is searched
+//!    in a wide window (`window`) around its current estimate: wide enough
+//!    for the drift since, exact thanks to branch and bound.
+//! 3. **Accept**: only a match whose mean field value reaches `min_score`
+//!    (most points on mapped walls) becomes an edge; the driver
+//!    ([`super::logslam`]) then optimises the graph and keeps the edge only if
+//!    the result is consistent (see there).
+
+use super::multires::{field_from_points, match_scan, Window};
+use super::posegraph::Edge;
+use crate::geom::Pose2;
+use glam::DVec2;
+
+/// Settings of the loop-closure search.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoopConfig {
+    pub search_radius_m: f64,
+    pub min_key_gap: usize,
+    pub submap_half: usize,
+    pub window: Window,
+    pub min_score: f64,
+    /// Standard deviations given to an accepted closure's edge.
+    pub sigma_m: f64,
+    pub sigma_rad: f64,
+}
+
+impl Default for LoopConfig {
+    fn default() -> Self {
+        LoopConfig {
+            search_radius_m: 4.0,
+            min_key_gap: 40,
+            submap_half: 6,
+            window: Window {
+                linear_m: 1.5,
+                angular_rad: 12f64.to_radians(),
+            },
+            min_score: 0.55,
+            sigma_m: 0.05,
+            sigma_rad: 1f64.to_radians(),
+        }
+    }
+}
+
+/// A loop closure found: the edge and its match score.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Closure {
+    pub edge: Edge,
+    pub score: f64,
+}
+
+/// Looks for a closure of key `i` (pose `nodes[i]`, points `key_points[i]`
+/// in its robot frame) against the older keys.
+pub fn find_closure(
+    nodes: &[Pose2],
+    key_points: &[Vec<DVec2>],
+    i: usize,
+    resolution_m: f64,
+    cfg: &LoopConfig,
+) -> Option<Closure> {
+    if i < cfg.min_key_gap {
+        return None;
+    }
+    let here = nodes[i].position();
+    let (centre, _) = (0..=i - cfg.min_key_gap)
+        .map(|j| (j, nodes[j].position().distance(here)))
+        .filter(|&(_, d)| d <= cfg.search_radius_m)
+        .min_by(|a, b| a.1.total_cmp(&b.1))?;
+    let lo = centre.saturating_sub(cfg.submap_half);
+    let hi = (centre + cfg.submap_half).min(i - cfg.min_key_gap);
+    let mut world = Vec::new();
+    for j in lo..=hi {
+        let f = nodes[j].frame();
+        world.extend(key_points[j].iter().map(|&p| f.to_parent(p)));
+    }
+    let field = field_from_points(&world, resolution_m, 8, cfg.window.linear_m + 1.0);
+    let m = match_scan(&field, &key_points[i], &nodes[i], &cfg.window)?;
+    if m.score < cfg.min_score {
+        return None;
+    }
+    let mut edge = Edge::new(
+        centre,
+        i,
+        nodes[centre].between(&m.pose),
+        cfg.sigma_m,
+        cfg.sigma_rad,
+    );
+    edge.loop_closure = true;
+    Some(Closure {
+        edge,
+        score: m.score,
+    })
+}

@@ -1,0 +1,178 @@
+//! The CARMEN log reader on hand-written logs: FLASER geometry and the
+//! no-return value, ROBOTLASER1's own geometry and laser offset, RAWLASER1
+//! odometry interpolated from ODOM records, gzip, skipped records counted,
+//! and malformed lines refused with their line number.
+
+use slamlab::carmen::{parse_bytes, parse_str};
+use std::f64::consts::{FRAC_PI_2, PI};
+use std::io::Write;
+use wasm_bindgen_test::wasm_bindgen_test;
+
+fn flaser(ranges: &[f64], pose: [f64; 3], odom: [f64; 3], t: f64) -> String {
+    let r: Vec<String> = ranges.iter().map(|v| v.to_string()).collect();
+    format!(
+        "FLASER {} {} {} {} {} {} {} {} {t} host {t}",
+        ranges.len(),
+        r.join(" "),
+        pose[0],
+        pose[1],
+        pose[2],
+        odom[0],
+        odom[1],
+        odom[2]
+    )
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn flaser_geometry_poses_and_no_return() {
+    let text = [
+        "# a comment".to_string(),
+        "PARAM robot_frontlaser_offset 0.0 nohost 0".into(),
+        flaser(&[1.0, 2.0, 81.91], [1.0, 2.0, 0.5], [1.5, 2.5, 0.25], 10.0),
+        "NEFF 30".into(),
+        flaser(&[3.0, 81.91, 0.0, 4.0], [0.0; 3], [0.0; 3], 11.0),
+        "RLASER 2 1 1 0 0 0 0 0 0 12 host 12".into(),
+    ]
+    .join("\n");
+    let log = parse_str(&text).unwrap();
+    assert_eq!(log.scans.len(), 2);
+    let a = &log.scans[0];
+    assert_eq!((a.index, a.line, a.time), (0, 3, 10.0));
+    assert_eq!(a.ranges, vec![1.0, 2.0, 81.91]);
+    // Odd count: beams at both ends, 90° apart for 3 beams.
+    assert!((a.bearing(0) + FRAC_PI_2).abs() < 1e-12);
+    assert!((a.bearing(2) - FRAC_PI_2).abs() < 1e-12);
+    assert_eq!(a.logged_pose.unwrap().x, 1.0);
+    assert_eq!(
+        (a.odometry.x, a.odometry.y, a.odometry.theta),
+        (1.5, 2.5, 0.25)
+    );
+    // The log's largest range is the no-return value; zero is no return too.
+    assert!((a.max_range - 81.91).abs() < 1e-12);
+    assert_eq!(
+        (0..3).map(|i| a.no_return(i)).collect::<Vec<_>>(),
+        vec![false, false, true]
+    );
+    let b = &log.scans[1];
+    // Even count: 180° / n steps from −90°.
+    assert!((b.angle_step - PI / 4.0).abs() < 1e-12);
+    assert_eq!(
+        (0..4).map(|i| b.no_return(i)).collect::<Vec<_>>(),
+        vec![false, true, true, false]
+    );
+    assert_eq!(
+        log.params,
+        vec![("robot_frontlaser_offset".into(), "0.0".into())]
+    );
+    assert_eq!(
+        log.skipped,
+        vec![
+            ("comment".into(), 1),
+            ("NEFF".into(), 1),
+            ("RLASER".into(), 1)
+        ]
+    );
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn robotlaser1_geometry_and_laser_offset() {
+    // type start fov res maxrange accuracy remission n r.. m e.. laser pose, robot pose,
+    // tv rv fwd side turn ts host ts
+    let line = "ROBOTLASER1 0 -1.0 2.0 0.5 30.0 0.01 0 5 1 2 3 30 5 2 7 7 \
+                1.2 3.0 0.6 1.0 3.0 0.5 0 0 0 0 0 99.5 host 99.5";
+    let log = parse_str(line).unwrap();
+    let s = &log.scans[0];
+    assert_eq!(s.ranges, vec![1.0, 2.0, 3.0, 30.0, 5.0]);
+    assert_eq!(
+        (s.start_angle, s.angle_step, s.max_range),
+        (-1.0, 0.5, 30.0)
+    );
+    assert!((s.bearing(4) - 1.0).abs() < 1e-12);
+    assert!(s.no_return(3) && !s.no_return(4));
+    assert_eq!(
+        (s.odometry.x, s.odometry.y, s.odometry.theta),
+        (1.0, 3.0, 0.5)
+    );
+    assert_eq!(s.time, 99.5);
+    // Laser at (1.2, 3.0, 0.6) seen from the robot at (1, 3, 0.5), facing 0.5 rad:
+    // 0.2 m along x of the world is (0.2 cos 0.5, −0.2 sin 0.5) in the robot frame.
+    let o = s.laser_offset;
+    assert!((o.x - 0.2 * 0.5f64.cos()).abs() < 1e-12);
+    assert!((o.y + 0.2 * 0.5f64.sin()).abs() < 1e-12);
+    assert!((o.theta - 0.1).abs() < 1e-12);
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn rawlaser1_odometry_interpolated_between_odom_records() {
+    let text = "ODOM 0 0 0 0 0 0 10.0 host 10.0\n\
+                RAWLASER1 0 -1.5708 3.1416 1.5708 20 0.01 0 3 1 2 3 0 12.5 host 12.5\n\
+                ODOM 2 4 1.0 0 0 0 20.0 host 20.0\n\
+                RAWLASER1 0 -1.5708 3.1416 1.5708 20 0.01 0 3 1 2 3 0 25.0 host 25.0\n";
+    let log = parse_str(text).unwrap();
+    assert_eq!(log.odometry_records, 2);
+    let a = log.scans[0].odometry;
+    // A quarter of the way from 10 s to 20 s.
+    assert!((a.x - 0.5).abs() < 1e-12 && (a.y - 1.0).abs() < 1e-12);
+    assert!((a.theta - 0.25).abs() < 1e-12);
+    // After the last ODOM: that one.
+    let b = log.scans[1].odometry;
+    assert_eq!((b.x, b.y, b.theta), (2.0, 4.0, 1.0));
+    assert!(log.scans[0].logged_pose.is_none());
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn gzip_compressed_logs_read_like_plain_ones() {
+    let text = format!(
+        "{}\n{}\n",
+        flaser(&[1.0, 2.0, 3.0], [0.0; 3], [0.0; 3], 1.0),
+        flaser(&[1.5, 2.5, 3.5], [0.1, 0.0, 0.0], [0.1, 0.0, 0.0], 2.0)
+    );
+    let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+    gz.write_all(text.as_bytes()).unwrap();
+    let bytes = gz.finish().unwrap();
+    assert_eq!(&bytes[..2], &[0x1f, 0x8b]);
+    assert_eq!(parse_bytes(&bytes).unwrap(), parse_str(&text).unwrap());
+    // A cut-off gzip stream is an error, not a shorter log.
+    let e = parse_bytes(&bytes[..bytes.len() - 12]).unwrap_err();
+    assert!(e.to_string().contains("gzip"), "{e}");
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn bad_and_truncated_lines_name_their_line() {
+    let good = flaser(&[1.0, 2.0, 3.0], [0.0; 3], [0.0; 3], 1.0);
+    let cases = [
+        // Fewer ranges than announced (cut off mid-line).
+        (format!("{good}\nFLASER 3 1.0 2.0"), 2, "truncated"),
+        // A range that is not a number.
+        (
+            format!("# c\n{good}\n{}", good.replace("2 3", "2 x")),
+            3,
+            "not a number",
+        ),
+        // The beam count is not a count.
+        (format!("{good}\nFLASER three 1 2 3"), 2, "not a beam count"),
+        // The odometry pose is missing.
+        ("FLASER 3 1 2 3 0 0 0".to_string(), 1, "truncated"),
+        // ODOM without its timestamp.
+        (format!("{good}\n\nODOM 1 2 3"), 3, "truncated"),
+        // ROBOTLASER1 whose field of view does not fit its beams.
+        (
+            "ROBOTLASER1 0 -1.0 2.0 0.1 30.0 0.01 0 3 1 2 3 0 0 0 0 0 0 0 0 0 0 0 0 1 h 1"
+                .to_string(),
+            1,
+            "field of view",
+        ),
+        // A laser-free log.
+        ("ODOM 0 0 0 0 0 0 1 h 1".to_string(), 0, "no laser records"),
+    ];
+    for (text, line, words) in cases {
+        let e = parse_str(&text).unwrap_err();
+        assert_eq!(e.line, line, "{text:?}: {e}");
+        assert!(e.to_string().contains(words), "{e}");
+        if line > 0 {
+            assert!(e.to_string().starts_with(&format!("line {line}:")), "{e}");
+        }
+    }
+    let e = parse_bytes(b"FLASER 1 \xff\xfe").unwrap_err();
+    assert_eq!(e.line, 1);
+}

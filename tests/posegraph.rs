@@ -1,0 +1,167 @@
+//! The pose graph against hand-computed solutions, the relation-error
+//! scoring and the drifting odometry's model.
+
+use slamlab::geom::Pose2;
+use slamlab::slam::posegraph::{Edge, PoseGraph};
+use slamlab::slam::relations::{drift_odometry, relation_errors, DriftModel};
+use std::f64::consts::FRAC_PI_2;
+use wasm_bindgen_test::wasm_bindgen_test;
+
+fn close(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn a_corridor_loop_spreads_its_error_evenly() {
+    // Three steps of 1 m measured, and a closure saying the end is 2.7 m
+    // from the start: all four edges alike, so each takes a quarter of the
+    // 0.3 m disagreement. By hand: x1 = 0.925, x2 = 1.85, x3 = 2.775.
+    let mut g = PoseGraph {
+        nodes: vec![
+            Pose2::IDENTITY,
+            Pose2::new(1.0, 0.0, 0.0),
+            Pose2::new(2.0, 0.0, 0.0),
+            Pose2::new(3.0, 0.0, 0.0),
+        ],
+        edges: vec![],
+    };
+    for i in 0..3 {
+        g.edges
+            .push(Edge::new(i, i + 1, Pose2::new(1.0, 0.0, 0.0), 0.1, 0.01));
+    }
+    g.edges
+        .push(Edge::new(0, 3, Pose2::new(2.7, 0.0, 0.0), 0.1, 0.01));
+    g.optimise(10).unwrap();
+    for (k, x) in [0.0, 0.925, 1.85, 2.775].into_iter().enumerate() {
+        let p = g.nodes[k];
+        assert!(
+            close(p.x, x, 1e-9) && close(p.y, 0.0, 1e-9),
+            "node {k}: {p:?}"
+        );
+        assert!(close(p.theta, 0.0, 1e-9));
+    }
+    // Each edge is off by 0.075 m at σ = 0.1 m: χ² = 4 · 0.5625.
+    assert!(close(g.total_chi2(), 2.25, 1e-9), "{}", g.total_chi2());
+}
+
+fn square_truth() -> Vec<Pose2> {
+    vec![
+        Pose2::new(0.0, 0.0, 0.0),
+        Pose2::new(2.0, 0.0, FRAC_PI_2),
+        Pose2::new(2.0, 2.0, 2.0 * FRAC_PI_2),
+        Pose2::new(0.0, 2.0, -FRAC_PI_2),
+    ]
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn a_square_loop_with_a_closure_comes_back_to_the_square() {
+    // Exact measurements of a 2 m square (turning left at each corner) and
+    // the closure from the last corner back to the first; the start guess is
+    // dead reckoning with a heading error of 10° per corner.
+    let truth = square_truth();
+    let step = Pose2::new(2.0, 0.0, FRAC_PI_2);
+    let mut guess = vec![Pose2::IDENTITY];
+    for k in 1..4 {
+        let bent = Pose2::new(2.0, 0.0, FRAC_PI_2 + 10f64.to_radians());
+        guess.push(guess[k - 1].compose(&bent));
+    }
+    let mut g = PoseGraph {
+        nodes: guess,
+        edges: vec![],
+    };
+    for i in 0..3 {
+        g.edges.push(Edge::new(i, i + 1, step, 0.05, 0.02));
+    }
+    g.edges.push(Edge::new(3, 0, step, 0.05, 0.02));
+    let steps = g.optimise(20).unwrap();
+    assert!(steps < 20, "Gauss–Newton should converge");
+    for (p, t) in g.nodes.iter().zip(&truth) {
+        assert!(p.position().distance(t.position()) < 1e-7, "{p:?} vs {t:?}");
+        assert!(slamlab::geom::wrap_angle(p.theta - t.theta).abs() < 1e-7);
+    }
+    assert!(g.total_chi2() < 1e-10);
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn a_closure_pulls_drifted_poses_back_and_node_zero_stays() {
+    // Odometry edges measured 5 % long around the square, a closure that
+    // is exact and much more certain: the optimum honours the closure, the
+    // total disagreement drops, and node 0 does not move.
+    let truth = square_truth();
+    let long = Pose2::new(2.1, 0.0, FRAC_PI_2);
+    let mut g = PoseGraph {
+        nodes: vec![Pose2::IDENTITY],
+        edges: vec![],
+    };
+    for k in 1..4 {
+        let p = g.nodes[k - 1].compose(&long);
+        g.nodes.push(p);
+        g.edges.push(Edge::new(k - 1, k, long, 0.1, 0.01));
+    }
+    let mut closure = Edge::new(3, 0, Pose2::new(2.0, 0.0, FRAC_PI_2), 0.001, 0.001);
+    closure.loop_closure = true;
+    g.edges.push(closure);
+    let before = g.total_chi2();
+    assert!(close(
+        g.nodes[3].position().distance(truth[3].position()),
+        0.1,
+        1e-9
+    ));
+    g.optimise(20).unwrap();
+    assert_eq!(g.nodes[0], Pose2::IDENTITY);
+    assert!(
+        g.total_chi2() < before / 10.0,
+        "{before} -> {}",
+        g.total_chi2()
+    );
+    // The closure holds: node 0 seen from node 3 is where it said.
+    let seen = g.nodes[3].between(&g.nodes[0]);
+    assert!(close(seen.x, 2.0, 0.01) && close(seen.y, 0.0, 0.01));
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn relation_errors_by_hand() {
+    // Estimate = reference with node 2 shifted 0.1 m sideways: relations
+    // (1,2) and (2,3) are off by 0.1 m, (0,1) not at all.
+    let reference: Vec<Pose2> = (0..4).map(|i| Pose2::new(i as f64, 0.0, 0.0)).collect();
+    let mut est = reference.clone();
+    est[2].y = 0.1;
+    let e = relation_errors(&est, &reference, 10, 3);
+    assert_eq!(e[0].pairs_of, "k=1");
+    assert_eq!(e[0].pairs, 3);
+    assert!(close(e[0].trans_m, 0.2 / 3.0, 1e-12));
+    assert!(close(e[0].rot_deg, 0.0, 1e-12));
+    let all = e.last().unwrap();
+    assert_eq!(all.pairs_of, "all");
+    // A perfect estimate scores zero everywhere.
+    for r in relation_errors(&reference, &reference, 10, 3) {
+        assert_eq!((r.trans_m, r.rot_deg), (0.0, 0.0));
+    }
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn drifting_odometry_follows_its_model() {
+    // A straight 100 m drive in 0.5 m steps: with only the bias switched
+    // on, the heading turns by exactly bias · distance.
+    let reference: Vec<Pose2> = (0..=200)
+        .map(|i| Pose2::new(0.5 * i as f64, 0.0, 0.0))
+        .collect();
+    let bias_only = DriftModel {
+        trans_per_m: 0.0,
+        rot_per_rad: 0.0,
+        heading_per_m: 0.0,
+        bias_rad_per_m: 0.001,
+    };
+    let o = drift_odometry(&reference, &bias_only, 1);
+    assert!(close(o[200].theta, 0.1, 1e-9), "{:?}", o[200]);
+    // Noise is seeded: the same seed, the same odometry; another, another.
+    let m = DriftModel::default();
+    assert_eq!(
+        drift_odometry(&reference, &m, 5),
+        drift_odometry(&reference, &m, 5)
+    );
+    assert_ne!(
+        drift_odometry(&reference, &m, 5),
+        drift_odometry(&reference, &m, 6)
+    );
+}

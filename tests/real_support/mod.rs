@@ -1,0 +1,142 @@
+//! Shared by the real-data log tests (`tests/real_logs.rs`) and the
+//! benchmark example (`crate/examples/log_relations.rs`): locating the data,
+//! replaying a log through the log SLAM, scoring it by relation errors.
+#![allow(dead_code)]
+
+use slamlab::carmen::{parse_bytes, CarmenLog};
+use slamlab::geom::Pose2;
+use slamlab::slam::logslam::{LogSlam, LogSlamConfig};
+use slamlab::slam::relations::{drift_odometry, relation_errors, DriftModel, RelationErrors};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// `$SLAMLAB_DATA`, else `<repo>/../shared/data`; panics when missing.
+pub fn data_dir() -> PathBuf {
+    let dir = match std::env::var_os("SLAMLAB_DATA") {
+        Some(d) => PathBuf::from(d),
+        None => PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/data"),
+    };
+    assert!(
+        dir.join("carmen").is_dir(),
+        "real data not found: {} has no carmen/ (set SLAMLAB_DATA to the shared data folder)",
+        dir.display()
+    );
+    dir
+}
+
+pub fn load(name: &str) -> CarmenLog {
+    let path = data_dir().join("carmen").join(name);
+    let bytes =
+        std::fs::read(&path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
+    parse_bytes(&bytes).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+/// One evaluated replay.
+pub struct Outcome {
+    pub ours: Vec<RelationErrors>,
+    pub odometry: Vec<RelationErrors>,
+    pub seconds: f64,
+    pub scans: usize,
+    pub closures: usize,
+    pub slam: LogSlam,
+}
+
+/// Replays `log` (its odometry replaced by `odometry` when given) and
+/// returns every scan's final pose and the SLAM.
+pub fn replay(log: &CarmenLog, odometry: Option<&[Pose2]>) -> (Vec<Pose2>, LogSlam, f64) {
+    let t0 = Instant::now();
+    let mut slam = LogSlam::new(LogSlamConfig::default());
+    for (k, scan) in log.scans.iter().enumerate() {
+        match odometry {
+            Some(o) => {
+                let mut s = scan.clone();
+                s.odometry = o[k];
+                slam.add_scan(&s);
+            }
+            None => slam.add_scan(scan),
+        }
+    }
+    slam.finish().expect("pose graph");
+    let seconds = t0.elapsed().as_secs_f64();
+    (slam.poses(), slam, seconds)
+}
+
+/// The seed of the drifting odometry in every figure.
+pub const DRIFT_SEED: u64 = 21;
+/// Random far pairs per evaluation.
+pub const RANDOM_PAIRS: usize = 1000;
+
+/// A corrected log: its poses are the reference; odometry drifted from them.
+pub fn corrected(name: &str) -> Outcome {
+    let log = load(name);
+    let reference: Vec<Pose2> = log
+        .scans
+        .iter()
+        .map(|s| s.logged_pose.expect("FLASER pose"))
+        .collect();
+    let odom = drift_odometry(&reference, &DriftModel::default(), DRIFT_SEED);
+    let (est, slam, seconds) = replay(&log, Some(&odom));
+    Outcome {
+        ours: relation_errors(&est, &reference, RANDOM_PAIRS, 1),
+        odometry: relation_errors(&odom, &reference, RANDOM_PAIRS, 1),
+        seconds,
+        scans: log.scans.len(),
+        closures: slam.closures.len(),
+        slam,
+    }
+}
+
+/// The raw MIT CSAIL log against GMapping's poses for 406 of its scans.
+pub fn csail_raw() -> (Outcome, f64) {
+    let log = load("mit-csail.clf.gz");
+    let path = data_dir().join("carmen/mit-csail_gmapping_reference.txt");
+    let text = std::fs::read_to_string(&path).expect("reference file");
+    let mut idx = Vec::new();
+    let mut reference = Vec::new();
+    for line in text
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
+    {
+        let f: Vec<f64> = line
+            .split_whitespace()
+            .map(|v| v.parse().expect("number"))
+            .collect();
+        idx.push(f[0] as usize);
+        reference.push(Pose2::new(f[5], f[6], f[7]));
+    }
+    let (est, slam, seconds) = replay(&log, None);
+    let ours: Vec<Pose2> = idx.iter().map(|&i| est[i]).collect();
+    let odom: Vec<Pose2> = idx.iter().map(|&i| log.scans[i].odometry).collect();
+    let recorded = log.scans.last().unwrap().time - log.scans[0].time;
+    (
+        Outcome {
+            ours: relation_errors(&ours, &reference, RANDOM_PAIRS, 1),
+            odometry: relation_errors(&odom, &reference, RANDOM_PAIRS, 1),
+            seconds,
+            scans: log.scans.len(),
+            closures: slam.closures.len(),
+            slam,
+        },
+        recorded,
+    )
+}
+
+/// The pooled ("all") errors of a list.
+pub fn pooled(e: &[RelationErrors]) -> &RelationErrors {
+    e.last().expect("relation errors")
+}
+
+pub fn table(name: &str, o: &Outcome) -> String {
+    let mut s = format!(
+        "{name}: {} scans, {} keys, {} loop closures ({} rejected), {:.2} s\n",
+        o.scans, o.slam.stats.keys, o.closures, o.slam.stats.closures_rejected, o.seconds
+    );
+    s += "  pairs      ours m / deg        odometry m / deg\n";
+    for (a, b) in o.ours.iter().zip(&o.odometry) {
+        s += &format!(
+            "  {:8} {:7.3} / {:6.2}     {:7.3} / {:6.2}   ({} pairs)\n",
+            a.pairs_of, a.trans_m, a.rot_deg, b.trans_m, b.rot_deg, a.pairs
+        );
+    }
+    s
+}
