@@ -11,7 +11,7 @@ and prints one table row per pair: verdict and error against the truth (laser pa
 expect.json; Halmstad KPT4A: the fit_reference.py transform), plus the time of a merge
 of two 2000 x 2000 maps in node (two laser maps padded with unknown).
 
-Needs: python3 with numpy and opencv-python-headless (pip install numpy opencv-python-headless),
+Needs: python3 with numpy and OpenCV 4 (pip install numpy "opencv-python-headless<5": OpenCV 5 dropped AKAZE from the wheel),
 node, and ./build.sh build. Usage: python3 tests/bench/maps_merge.py [--skip-halmstad]
 """
 import json

@@ -67,8 +67,8 @@ async function mergeMaps(argv, wasm) {
   const t0 = performance.now();
   const merger = new wasm.MapMerge();
   for (const file of positional) {
-    await addMap(merger, file, wasm);
-    const info = JSON.parse(merger.mapInfoJson(positional.indexOf(file)));
+    const index = await addMap(merger, file, wasm);
+    const info = JSON.parse(merger.mapInfoJson(index));
     process.stderr.write(`read ${file}: ${info.width} x ${info.height} cells at ${info.resolution} m\n`);
   }
   const tRead = performance.now();

@@ -29,7 +29,7 @@
 //! 2. **agreement dominates**: the acceptance index of the two directions
 //!    pooled is at least `min_index`;
 //! 3. **a clear winner**: overlays are ranked by their *net support*,
-//!    agreeing wall minus twice the disagreeing wall (metres), and every
+//!    agreeing wall minus disagreeing wall (metres), and every
 //!    *different* overlay the search found (its transform moves B's walls
 //!    by `distinct_m` or turns them by `distinct_rad`) has at most
 //!    `1 / min_margin` of the winner's net support. A symmetric building turned by 180° lies on itself in part,
@@ -56,7 +56,7 @@ pub struct EvidenceConfig {
     pub min_index: f64,
     pub min_margin: f64,
     /// What a disagreeing wall point costs in the net support, in
-    /// agreeing points. Default 2.
+    /// agreeing points. Default 1 (the figures in BENCHMARKS.md).
     pub disagree_weight: f64,
     pub distinct_m: f64,
     pub distinct_rad: f64,
@@ -70,7 +70,7 @@ impl Default for EvidenceConfig {
             min_agree_m: 20.0,
             min_index: 0.7,
             min_margin: 1.5,
-            disagree_weight: 2.0,
+            disagree_weight: 1.0,
             distinct_m: 1.0,
             distinct_rad: 3f64.to_radians(),
         }
@@ -130,8 +130,8 @@ pub fn evidence(a: &WallMap, b: &WallMap, pose: &Pose2, cfg: &EvidenceConfig) ->
             0.0
         },
         support_m: 0.5
-            * ((ba[0] as f64 - ba[2] as f64) * b.resolution
-                + (ab[0] as f64 - ab[2] as f64) * a.resolution),
+            * ((ba[0] as f64 - cfg.disagree_weight * ba[2] as f64) * b.resolution
+                + (ab[0] as f64 - cfg.disagree_weight * ab[2] as f64) * a.resolution),
     }
 }
 
