@@ -289,7 +289,7 @@ impl LogSlam {
             relative: Pose2::IDENTITY,
         });
         self.stats.keys += 1;
-        if self.config.close_loops && id % self.config.loop_every.max(1) == 0 {
+        if self.config.close_loops && id.is_multiple_of(self.config.loop_every.max(1)) {
             self.try_close(id);
         }
         self.rebuild_local();

@@ -9,9 +9,9 @@
 //! Scan Matching*, ICRA 2009):
 //!
 //! 1. every point marks its cell (the "rasterised" scans, §III-B);
-//! 2. a Gaussian blur of one cell turns marks into a likelihood field, so a
-//!    point a cell off a wall still scores (the same field as
-//!    [`super::likelihood`] builds from a grid);
+//! 2. each mark spreads to the cells within two of it with weight
+//!    `exp(−d² / 2)` (d in cells; the maximum where marks overlap, as in
+//!    Olson's rasterised table), so a point a cell off a wall still scores;
 //! 3. the low-resolution table holds the maximum of each `k × k` block of
 //!    the fine one (§IV), so the search over translations can skip whole
 //!    blocks whose bound cannot beat the best pose found: the answer is the
@@ -82,8 +82,9 @@ pub fn field_from_points(
     }
 }
 
-/// Separable Gaussian blur, σ = 1 cell, radius 2, peak 1 (a point's own
-/// cell scores 1, as a confident wall does in the grid's field).
+/// Spreads marks by a separable Gaussian of σ = 1 cell, radius 2, taking
+/// the maximum where spreads overlap: a point's own cell scores 1, as a
+/// confident wall does in the grid's field.
 fn blur(raw: &[f32], width: usize, height: usize) -> Vec<f32> {
     let mut rows = vec![0f32; width * height];
     for y in 0..height {
