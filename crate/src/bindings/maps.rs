@@ -7,9 +7,9 @@
 //! converting layer: every error is a `JsError` whose message names the
 //! file and the field.
 
+use super::convert::js_err as err;
 use crate::merge::offline::{merge_all, OfflineConfig, OfflineMerge};
 use crate::rosmap::{self, write::MergedMap, MapYaml, RosMap};
-use super::convert::js_err as err;
 use wasm_bindgen::prelude::*;
 
 /// Saved maps and, after `merge`, the result.
