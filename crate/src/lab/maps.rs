@@ -80,18 +80,9 @@ pub fn figures(sim: &Simulation, robot: &RobotSim) -> SlamFigures {
     }
 }
 
-/// Map metadata for the page.
-#[derive(Serialize)]
-pub struct MapInfo {
-    pub width: usize,
-    pub height: usize,
-    pub resolution_m: f64,
-    /// Lower-left corner of cell (0, 0) in the robot's odometry frame.
-    pub origin_m: [f64; 2],
-    pub occupied_cells: usize,
-    pub scans: u64,
-    pub dropped_updates: u64,
-}
+/// Map metadata for the page (defined beside the grids, which the log
+/// replay reports too).
+pub use crate::slam::export::MapInfo;
 
 /// Position error over time for the page's plot: every `stride`-th step,
 /// `[t, slam_error_m, odometry_error_m]`.
@@ -156,17 +147,7 @@ impl Lab {
     }
 
     pub fn map_info(&self, robot: usize, which: MapperKind) -> Result<MapInfo, String> {
-        let g = self.robot_map(robot, which)?;
-        let o = g.origin_m();
-        Ok(MapInfo {
-            width: g.width(),
-            height: g.height(),
-            resolution_m: g.resolution_m(),
-            origin_m: [o.x, o.y],
-            occupied_cells: g.occupied_count(),
-            scans: g.scans(),
-            dropped_updates: g.dropped_updates(),
-        })
+        Ok(MapInfo::of(self.robot_map(robot, which)?))
     }
 
     pub fn slam_figures(&self, robot: usize) -> Result<SlamFigures, String> {

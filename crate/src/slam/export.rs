@@ -221,3 +221,33 @@ fn paint(rgba: [u8; 4]) -> tiny_skia::Paint<'static> {
     p.anti_alias = true;
     p
 }
+
+/// A grid's size and place, as the page and the reports show them.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct MapInfo {
+    pub width: usize,
+    pub height: usize,
+    pub resolution_m: f64,
+    /// Lower-left corner of cell (0, 0) in the map's frame (the robot's
+    /// odometry frame).
+    pub origin_m: [f64; 2],
+    pub occupied_cells: usize,
+    pub scans: u64,
+    pub dropped_updates: u64,
+}
+
+impl MapInfo {
+    /// The figures of `grid`.
+    pub fn of(grid: &OccupancyGrid) -> MapInfo {
+        let o = grid.origin_m();
+        MapInfo {
+            width: grid.width(),
+            height: grid.height(),
+            resolution_m: grid.resolution_m(),
+            origin_m: [o.x, o.y],
+            occupied_cells: grid.occupied_count(),
+            scans: grid.scans(),
+            dropped_updates: grid.dropped_updates(),
+        }
+    }
+}

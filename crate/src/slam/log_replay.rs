@@ -7,8 +7,8 @@
 //! at the final poses and writes the report of `docs/interfaces.md`
 //! ("Real laser logs: run-log").
 
+use super::export::MapInfo;
 use super::grid::OccupancyGrid;
-use super::lab::MapInfo;
 use super::logslam::{ClosureInfo, LogSlam, LogSlamConfig, LogSlamStats};
 use crate::carmen::{parse_bytes, CarmenLog, LogError};
 use serde::Serialize;
@@ -140,22 +140,13 @@ impl LogReplay {
                 pose: [p.x, p.y, p.theta],
             })
             .collect();
-        let o = grid.origin_m();
         Ok(LogReport {
             frame: FRAME,
             laser_records: self.log.scans.len(),
             from: self.from,
             to: self.to,
             scans,
-            map: MapInfo {
-                width: grid.width(),
-                height: grid.height(),
-                resolution_m: grid.resolution_m(),
-                origin_m: [o.x, o.y],
-                occupied_cells: grid.occupied_count(),
-                scans: grid.scans(),
-                dropped_updates: grid.dropped_updates(),
-            },
+            map: MapInfo::of(grid),
             loop_closures: self.slam.closures.clone(),
             slam: self.slam.stats.clone(),
             params: self.log.params.len(),
