@@ -92,7 +92,7 @@ fn parse(b: &[u8]) -> Result<Vec<Option<[f64; 2]>>, String> {
             })
             .collect()
     };
-    if values.len() % 2 != 0 {
+    if !values.len().is_multiple_of(2) {
         return Err(format!("{} values do not make rows of two", values.len()));
     }
     Ok(values
