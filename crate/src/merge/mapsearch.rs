@@ -91,6 +91,7 @@
 //! show: a small overlap gives too little evidence by design.
 
 use super::align::refine_alignment;
+use super::correlation::{add_row, Correlation};
 use super::verdict::{contradiction_reason, map_agreement, Agreement, VerdictConfig};
 use super::MergeStatus;
 use crate::geom::{wrap_angle, Pose2};
@@ -367,16 +368,6 @@ impl Raster {
     }
 }
 
-/// Scores of every whole-cell translation `t` of B's raster onto A's
-/// (see step 2): `acc[(ty − ty0)·nx + tx − tx0]`, with `(tx0, ty0)` the
-/// smallest translation at which the rasters touch.
-struct Correlation {
-    t0: [i64; 2],
-    nx: usize,
-    ny: usize,
-    acc: Vec<i32>,
-}
-
 fn correlate(a: &Raster, b: &Raster) -> Correlation {
     let nx = a.width + b.width - 1;
     let ny = a.height + b.height - 1;
@@ -406,54 +397,6 @@ fn correlate(a: &Raster, b: &Raster) -> Correlation {
         }
     }
     Correlation { t0, nx, ny, acc }
-}
-
-/// `row += add`, element by element (a function of its own so the compiler
-/// sees two plain slices and vectorises it).
-fn add_row(row: &mut [i32], add: &[i32]) {
-    for (r, a) in row.iter_mut().zip(add) {
-        *r += *a;
-    }
-}
-
-/// The best `count` local maxima of a correlation at least `apart` cells
-/// from each other, as (translation in cells, score).
-fn peaks(c: &Correlation, count: usize, apart: f64) -> Vec<([i64; 2], i32)> {
-    let mut local: Vec<(usize, usize, i32)> = Vec::new();
-    for y in 1..c.ny.saturating_sub(1) {
-        for x in 1..c.nx.saturating_sub(1) {
-            let v = c.acc[y * c.nx + x];
-            if v <= 0 {
-                continue;
-            }
-            let is_max = (0..3).all(|dy| {
-                (0..3).all(|dx| {
-                    let w = c.acc[(y + dy - 1) * c.nx + x + dx - 1];
-                    w < v || (w == v && (dy, dx) >= (1, 1))
-                })
-            });
-            if is_max {
-                local.push((x, y, v));
-            }
-        }
-    }
-    // Strongest first; ties by position, so the order is deterministic.
-    local.sort_by(|p, q| q.2.cmp(&p.2).then(p.1.cmp(&q.1)).then(p.0.cmp(&q.0)));
-    let mut out: Vec<([i64; 2], i32)> = Vec::new();
-    for (x, y, v) in local {
-        if out.len() >= count {
-            break;
-        }
-        let t = [x as i64 + c.t0[0], y as i64 + c.t0[1]];
-        let far = out.iter().all(|(u, _)| {
-            let (dx, dy) = ((u[0] - t[0]) as f64, (u[1] - t[1]) as f64);
-            dx.hypot(dy) >= apart
-        });
-        if far {
-            out.push((t, v));
-        }
-    }
-    out
 }
 
 /// Whether two transforms of B differ by more than the settings allow, at
@@ -550,7 +493,7 @@ pub fn search_maps(
             return MapSearch::refuse("maps alone: a map is empty".into());
         };
         let corr = correlate(&ra, &rb);
-        for (t, score) in peaks(&corr, cfg.peaks_per_rotation, cfg.distinct_m / cell) {
+        for (t, score) in corr.peaks(cfg.peaks_per_rotation, cfg.distinct_m / cell) {
             let pose = Pose2::new(t[0] as f64 * cell, t[1] as f64 * cell, theta);
             coarse.push((pose, score as i64));
         }

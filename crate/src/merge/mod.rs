@@ -51,6 +51,7 @@ pub mod align;
 pub mod baseline;
 pub mod config;
 pub mod consistency;
+pub mod correlation;
 pub mod described;
 pub mod evidence;
 pub mod frames;

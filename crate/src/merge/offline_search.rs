@@ -39,6 +39,7 @@
 //!
 //! Everything is deterministic; no random sampling.
 
+use super::correlation::{add_row, Correlation};
 use super::wallmap::WallMap;
 use crate::geom::{wrap_angle, Pose2};
 use glam::DVec2;
@@ -232,12 +233,6 @@ impl Coarse {
     }
 }
 
-fn add_row(row: &mut [i32], add: &[i32]) {
-    for (r, a) in row.iter_mut().zip(add) {
-        *r += *a;
-    }
-}
-
 /// Best `count` translation peaks (cells, score) of B's raster over A's,
 /// at least `apart` cells from each other.
 fn translation_peaks(a: &Coarse, b: &Coarse, count: usize, apart: f64) -> Vec<([i64; 2], i32)> {
@@ -259,39 +254,7 @@ fn translation_peaks(a: &Coarse, b: &Coarse, count: usize, apart: f64) -> Vec<([
         a.origin[0] - b.origin[0] - b.width as i64 + 1,
         a.origin[1] - b.origin[1] - b.height as i64 + 1,
     ];
-    let mut local: Vec<(usize, usize, i32)> = Vec::new();
-    for y in 1..ny.saturating_sub(1) {
-        for x in 1..nx.saturating_sub(1) {
-            let v = acc[y * nx + x];
-            if v <= 0 {
-                continue;
-            }
-            let is_max = (0..3).all(|dy| {
-                (0..3).all(|dx| {
-                    let w = acc[(y + dy - 1) * nx + x + dx - 1];
-                    w < v || (w == v && (dy, dx) >= (1, 1))
-                })
-            });
-            if is_max {
-                local.push((x, y, v));
-            }
-        }
-    }
-    local.sort_by(|p, q| q.2.cmp(&p.2).then(p.1.cmp(&q.1)).then(p.0.cmp(&q.0)));
-    let mut out: Vec<([i64; 2], i32)> = Vec::new();
-    for (x, y, v) in local {
-        if out.len() >= count {
-            break;
-        }
-        let t = [x as i64 + t0[0], y as i64 + t0[1]];
-        if out
-            .iter()
-            .all(|(u, _)| (((u[0] - t[0]).pow(2) + (u[1] - t[1]).pow(2)) as f64).sqrt() >= apart)
-        {
-            out.push((t, v));
-        }
-    }
-    out
+    Correlation { t0, nx, ny, acc }.peaks(count, apart)
 }
 
 /// The coarse cell for two maps (step 2).
