@@ -215,3 +215,122 @@ test('merging in the page: the table fills, a pair shows its matches, the verdic
   assert.deepEqual(problems, [], 'no console errors or page errors');
   await context.close();
 });
+
+// ---- issue 23: the page as a newcomer meets it -------------------------------
+
+/** A page in a context of its own (`deviceScaleFactor` for HiDPI), recording console errors. */
+async function pageWith(viewport, deviceScaleFactor = 1) {
+  const context = await env.browser.newContext({ viewport, deviceScaleFactor });
+  const page = await context.newPage();
+  const problems = [];
+  page.on('console', (m) => m.type() === 'error' && problems.push(`console error: ${m.text()}`));
+  page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
+  await page.goto(env.baseUrl);
+  await waitReady(page);
+  return { context, page, problems };
+}
+
+/** Runs the loaded scenario at 50× to its end (`duration` s if given). */
+async function runToEnd(page, duration) {
+  if (duration) {
+    await page.fill('#duration', String(duration));
+    await page.locator('#duration').dispatchEvent('change');
+  }
+  await page.locator('#speed').fill('50');
+  await page.getByRole('button', { name: 'Run', exact: true }).click();
+  await page.waitForFunction(() => window.slamlab.state().finished, null, { timeout: 240000 });
+}
+
+test('issue 23: a finished run shows its final figures, points to Merge, and is short to Tab through', { timeout: 300000 }, async () => {
+  const { context, page, problems } = await pageWith({ width: 1366, height: 768 });
+  await page.selectOption('#preset', 'thesis');
+  await page.waitForFunction(() => window.slamlab.scenario().name === 'thesis');
+
+  // Item 10: the canvas hint sits above the maze, not on it (the fit keeps a band free).
+  const top = await page.evaluate(() => {
+    const s = window.slamlab.scenario();
+    const yMax = Math.max(...s.walls.flatMap((w) => [w.from[1], w.to[1]]));
+    const x = s.walls[0].from[0];
+    return window.slamlab.worldToClient(x, yMax)[1] - document.querySelector('#world').getBoundingClientRect().top;
+  });
+  assert.ok(top >= 31, `the top wall is drawn ${top} px below the canvas top, under the hint (8–30 px)`);
+
+  // Item 10: Add robot puts the new robot clear of the others (labels apart).
+  await page.getByRole('button', { name: 'Add a robot' }).click();
+  const robots = (await scenario(page)).robots;
+  assert.equal(robots.length, 3);
+  const nearest = Math.min(...robots.slice(0, 2).map((r) => Math.hypot(r.start[0] - robots[2].start[0], r.start[1] - robots[2].start[1])));
+  assert.ok(nearest >= 1.5 - 1e-9, `the new robot is ${nearest} m from another`);
+  await page.keyboard.press('Control+z');
+  await page.waitForFunction(() => window.slamlab.scenario().robots.length === 2);
+
+  // A 300-s run: 301 frames per robot.
+  await runToEnd(page, 300);
+
+  // Item 1: every panel shows the final state, equal to the lab's report figures.
+  const final = await page.evaluate(() => ({
+    t: window.slamlab.state().time_s,
+    figures: [0, 1].map((i) => JSON.parse(window.slamlab.lab.slamFiguresJson(i))),
+    frames: [0, 1].map((i) => window.slamlab.lab.frameCount(i)),
+    shown: [...document.querySelectorAll('.map-figures')].map((e) => e.textContent),
+    plots: [...document.querySelectorAll('.map-plot')].map((e) => JSON.parse(e.dataset.last)),
+    strips: [...document.querySelectorAll('.cam-strip')].map((e) => e.querySelectorAll('.cam-thumb').length),
+  }));
+  assert.equal(final.t, 300);
+  const pct = (x) => `${(100 * x).toFixed(0)} %`;
+  for (const i of [0, 1]) {
+    const f = final.figures[i];
+    assert.ok(final.shown[i].includes(`SLAM ${f.ate_m.toFixed(2)} m · odometry ${f.odometry_ate_m.toFixed(2)} m`),
+      `robot ${i}: the Maps panel shows "${final.shown[i]}", the report ATE ${f.ate_m} / ${f.odometry_ate_m}`);
+    assert.deepEqual(final.plots[i], [300, f.final_error_m, f.odometry_final_error_m], 'the error plot ends at the last step');
+    assert.equal(final.strips[i], final.frames[i], 'the film strip holds every frame');
+    assert.equal(final.frames[i], 301);
+    // Item 9: how much of the building each map holds (the report's wall_coverage).
+    assert.ok(final.shown[i].includes(`walls mapped: SLAM ${pct(f.wall_coverage)} · odometry ${pct(f.odometry_wall_coverage)}`),
+      final.shown[i]);
+  }
+
+  // Item 3: the status line names the next step and the Merge button is in view, focused.
+  assert.match(await statusText(page), /Run finished at t = 300\.0 s\. Next: merge the robots’ maps with Merge maps/);
+  const merge = page.locator('#merge-run');
+  const box = await merge.boundingBox();
+  assert.ok(box && box.y >= 0 && box.y + box.height <= 768, `Merge maps at y = ${box?.y}, in the 768-px window`);
+  assert.equal(await page.evaluate(() => document.activeElement.id), 'merge-run');
+  await page.screenshot({ path: path.join(ARTIFACTS, 'issue23-finished-1366.png') });
+
+  // Item 2: from the map to Merge maps in at most 30 Tab presses (one stop per film strip).
+  for (const s of await page.locator('.cam-strip').all()) {
+    assert.equal(await s.locator('.cam-thumb[tabindex="0"]').count(), 1, 'one tab stop per strip');
+  }
+  await page.locator('#world').focus();
+  let presses = 0;
+  while (presses < 60 && (await page.evaluate(() => document.activeElement.id)) !== 'merge-run') {
+    await page.keyboard.press('Tab');
+    presses++;
+  }
+  assert.ok(presses <= 30, `${presses} Tab presses from the map to Merge maps`);
+
+  // Item 2: arrow keys inside a strip move between frames (and show them).
+  const strip1 = page.locator('.cam-block').first();
+  await strip1.locator('.cam-thumb[tabindex="0"]').focus();
+  await page.keyboard.press('ArrowLeft');
+  await page.keyboard.press('ArrowLeft');
+  assert.match(await strip1.locator('.cam-what').innerText(), /^frame 298 · t = 298\.0 s/);
+  assert.equal(await page.evaluate(() => document.activeElement.dataset.index), '298');
+  await page.keyboard.press('Home');
+  assert.match(await strip1.locator('.cam-what').innerText(), /^frame 0 /);
+  assert.equal(await page.evaluate(() => window.slamlab.state().time_s), 300, 'the arrows did not step the run');
+
+  // Item 6: a frame by its number; each robot keeps its own picked frame; both marked on the map.
+  await strip1.locator('.cam-goto').fill('143');
+  await strip1.locator('.cam-goto').dispatchEvent('change');
+  assert.match(await strip1.locator('.cam-what').innerText(), /^frame 143 · t = 143\.0 s/);
+  const strip2 = page.locator('.cam-block').nth(1);
+  await strip2.locator('.cam-thumb[data-index="10"]').click();
+  assert.match(await strip2.locator('.cam-what').innerText(), /^frame 10 /);
+  assert.match(await strip1.locator('.cam-what').innerText(), /^frame 143 /, 'robot1 keeps its frame');
+  assert.deepEqual(await page.evaluate(() => window.slamlab.picks()), [[0, 143], [1, 10]]);
+
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});
