@@ -10,7 +10,8 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import path from 'node:path';
-import { ARTIFACTS, newPage, useBrowser, waitReady } from './support/browser.mjs';
+import { readFile } from 'node:fs/promises';
+import { ARTIFACTS, ROOT, newPage, useBrowser, waitReady } from './support/browser.mjs';
 
 const STORAGE_KEY = 'slamlab.scenario.v1';
 const env = useBrowser();
@@ -330,6 +331,102 @@ test('issue 23: a finished run shows its final figures, points to Merge, and is 
   assert.match(await strip2.locator('.cam-what').innerText(), /^frame 10 /);
   assert.match(await strip1.locator('.cam-what').innerText(), /^frame 143 /, 'robot1 keeps its frame');
   assert.deepEqual(await page.evaluate(() => window.slamlab.picks()), [[0, 143], [1, 10]]);
+
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});
+
+test('issue 23: a wrong merge stands out; the pair table by keyboard; HiDPI side canvases', { timeout: 400000 }, async () => {
+  const { context, page, problems } = await pageWith({ width: 1366, height: 768 }, 2);
+  // Exercise 5: every wall the same texture; the thesis method joins two look-alike places.
+  await page.setInputFiles('#import-file', path.join(ROOT, 'scenarios/ex-repeated.json'));
+  await page.waitForFunction(() => window.slamlab.scenario().walls.every((w) => w.texture === 'brick'));
+  await runToEnd(page);
+
+  // Item 10: the method names fit their select.
+  const fits = await page.evaluate(() => {
+    const s = document.querySelector('#merge-method');
+    const probe = document.createElement('span');
+    probe.style.cssText = `position:absolute;white-space:nowrap;font:${getComputedStyle(s).font}`;
+    document.body.append(probe);
+    const widest = Math.max(...[...s.options].map((o) => ((probe.textContent = o.text), probe.getBoundingClientRect().width)));
+    probe.remove();
+    return { widest, room: s.clientWidth - 24 };
+  });
+  assert.ok(fits.widest <= fits.room, `the longest method name takes ${fits.widest} px of ${fits.room}`);
+
+  await page.selectOption('#merge-method', 'thesis');
+  await page.locator('#merge-run').click();
+  await page.waitForFunction(() => document.querySelector('#merge-verdict')?.textContent.length > 0, null, { timeout: 120000 });
+  const view = await page.evaluate(() => JSON.parse(window.slamlab.lab.mergeViewJson()));
+  const e2 = view.report.errors.find((e) => e.robot === 'robot2');
+  assert.equal(view.report.status, 'merged');
+  assert.ok(e2.error_m > 5, `robot2 is ${e2.error_m} m off: the case of exercise 5`);
+
+  // Item 5: the panel, the status line and the summary say it is wrong.
+  const verdict = page.locator('#merge-verdict');
+  assert.equal(await verdict.getAttribute('class'), 'merge-verdict wrong');
+  assert.match(await verdict.innerText(), new RegExp(`^Wrong merge \\(confidence \\d\\.\\d\\d\\): robot2’s map is placed ${e2.error_m.toFixed(1)} m and \\d+° from where it really belongs`));
+  assert.equal(await page.locator('#merge-transforms td.bad').count(), 1, 'robot2\'s error cell is marked');
+  assert.equal(await page.locator('#status').getAttribute('class'), 'status error');
+  assert.match(await statusText(page), /^Wrong merge: robot2’s map is placed/);
+  await page.getByRole('button', { name: 'Summary of the run, printable' }).click();
+  await page.waitForSelector('#summary:not([hidden]) .summary-verdict');
+  assert.equal(await page.locator('.summary-verdict').getAttribute('class'), 'summary-verdict wrong');
+  assert.match(await page.locator('.summary-verdict').innerText(), /^Wrong merge/);
+  await page.keyboard.press('Escape');
+  await page.waitForFunction(() => document.querySelector('#summary').hidden);
+
+  // Item 4: a legend, cells of a readable size, plain words.
+  assert.equal(await page.locator('#merge-legend > span').count(), 4);
+  assert.match(await page.locator('#merge-legend').innerText(), /not checked[\s\S]*checked, no agreeing matches[\s\S]*the best pair/);
+  assert.ok(Number(await page.locator('#merge-table').getAttribute('data-cell')) >= 7, 'cells of at least 7 px');
+  assert.match(await page.locator('#merge-table-hint').innerText(), /A row is one of robot1’s frames, a column one of robot2’s/);
+
+  // Item 2: arrows move a cursor in the table, Enter opens that pair, Esc returns the focus.
+  const t = view.tables[0];
+  const target = t.cells.find((c) => c[0] !== t.best[0] || c[1] !== t.best[1]);
+  await page.locator('#merge-table').focus();
+  const keys = [
+    ...Array(Math.abs(target[0] - t.best[0])).fill(target[0] > t.best[0] ? 'ArrowDown' : 'ArrowUp'),
+    ...Array(Math.abs(target[1] - t.best[1])).fill(target[1] > t.best[1] ? 'ArrowRight' : 'ArrowLeft'),
+  ];
+  for (const k of keys) await page.keyboard.press(k);
+  const fa = view.robots[t.a].frames[target[0]];
+  const fb = view.robots[t.b].frames[target[1]];
+  assert.match(await statusText(page), new RegExp(`^robot1 frame ${fa} × robot2 frame ${fb}: ${target[2]} agreeing matches`));
+  await page.keyboard.press('Enter');
+  await page.waitForSelector('#pair-overlay:not([hidden]) canvas');
+  assert.equal(await page.locator('#pair-overlay h2').innerText(), `robot1 frame ${fa} ↔ robot2 frame ${fb}`);
+  // Item 6: the pair view says where the two frames were taken.
+  assert.match(await page.locator('#pair-overlay .pair-where').innerText(), /robot1 took frame \d+ at x -?\d+\.\d m, y -?\d+\.\d m[\s\S]*\d+\.\d m apart/);
+  await page.keyboard.press('Escape');
+  assert.equal(await page.locator('#pair-overlay').isHidden(), true);
+  assert.equal(await page.evaluate(() => document.activeElement.id), 'merge-table', 'Esc gives the focus back to the table');
+
+  // Item 8: the side canvases are drawn at the device pixel ratio (2).
+  const sizes = await page.evaluate(() =>
+    ['.map-view', '.map-plot', '#merge-table', '#merge-map', '#merge-methods-chart'].map((sel) => {
+      const c = document.querySelector(sel);
+      return [sel, c.width, c.getBoundingClientRect().width];
+    }));
+  for (const [sel, w, css] of sizes) assert.ok(css > 50 && Math.abs(w - 2 * css) <= 1, `${sel}: ${w} device px for ${css} CSS px`);
+
+  // Item 10: the merged-map PNG is the picture the panel shows (with the paths), at 4 × its size.
+  const [download] = await Promise.all([page.waitForEvent('download'), page.getByRole('button', { name: 'Merged map PNG' }).click()]);
+  const png = await readFile(await download.path());
+  assert.deepEqual([png.readUInt32BE(16), png.readUInt32BE(20)], [1320, 960], 'PNG width and height');
+
+  // Item 10: the automatic method merges right, and its verdict does not repeat itself.
+  await page.selectOption('#merge-method', 'auto');
+  await page.locator('#merge-run').click();
+  await page.waitForFunction(() => /^Merged|^No merge/.test(document.querySelector('#merge-verdict')?.textContent ?? ''), null, { timeout: 180000 });
+  const auto = await verdict.innerText();
+  assert.equal(await verdict.getAttribute('class'), 'merge-verdict ok', auto);
+  assert.doesNotMatch(auto, /: merged: /);
+  assert.match(auto, /wall cells \(grid cells that are wall in both maps once joined\)/);
+  await page.locator('.merge-panel').scrollIntoViewIfNeeded();
+  await page.screenshot({ path: path.join(ARTIFACTS, 'issue23-merge-hidpi.png') });
 
   assert.deepEqual(problems, [], 'no console errors or page errors');
   await context.close();

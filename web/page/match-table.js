@@ -77,11 +77,20 @@ export class MatchTable {
     if (view !== this.view && this.view?.tables?.[0]?.pair !== view?.tables?.[0]?.pair) this.cursor = null;
     this.view = view;
     this.draw();
+    // Once the table is complete, bring the best pair into the box.
+    const best = this.best();
+    if (view?.progress?.finished && best && !this.shownBest) {
+      this.shownBest = true;
+      const g = this.geometry();
+      this.scroller.scrollLeft = X0 + best[1] * g.cell - this.scroller.clientWidth / 2;
+      this.scroller.scrollTop = Y0 + best[0] * g.cell - this.scroller.clientHeight / 2;
+    }
   }
 
   reset() {
     this.view = null;
     this.cursor = null;
+    this.shownBest = false;
   }
 
   geometry() {

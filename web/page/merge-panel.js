@@ -222,6 +222,7 @@ export class MergePanel {
       this.active = true;
       this.view = null;
       this.result.hidden = true;
+      this.matchTable.reset();
       this.tableBox.hidden = this.method === 'map-only';
       this.hint.textContent = '';
       this.closePair();
