@@ -431,3 +431,59 @@ test('issue 23: a wrong merge stands out; the pair table by keyboard; HiDPI side
   assert.deepEqual(problems, [], 'no console errors or page errors');
   await context.close();
 });
+
+test('issue 23: problems in words with the wall marked; one robot cannot merge; the guide keeps time; modes explained', { timeout: 120000 }, async () => {
+  const { context, page, problems } = await pageWith({ width: 1366, height: 768 });
+  const thesis = JSON.parse(await readFile(path.join(ROOT, 'scenarios/thesis.json'), 'utf8'));
+  const importScenario = (s) =>
+    page.setInputFiles('#import-file', { name: 'x.json', mimeType: 'application/json', buffer: Buffer.from(JSON.stringify(s)) });
+
+  // Item 7: robot2 stands on walls[4] (a quarter of the way along it).
+  const w = thesis.walls[4];
+  const at = (f) => [w.from[0] + f * (w.to[0] - w.from[0]), w.from[1] + f * (w.to[1] - w.from[1])];
+  const bad = structuredClone(thesis);
+  bad.robots[1].start = [...at(0.25), 0];
+  await importScenario(bad);
+  await page.waitForFunction(() => window.slamlab.problems().length === 1);
+  await page.getByRole('button', { name: 'Run', exact: true }).click();
+  const said = await statusText(page);
+  assert.match(said, /^Cannot run: robot2 overlaps a wall \(marked in red on the map\)/);
+  assert.doesNotMatch(said, /walls\[|robots\[/);
+  assert.equal((await page.evaluate(() => window.slamlab.problems()))[0].wall, 4);
+  // The wall is drawn in red where the robot is not (three quarters along it).
+  await page.waitForTimeout(100);
+  const rgb = await page.evaluate(([x, y]) => {
+    const c = document.querySelector('#world');
+    const [cx, cy] = window.slamlab.worldToClient(x, y);
+    const r = c.getBoundingClientRect();
+    const k = c.width / r.width;
+    return [...c.getContext('2d').getImageData(Math.round((cx - r.left) * k), Math.round((cy - r.top) * k), 1, 1).data];
+  }, at(0.75));
+  assert.ok(rgb[0] > 170 && rgb[1] < 90 && rgb[2] < 90, `the overlapped wall is marked red: rgb ${rgb}`);
+
+  // Item 7: with one robot the merge hint says a merge needs two.
+  const one = structuredClone(thesis);
+  one.robots = one.robots.slice(0, 1);
+  await importScenario(one);
+  await page.waitForFunction(() => window.slamlab.scenario().robots.length === 1);
+  await page.getByRole('button', { name: 'Step', exact: true }).click();
+  assert.match(await page.locator('#merge-hint').innerText(), /^Merging needs at least two robots/);
+
+  // Item 10: the guide's running time is the clock's when the run pauses.
+  await importScenario(thesis);
+  await page.waitForFunction(() => window.slamlab.scenario().robots.length === 2);
+  await page.getByRole('button', { name: 'Run', exact: true }).click();
+  await page.waitForFunction(() => window.slamlab.state().time_s >= 2);
+  await page.locator('#guided-open').click();
+  await page.waitForTimeout(300);
+  await page.getByRole('button', { name: 'Pause', exact: true }).click();
+  const clock = /t = (\d+\.\d) s/.exec(await page.locator('#clock').innerText())[1];
+  assert.match(await page.locator('#guide .guide-live').innerText(), new RegExp(`Paused: t = ${clock.replace('.', '\\.')} s`));
+
+  // Item 10: the robot card says what its mode means.
+  const modes = await page.$$eval('.robot-card .readout .mode', (els) => els.map((e) => [e.textContent, e.title]));
+  for (const [mode, words] of modes) assert.ok(words.length > 10, `mode "${mode}" is explained: "${words}"`);
+
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});
