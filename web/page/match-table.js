@@ -58,7 +58,7 @@ export class MatchTable {
     this.canvas.addEventListener('focus', () => {
       if (!this.cursor) this.cursor = this.best() ?? [0, 0];
       this.draw();
-      this.announce();
+      this.announce(false); // the status line keeps the verdict until a key moves the cursor
     });
     this.canvas.addEventListener('blur', () => this.draw());
   }
@@ -187,11 +187,11 @@ export class MatchTable {
     this.canvas.title = c ? this.describe(c.row, c.col) : '';
   }
 
-  announce() {
+  announce(say = true) {
     if (!this.cursor || !this.table()) return;
     const text = this.describe(...this.cursor);
     this.canvas.setAttribute('aria-label', `Matched-pair table, ${text}. Arrow keys move, Enter opens the pair.`);
-    this.hooks.say(text);
+    if (say) this.hooks.say(text);
   }
 
   key(e) {
