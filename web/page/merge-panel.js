@@ -5,12 +5,15 @@
 // milliseconds per frame), so the page stays responsive while the
 // matched-pair table fills in: one row per frame of the first robot, one
 // column per frame of the second, each checked pair a cell coloured by its
-// inlier count (the thesis's Table 1). Clicking a cell opens the two frames
+// inlier count (the thesis's Table 1; web/page/match-table.js draws it, with
+// its legend and keyboard cursor). Clicking a cell opens the two frames
 // with their matches and the matched-region quad (thesis Figure 8;
 // web/page/pair-view.js). At the
 // end the verdict appears with its reason, the transform of each robot's map
 // frame, its error against the ground truth, and the merged map with
-// downloads (PNG, ROS map_server PGM + YAML, report JSON).
+// downloads (PNG, ROS map_server PGM + YAML, report JSON). A merge the
+// ground truth puts more than 0.5 m or 5° off is called a wrong merge, in
+// red, however confident the method was (web/page/merge-words.js).
 //
 // The panel remembers each method's result on the current run, and a small
 // chart compares their transform errors (position and heading against the
