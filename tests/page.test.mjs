@@ -479,6 +479,15 @@ test('issue 23: problems in words with the wall marked; one robot cannot merge; 
   await page.getByRole('button', { name: 'Pause', exact: true }).click();
   const clock = /t = (\d+\.\d) s/.exec(await page.locator('#clock').innerText())[1];
   assert.match(await page.locator('#guide .guide-live').innerText(), new RegExp(`Paused: t = ${clock.replace('.', '\\.')} s`));
+  // Item 1: paused, the Maps panel's plot and the film strips end at the pause, not half a second before.
+  const paused = await page.evaluate(() => ({
+    t: window.slamlab.state().time_s,
+    plots: [...document.querySelectorAll('.map-plot')].map((e) => JSON.parse(e.dataset.last)[0]),
+    strips: [...document.querySelectorAll('.cam-strip')].map((e) => e.querySelectorAll('.cam-thumb').length),
+    frames: [0, 1].map((i) => window.slamlab.lab.frameCount(i)),
+  }));
+  assert.deepEqual(paused.plots, [paused.t, paused.t], `the plots end at the pause (t = ${paused.t})`);
+  assert.deepEqual(paused.strips, paused.frames);
 
   // Item 10: the robot card says what its mode means.
   const modes = await page.$$eval('.robot-card .readout .mode', (els) => els.map((e) => [e.textContent, e.title]));
