@@ -374,6 +374,9 @@ test('issue 23: a wrong merge stands out; the pair table by keyboard; HiDPI side
   await page.waitForSelector('#summary:not([hidden]) .summary-verdict');
   assert.equal(await page.locator('.summary-verdict').getAttribute('class'), 'summary-verdict wrong');
   assert.match(await page.locator('.summary-verdict').innerText(), /^Wrong merge/);
+  // Item 9: the summary also says how much of the building each map holds.
+  const cover = await page.evaluate(() => Math.round(100 * JSON.parse(window.slamlab.lab.slamFiguresJson(0)).wall_coverage));
+  assert.match(await page.locator('#summary').innerText(), new RegExp(`walls mapped \\(SLAM\\)[\\s\\S]*robot1[^\\n]*\\b${cover} %`));
   await page.keyboard.press('Escape');
   await page.waitForFunction(() => document.querySelector('#summary').hidden);
 

@@ -72,10 +72,10 @@ export function buildSummary(host, data, { onPrint, onClose }) {
   const robotRows = data.robots.map((r) => [
     r.name, `${r.follow} wall, ${fmt(r.distance, 2)} m`, r.frames, r.bumps,
     r.figures ? `${fmt(r.figures.ate_m)} m` : '–', r.figures ? `${fmt(r.figures.odometry_ate_m)} m` : '–',
-    r.figures ? pct(r.figures.occupied_precision) : '–',
+    r.figures ? pct(r.figures.occupied_precision) : '–', r.figures ? pct(r.figures.wall_coverage) : '–',
   ]);
   parts.push(table('Robots: position error (ATE, RMS against the ground truth) of SLAM and of odometry alone',
-    ['robot', 'follows', 'pictures', 'bumps', 'ATE SLAM', 'ATE odometry', 'map cells on a wall'], robotRows));
+    ['robot', 'follows', 'frames', 'bumps', 'ATE SLAM', 'ATE odometry', 'map cells on a wall', 'walls mapped (SLAM)'], robotRows));
   if (data.plots.length) {
     parts.push(el('div', { class: 'summary-figures' },
       ...data.plots.map((p) => figure(p.src, `${p.name}'s position error over time`,
