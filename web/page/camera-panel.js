@@ -237,6 +237,8 @@ export class CameraPanel {
     }
     b.empty.hidden = b.shown.length > 0;
     b.strip.dataset.frames = String(b.shown.length);
+    b.goto.hidden = b.shown.length === 0;
+    b.goto.max = String(Math.max(0, ...b.shown));
     this.rove(b);
     if (atEnd) b.strip.scrollLeft = b.strip.scrollWidth;
   }
