@@ -44,9 +44,9 @@ test('guided mode: §6.2.1 to §6.2.5 on the thesis preset, numbers on the way, 
   await page.waitForFunction(() => window.slamlab.state().finished, null, { timeout: 240000 });
   await nextEnabled(page, 5000);
   const collect = await liveText(page);
-  const pictures = /Pictures: robot1 (\d+), robot2 (\d+)/.exec(collect);
-  assert.ok(pictures, `the step reports the pictures taken: ${collect}`);
-  assert.equal(Number(pictures[1]), 148, 'one picture per simulated second over 147 s, t = 0 included');
+  const pictures = /Frames: robot1 (\d+), robot2 (\d+)/.exec(collect);
+  assert.ok(pictures, `the step reports the frames taken: ${collect}`);
+  assert.equal(Number(pictures[1]), 148, 'one frame per simulated second over 147 s, t = 0 included');
   assert.equal(Number(pictures[2]), 148);
   assert.match(collect, /robot1 \d+\.\d\d m \(odometry alone \d+\.\d\d m\)/);
 
@@ -68,7 +68,7 @@ test('guided mode: §6.2.1 to §6.2.5 on the thesis preset, numbers on the way, 
   const markers = await page.evaluate(() => window.slamlab.markers());
   assert.equal(markers.length, sel.robots[0].selected.length + sel.robots[1].selected.length, 'a marker per selected frame');
   const selText = await liveText(page);
-  assert.match(selText, new RegExp(`robot1: 148 pictures → ${sel.robots[0].square} facing a wall squarely → ${sel.robots[0].selected.length} kept`));
+  assert.match(selText, new RegExp(`robot1: 148 frames → ${sel.robots[0].square} facing a wall squarely → ${sel.robots[0].selected.length} kept`));
   await page.waitForTimeout(300);
   const held = await mergeView(page);
   assert.equal(held.progress.stage, 'features');

@@ -10,7 +10,8 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import path from 'node:path';
-import { ARTIFACTS, newPage, useBrowser, waitReady } from './support/browser.mjs';
+import { readFile } from 'node:fs/promises';
+import { ARTIFACTS, ROOT, newPage, useBrowser, waitReady } from './support/browser.mjs';
 
 const STORAGE_KEY = 'slamlab.scenario.v1';
 const env = useBrowser();
@@ -212,6 +213,289 @@ test('merging in the page: the table fills, a pair shows its matches, the verdic
   await page.getByRole('button', { name: 'Reset', exact: true }).click();
   await page.waitForFunction(() => document.querySelector('.merge-result').hidden);
   assert.equal(await page.evaluate(() => window.slamlab.lab.hasMerge()), false);
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});
+
+// ---- issue 23: the page as a newcomer meets it -------------------------------
+
+/** A page in a context of its own (`deviceScaleFactor` for HiDPI), recording console errors. */
+async function pageWith(viewport, deviceScaleFactor = 1) {
+  const context = await env.browser.newContext({ viewport, deviceScaleFactor });
+  const page = await context.newPage();
+  const problems = [];
+  page.on('console', (m) => m.type() === 'error' && problems.push(`console error: ${m.text()}`));
+  page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
+  await page.goto(env.baseUrl);
+  await waitReady(page);
+  return { context, page, problems };
+}
+
+/** Runs the loaded scenario at 50× to its end (`duration` s if given). */
+async function runToEnd(page, duration) {
+  if (duration) {
+    await page.fill('#duration', String(duration));
+    await page.locator('#duration').dispatchEvent('change');
+  }
+  await page.locator('#speed').fill('50');
+  await page.getByRole('button', { name: 'Run', exact: true }).click();
+  await page.waitForFunction(() => window.slamlab.state().finished, null, { timeout: 240000 });
+}
+
+test('issue 23: a finished run shows its final figures, points to Merge, and is short to Tab through', { timeout: 300000 }, async () => {
+  const { context, page, problems } = await pageWith({ width: 1366, height: 768 });
+  await page.selectOption('#preset', 'thesis');
+  await page.waitForFunction(() => window.slamlab.scenario().name === 'thesis');
+
+  // Item 10: the canvas hint sits above the maze, not on it (the fit keeps a band free).
+  const top = await page.evaluate(() => {
+    const s = window.slamlab.scenario();
+    const yMax = Math.max(...s.walls.flatMap((w) => [w.from[1], w.to[1]]));
+    const x = s.walls[0].from[0];
+    return window.slamlab.worldToClient(x, yMax)[1] - document.querySelector('#world').getBoundingClientRect().top;
+  });
+  assert.ok(top >= 31, `the top wall is drawn ${top} px below the canvas top, under the hint (8–30 px)`);
+
+  // Item 10: Add robot puts the new robot clear of the others (labels apart).
+  await page.getByRole('button', { name: 'Add a robot' }).click();
+  const robots = (await scenario(page)).robots;
+  assert.equal(robots.length, 3);
+  const nearest = Math.min(...robots.slice(0, 2).map((r) => Math.hypot(r.start[0] - robots[2].start[0], r.start[1] - robots[2].start[1])));
+  assert.ok(nearest >= 1.5 - 1e-9, `the new robot is ${nearest} m from another`);
+  await page.keyboard.press('Control+z');
+  await page.waitForFunction(() => window.slamlab.scenario().robots.length === 2);
+
+  // A 300-s run: 301 frames per robot.
+  await runToEnd(page, 300);
+
+  // Item 1: every panel shows the final state, equal to the lab's report figures.
+  const final = await page.evaluate(() => ({
+    t: window.slamlab.state().time_s,
+    figures: [0, 1].map((i) => JSON.parse(window.slamlab.lab.slamFiguresJson(i))),
+    frames: [0, 1].map((i) => window.slamlab.lab.frameCount(i)),
+    shown: [...document.querySelectorAll('.map-figures')].map((e) => e.textContent),
+    plots: [...document.querySelectorAll('.map-plot')].map((e) => JSON.parse(e.dataset.last)),
+    strips: [...document.querySelectorAll('.cam-strip')].map((e) => e.querySelectorAll('.cam-thumb').length),
+  }));
+  assert.equal(final.t, 300);
+  const pct = (x) => `${(100 * x).toFixed(0)} %`;
+  for (const i of [0, 1]) {
+    const f = final.figures[i];
+    assert.ok(final.shown[i].includes(`SLAM ${f.ate_m.toFixed(2)} m · odometry ${f.odometry_ate_m.toFixed(2)} m`),
+      `robot ${i}: the Maps panel shows "${final.shown[i]}", the report ATE ${f.ate_m} / ${f.odometry_ate_m}`);
+    assert.deepEqual(final.plots[i], [300, f.final_error_m, f.odometry_final_error_m], 'the error plot ends at the last step');
+    assert.equal(final.strips[i], final.frames[i], 'the film strip holds every frame');
+    assert.equal(final.frames[i], 301);
+    // Item 9: how much of the building each map holds (the report's wall_coverage).
+    assert.ok(final.shown[i].includes(`walls mapped: SLAM ${pct(f.wall_coverage)} · odometry ${pct(f.odometry_wall_coverage)}`),
+      final.shown[i]);
+  }
+
+  // Item 3: the status line names the next step and the Merge button is in view, focused.
+  assert.match(await statusText(page), /Run finished at t = 300\.0 s\. Next: merge the robots’ maps with Merge maps/);
+  const merge = page.locator('#merge-run');
+  const box = await merge.boundingBox();
+  assert.ok(box && box.y >= 0 && box.y + box.height <= 768, `Merge maps at y = ${box?.y}, in the 768-px window`);
+  assert.equal(await page.evaluate(() => document.activeElement.id), 'merge-run');
+  await page.screenshot({ path: path.join(ARTIFACTS, 'issue23-finished-1366.png') });
+
+  // Item 2: from the map to Merge maps in at most 30 Tab presses (one stop per film strip).
+  for (const s of await page.locator('.cam-strip').all()) {
+    assert.equal(await s.locator('.cam-thumb[tabindex="0"]').count(), 1, 'one tab stop per strip');
+  }
+  await page.locator('#world').focus();
+  let presses = 0;
+  while (presses < 60 && (await page.evaluate(() => document.activeElement.id)) !== 'merge-run') {
+    await page.keyboard.press('Tab');
+    presses++;
+  }
+  assert.ok(presses <= 30, `${presses} Tab presses from the map to Merge maps`);
+
+  // Item 2: arrow keys inside a strip move between frames (and show them).
+  const strip1 = page.locator('.cam-block').first();
+  await strip1.locator('.cam-thumb[tabindex="0"]').focus();
+  await page.keyboard.press('ArrowLeft');
+  await page.keyboard.press('ArrowLeft');
+  assert.match(await strip1.locator('.cam-what').innerText(), /^frame 298 · t = 298\.0 s/);
+  assert.equal(await page.evaluate(() => document.activeElement.dataset.index), '298');
+  await page.keyboard.press('Home');
+  assert.match(await strip1.locator('.cam-what').innerText(), /^frame 0 /);
+  assert.equal(await page.evaluate(() => window.slamlab.state().time_s), 300, 'the arrows did not step the run');
+
+  // Item 6: a frame by its number; each robot keeps its own picked frame; both marked on the map.
+  await strip1.locator('.cam-goto').fill('143');
+  await strip1.locator('.cam-goto').dispatchEvent('change');
+  assert.match(await strip1.locator('.cam-what').innerText(), /^frame 143 · t = 143\.0 s/);
+  const strip2 = page.locator('.cam-block').nth(1);
+  await strip2.locator('.cam-thumb[data-index="10"]').click();
+  assert.match(await strip2.locator('.cam-what').innerText(), /^frame 10 /);
+  assert.match(await strip1.locator('.cam-what').innerText(), /^frame 143 /, 'robot1 keeps its frame');
+  assert.deepEqual(await page.evaluate(() => window.slamlab.picks()), [[0, 143], [1, 10]]);
+
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});
+
+test('issue 23: a wrong merge stands out; the pair table by keyboard; HiDPI side canvases', { timeout: 400000 }, async () => {
+  const { context, page, problems } = await pageWith({ width: 1366, height: 768 }, 2);
+  // Exercise 5: every wall the same texture; the thesis method joins two look-alike places.
+  await page.setInputFiles('#import-file', path.join(ROOT, 'scenarios/ex-repeated.json'));
+  await page.waitForFunction(() => window.slamlab.scenario().walls.every((w) => w.texture === 'brick'));
+  await runToEnd(page);
+
+  // Item 10: the method names fit their select.
+  const fits = await page.evaluate(() => {
+    const s = document.querySelector('#merge-method');
+    const probe = document.createElement('span');
+    probe.style.cssText = `position:absolute;white-space:nowrap;font:${getComputedStyle(s).font}`;
+    document.body.append(probe);
+    const widest = Math.max(...[...s.options].map((o) => ((probe.textContent = o.text), probe.getBoundingClientRect().width)));
+    probe.remove();
+    return { widest, room: s.clientWidth - 24 };
+  });
+  assert.ok(fits.widest <= fits.room, `the longest method name takes ${fits.widest} px of ${fits.room}`);
+
+  await page.selectOption('#merge-method', 'thesis');
+  await page.locator('#merge-run').click();
+  await page.waitForFunction(() => document.querySelector('#merge-verdict')?.textContent.length > 0, null, { timeout: 120000 });
+  const view = await page.evaluate(() => JSON.parse(window.slamlab.lab.mergeViewJson()));
+  const e2 = view.report.errors.find((e) => e.robot === 'robot2');
+  assert.equal(view.report.status, 'merged');
+  assert.ok(e2.error_m > 5, `robot2 is ${e2.error_m} m off: the case of exercise 5`);
+
+  // Item 5: the panel, the status line and the summary say it is wrong.
+  const verdict = page.locator('#merge-verdict');
+  assert.equal(await verdict.getAttribute('class'), 'merge-verdict wrong');
+  assert.match(await verdict.innerText(), new RegExp(`^Wrong merge \\(confidence \\d\\.\\d\\d\\): robot2’s map is placed ${e2.error_m.toFixed(1)} m and \\d+° from where it really belongs`));
+  assert.equal(await page.locator('#merge-transforms td.bad').count(), 1, 'robot2\'s error cell is marked');
+  assert.equal(await page.locator('#status').getAttribute('class'), 'status error');
+  assert.match(await statusText(page), /^Wrong merge: robot2’s map is placed/);
+  await page.getByRole('button', { name: 'Summary of the run, printable' }).click();
+  await page.waitForSelector('#summary:not([hidden]) .summary-verdict');
+  assert.equal(await page.locator('.summary-verdict').getAttribute('class'), 'summary-verdict wrong');
+  assert.match(await page.locator('.summary-verdict').innerText(), /^Wrong merge/);
+  // Item 9: the summary also says how much of the building each map holds.
+  const cover = await page.evaluate(() => Math.round(100 * JSON.parse(window.slamlab.lab.slamFiguresJson(0)).wall_coverage));
+  assert.match(await page.locator('#summary').innerText(), new RegExp(`walls mapped \\(SLAM\\)[\\s\\S]*robot1[^\\n]*\\b${cover} %`));
+  await page.keyboard.press('Escape');
+  await page.waitForFunction(() => document.querySelector('#summary').hidden);
+
+  // Item 4: a legend, cells of a readable size, plain words.
+  assert.equal(await page.locator('#merge-legend > span').count(), 4);
+  assert.match(await page.locator('#merge-legend').innerText(), /not checked[\s\S]*checked, no agreeing matches[\s\S]*the best pair/);
+  assert.ok(Number(await page.locator('#merge-table').getAttribute('data-cell')) >= 7, 'cells of at least 7 px');
+  assert.match(await page.locator('#merge-table-hint').innerText(), /A row is one of robot1’s frames, a column one of robot2’s/);
+
+  // Item 2: arrows move a cursor in the table, Enter opens that pair, Esc returns the focus.
+  const t = view.tables[0];
+  const target = t.cells.find((c) => c[0] !== t.best[0] || c[1] !== t.best[1]);
+  await page.locator('#merge-table').focus();
+  const keys = [
+    ...Array(Math.abs(target[0] - t.best[0])).fill(target[0] > t.best[0] ? 'ArrowDown' : 'ArrowUp'),
+    ...Array(Math.abs(target[1] - t.best[1])).fill(target[1] > t.best[1] ? 'ArrowRight' : 'ArrowLeft'),
+  ];
+  for (const k of keys) await page.keyboard.press(k);
+  const fa = view.robots[t.a].frames[target[0]];
+  const fb = view.robots[t.b].frames[target[1]];
+  assert.match(await statusText(page), new RegExp(`^robot1 frame ${fa} × robot2 frame ${fb}: ${target[2]} agreeing matches`));
+  await page.keyboard.press('Enter');
+  await page.waitForSelector('#pair-overlay:not([hidden]) canvas');
+  assert.equal(await page.locator('#pair-overlay h2').innerText(), `robot1 frame ${fa} ↔ robot2 frame ${fb}`);
+  // Item 6: the pair view says where the two frames were taken.
+  assert.match(await page.locator('#pair-overlay .pair-where').innerText(), /robot1 took frame \d+ at x -?\d+\.\d m, y -?\d+\.\d m[\s\S]*\d+\.\d m apart/);
+  await page.keyboard.press('Escape');
+  assert.equal(await page.locator('#pair-overlay').isHidden(), true);
+  assert.equal(await page.evaluate(() => document.activeElement.id), 'merge-table', 'Esc gives the focus back to the table');
+
+  // Item 8: the side canvases are drawn at the device pixel ratio (2).
+  const sizes = await page.evaluate(() =>
+    ['.map-view', '.map-plot', '#merge-table', '#merge-map', '#merge-methods-chart'].map((sel) => {
+      const c = document.querySelector(sel);
+      return [sel, c.width, c.getBoundingClientRect().width];
+    }));
+  for (const [sel, w, css] of sizes) assert.ok(css > 50 && Math.abs(w - 2 * css) <= 1, `${sel}: ${w} device px for ${css} CSS px`);
+
+  // Item 10: the merged-map PNG is the picture the panel shows (with the paths), at 4 × its size.
+  const [download] = await Promise.all([page.waitForEvent('download'), page.getByRole('button', { name: 'Merged map PNG' }).click()]);
+  const png = await readFile(await download.path());
+  assert.deepEqual([png.readUInt32BE(16), png.readUInt32BE(20)], [1320, 960], 'PNG width and height');
+
+  // Item 10: the automatic method merges right, and its verdict does not repeat itself.
+  await page.selectOption('#merge-method', 'auto');
+  await page.locator('#merge-run').click();
+  await page.waitForFunction(() => /^Merged|^No merge/.test(document.querySelector('#merge-verdict')?.textContent ?? ''), null, { timeout: 180000 });
+  const auto = await verdict.innerText();
+  assert.equal(await verdict.getAttribute('class'), 'merge-verdict ok', auto);
+  assert.doesNotMatch(auto, /: merged: /);
+  assert.match(auto, /wall cells \(grid cells that are wall in both maps once joined\)/);
+  await page.locator('.merge-panel').scrollIntoViewIfNeeded();
+  await page.screenshot({ path: path.join(ARTIFACTS, 'issue23-merge-hidpi.png') });
+
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});
+
+test('issue 23: problems in words with the wall marked; one robot cannot merge; the guide keeps time; modes explained', { timeout: 120000 }, async () => {
+  const { context, page, problems } = await pageWith({ width: 1366, height: 768 });
+  const thesis = JSON.parse(await readFile(path.join(ROOT, 'scenarios/thesis.json'), 'utf8'));
+  const importScenario = (s) =>
+    page.setInputFiles('#import-file', { name: 'x.json', mimeType: 'application/json', buffer: Buffer.from(JSON.stringify(s)) });
+
+  // Item 7: robot2 stands on walls[4] (a quarter of the way along it).
+  const w = thesis.walls[4];
+  const at = (f) => [w.from[0] + f * (w.to[0] - w.from[0]), w.from[1] + f * (w.to[1] - w.from[1])];
+  const bad = structuredClone(thesis);
+  bad.robots[1].start = [...at(0.25), 0];
+  await importScenario(bad);
+  await page.waitForFunction(() => window.slamlab.problems().length === 1);
+  await page.getByRole('button', { name: 'Run', exact: true }).click();
+  const said = await statusText(page);
+  assert.match(said, /^Cannot run: robot2 overlaps a wall \(marked in red on the map\)/);
+  assert.doesNotMatch(said, /walls\[|robots\[/);
+  assert.equal((await page.evaluate(() => window.slamlab.problems()))[0].wall, 4);
+  // The wall is drawn in red where the robot is not (three quarters along it).
+  await page.waitForTimeout(100);
+  const rgb = await page.evaluate(([x, y]) => {
+    const c = document.querySelector('#world');
+    const [cx, cy] = window.slamlab.worldToClient(x, y);
+    const r = c.getBoundingClientRect();
+    const k = c.width / r.width;
+    return [...c.getContext('2d').getImageData(Math.round((cx - r.left) * k), Math.round((cy - r.top) * k), 1, 1).data];
+  }, at(0.75));
+  assert.ok(rgb[0] > 170 && rgb[1] < 90 && rgb[2] < 90, `the overlapped wall is marked red: rgb ${rgb}`);
+
+  // Item 7: with one robot the merge hint says a merge needs two.
+  const one = structuredClone(thesis);
+  one.robots = one.robots.slice(0, 1);
+  await importScenario(one);
+  await page.waitForFunction(() => window.slamlab.scenario().robots.length === 1);
+  await page.getByRole('button', { name: 'Step', exact: true }).click();
+  assert.match(await page.locator('#merge-hint').innerText(), /^Merging needs at least two robots/);
+
+  // Item 10: the guide's running time is the clock's when the run pauses.
+  await importScenario(thesis);
+  await page.waitForFunction(() => window.slamlab.scenario().robots.length === 2);
+  await page.getByRole('button', { name: 'Run', exact: true }).click();
+  await page.waitForFunction(() => window.slamlab.state().time_s >= 2);
+  await page.locator('#guided-open').click();
+  await page.waitForTimeout(300);
+  await page.getByRole('button', { name: 'Pause', exact: true }).click();
+  const clock = /t = (\d+\.\d) s/.exec(await page.locator('#clock').innerText())[1];
+  assert.match(await page.locator('#guide .guide-live').innerText(), new RegExp(`Paused: t = ${clock.replace('.', '\\.')} s`));
+  // Item 1: paused, the Maps panel's plot and the film strips end at the pause, not half a second before.
+  const paused = await page.evaluate(() => ({
+    t: window.slamlab.state().time_s,
+    plots: [...document.querySelectorAll('.map-plot')].map((e) => JSON.parse(e.dataset.last)[0]),
+    strips: [...document.querySelectorAll('.cam-strip')].map((e) => e.querySelectorAll('.cam-thumb').length),
+    frames: [0, 1].map((i) => window.slamlab.lab.frameCount(i)),
+  }));
+  assert.deepEqual(paused.plots, [paused.t, paused.t], `the plots end at the pause (t = ${paused.t})`);
+  assert.deepEqual(paused.strips, paused.frames);
+
+  // Item 10: the robot card says what its mode means.
+  const modes = await page.$$eval('.robot-card .readout .mode', (els) => els.map((e) => [e.textContent, e.title]));
+  for (const [mode, words] of modes) assert.ok(words.length > 10, `mode "${mode}" is explained: "${words}"`);
+
   assert.deepEqual(problems, [], 'no console errors or page errors');
   await context.close();
 });

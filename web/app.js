@@ -14,7 +14,9 @@
 //   summary.js      the printable summary, read from each panel's method
 //   palette.js      the robots' colours; status.js the status line and guard
 //   *-panel.js, guided.js  the side and bottom panels, the guided mode;
-//                   pair-view.js the merge's frame pair over the page
+//                   pair-view.js the merge's frame pair over the page,
+//                   match-table.js its matched-pair table; merge-words.js the
+//                   verdict in words; hidpi.js canvases at the pixel ratio
 // and web/lab.js, the facade over the wasm `Lab` the command line uses too.
 //
 // Data flows one way: input handlers call the store or a controller; the
@@ -66,6 +68,7 @@ const cancelDrag = () => pointer.cancel();
 
 const runner = new RunController(store, {
   guard, cancelDrag, refreshPanels, refreshControls, invalidate, readouts: (force) => toolbar.readouts(force),
+  finished: (st) => st.robots.length >= 2 && !guide.isOpen && mergePanel.reveal(),
 });
 const view = new WorldView(canvas, store, {
   running: () => runner.running, editable, state: () => runner.state, readState: () => runner.readState(),
@@ -97,8 +100,9 @@ const robotsPanel = new RobotsPanel($('robots'), {
 });
 const cameraPanel = new CameraPanel($('cameras'), {
   lab,
-  onMarker: (m) => {
-    view.marker = m;
+  onMarker: (picks) => {
+    view.marker = picks[picks.length - 1] ?? null; // the camera's view cone
+    view.pickMarkers = picks; // with two or more, each is labelled on the map
     view.invalidate();
   },
   onError,
@@ -107,6 +111,7 @@ const mapsPanel = new MapsPanel($('maps'), { lab, onError, download });
 const mergePanel = new MergePanel($('merge'), $('pair-overlay'), {
   lab,
   canMerge: () => Boolean(store.lab && runner.state && runner.state.steps > 0 && !runner.running && store.scenario.robots.length >= 2),
+  robotCount: () => store.scenario?.robots.length ?? 0,
   onError,
   setStatus,
   download,
@@ -168,6 +173,12 @@ function refreshPanels() {
   $('robot-count').textContent = `(${scenario.robots.length} of at most ${MAX_ROBOTS})`;
   wallPanel.sync(ed);
   toolbar.readouts(true);
+  if (!runner.running) {
+    // Finished, paused or stepped: the final state, not the last throttled refresh.
+    cameraPanel.refresh(true);
+    mapsPanel.refresh();
+    guide.update(performance.now(), true);
+  }
 }
 
 /** After every change of the scenario (web/page/state.js says which kind). */
@@ -250,6 +261,8 @@ async function main() {
     guide,
     mergePanel,
     markers: () => clone(view.guideMarkers),
+    /** The frames picked in the film strips and marked on the map: `[[robot, index]]`. */
+    picks: () => view.pickMarkers.map((m) => [m.robot, m.index]),
   };
   document.body.dataset.ready = 'true';
   requestAnimationFrame(frame);

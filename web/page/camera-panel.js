@@ -5,7 +5,12 @@
 // frames captured so far (one per simulated second, as Fraps saved them in
 // the thesis). Clicking a thumbnail shows that frame (the grey image the
 // vision pipeline uses) and marks on the map where it was taken; "live"
-// returns to the live view.
+// returns to the live view. Each robot keeps its own picked frame, so two
+// robots' frames can be compared side by side (exercise 5), and a frame can
+// be reached by its number.
+//
+// By keyboard a strip is one tab stop (a roving tabindex): the arrow keys
+// move from frame to frame and show each, Home and End go to the ends.
 
 import { robotColour } from './palette.js';
 
@@ -16,7 +21,7 @@ const THUMB_H = 48;
 export class CameraPanel {
   /**
    * @param {HTMLElement} host
-   * @param {{lab: () => any, onMarker: (m: null | {robot: number, pose: number[], fovDeg: number}) => void,
+   * @param {{lab: () => any, onMarker: (m: {robot: number, index: number, pose: number[], fovDeg: number}[]) => void,
    *          onError: (e: unknown) => void}} hooks
    */
   constructor(host, hooks) {
@@ -41,7 +46,7 @@ export class CameraPanel {
     this.blocks = scenario.robots.map((r, i) => this.makeBlock(r.name, i));
     this.scratch.width = this.camera.width;
     this.scratch.height = this.camera.height;
-    this.select(null);
+    this.picked();
     this.refresh(true);
   }
 
@@ -56,14 +61,23 @@ export class CameraPanel {
     title.textContent = `${name} camera`;
     const what = document.createElement('span');
     what.className = 'cam-what';
+    what.textContent = 'live';
     const live = document.createElement('button');
     live.type = 'button';
     live.className = 'cam-live';
     live.textContent = 'live';
     live.hidden = true;
     live.setAttribute('aria-label', `Back to ${name}'s live camera view`);
-    live.addEventListener('click', () => this.select(null));
-    head.append(title, what, live);
+    live.addEventListener('click', () => this.select({ robot: i, index: null }));
+    const goto = document.createElement('input');
+    goto.type = 'number';
+    goto.min = '0';
+    goto.step = '1';
+    goto.className = 'cam-goto';
+    goto.placeholder = 'frame #';
+    goto.setAttribute('aria-label', `Show ${name}'s frame number`);
+    goto.addEventListener('change', () => this.goTo(i, goto));
+    head.append(title, what, live, goto);
     const body = document.createElement('div');
     body.className = 'cam-body';
     const view = document.createElement('canvas');
@@ -74,8 +88,9 @@ export class CameraPanel {
     view.setAttribute('aria-label', `What ${name}'s camera sees`);
     const strip = document.createElement('div');
     strip.className = 'cam-strip';
-    strip.setAttribute('role', 'list');
-    strip.setAttribute('aria-label', `${name}'s captured frames`);
+    strip.setAttribute('role', 'listbox');
+    strip.setAttribute('aria-label', `${name}'s captured frames: arrow keys move, Home and End go to the ends`);
+    strip.addEventListener('keydown', (e) => this.stripKey(e, i));
     const empty = document.createElement('p');
     empty.className = 'cam-empty';
     empty.textContent = 'Frames appear here once a second while the robots run.';
@@ -83,30 +98,77 @@ export class CameraPanel {
     body.append(view, strip);
     el.append(head, body);
     this.host.append(el);
-    return { el, what, live, view, ctx: view.getContext('2d'), strip, empty, shown: [], robot: i, selected: null };
+    return { el, what, live, goto, view, ctx: view.getContext('2d'), strip, empty, shown: [], robot: i, selected: null };
   }
 
-  /** Shows a captured frame in robot i's view (or live again with null). */
+  /** Shows captured frame `index` in robot `robot`'s view (live again with
+   *  index null; `null` for all: every view live). Other robots keep theirs. */
   select(choice) {
     const lab = this.hooks.lab();
     for (const b of this.blocks) {
-      const mine = choice && choice.robot === b.robot;
-      b.selected = mine ? choice.index : null;
-      b.live.hidden = !mine;
+      if (choice && choice.robot !== b.robot) continue;
+      b.selected = choice ? choice.index : null;
+      b.live.hidden = b.selected === null;
       for (const t of b.strip.querySelectorAll('.cam-thumb')) {
-        t.classList.toggle('selected', mine && Number(t.dataset.index) === choice.index);
+        const on = Number(t.dataset.index) === b.selected;
+        t.classList.toggle('selected', on);
+        t.setAttribute('aria-selected', String(on));
       }
-      if (mine && lab) {
-        const m = lab.frame(b.robot, choice.index);
-        lab.drawFrame(b.robot, choice.index, b.ctx);
+      if (b.selected !== null && lab) {
+        const m = lab.frame(b.robot, b.selected);
+        lab.drawFrame(b.robot, b.selected, b.ctx);
         b.what.textContent = `frame ${m.index} · t = ${m.time_s.toFixed(1)} s (grey, as the vision pipeline sees it)`;
-        this.hooks.onMarker({ robot: b.robot, pose: m.truth, fovDeg: this.camera.hfov_deg });
+        b.pose = m.truth;
       } else {
         b.what.textContent = 'live';
       }
+      this.rove(b);
     }
-    if (!choice) this.hooks.onMarker(null);
+    this.picked();
     this.lastLiveMs = 0;
+  }
+
+  /** Tells the map where every picked frame was taken. */
+  picked() {
+    this.hooks.onMarker(this.blocks.filter((b) => b.selected !== null)
+      .map((b) => ({ robot: b.robot, index: b.selected, pose: b.pose, fovDeg: this.camera.hfov_deg })));
+  }
+
+  /** The strip's one tab stop: the picked frame, else the newest. */
+  rove(b) {
+    const thumbs = [...b.strip.querySelectorAll('.cam-thumb')];
+    const stop = thumbs.find((t) => Number(t.dataset.index) === b.selected) ?? thumbs[thumbs.length - 1];
+    for (const t of thumbs) t.tabIndex = t === stop ? 0 : -1;
+  }
+
+  /** Arrow keys inside a strip: move to the next or previous frame and show it. */
+  stripKey(e, robot) {
+    const b = this.blocks[robot];
+    const thumbs = [...b.strip.querySelectorAll('.cam-thumb')];
+    const k = thumbs.indexOf(document.activeElement);
+    if (k < 0) return;
+    const to = { ArrowLeft: k - 1, ArrowRight: k + 1, ArrowUp: k - 1, ArrowDown: k + 1, Home: 0, End: thumbs.length - 1 }[e.key];
+    if (to === undefined) return;
+    e.preventDefault();
+    e.stopPropagation();
+    const t = thumbs[Math.max(0, Math.min(thumbs.length - 1, to))];
+    this.select({ robot, index: Number(t.dataset.index) });
+    t.focus();
+  }
+
+  /** The frame-number box: shows that frame and scrolls the strip to it. */
+  goTo(robot, input) {
+    const b = this.blocks[robot];
+    const index = Number(input.value);
+    const t = b.strip.querySelector(`.cam-thumb[data-index="${index}"]`);
+    if (!t) {
+      input.setCustomValidity(`No frame ${input.value} yet (frames 0 to ${b.shown.length - 1}).`);
+      input.reportValidity();
+      return;
+    }
+    input.setCustomValidity('');
+    this.select({ robot, index });
+    b.strip.scrollLeft = t.offsetLeft - b.strip.offsetLeft - b.strip.clientWidth / 2;
   }
 
   /** Called every animation frame; `changed` when the world moved or was edited. */
@@ -142,7 +204,7 @@ export class CameraPanel {
         if (!have.has(Number(t.dataset.index))) t.remove();
       }
       b.shown = b.shown.filter((k) => have.has(k));
-      if (b.selected !== null && !have.has(b.selected)) this.select(null);
+      if (b.selected !== null && !have.has(b.selected)) this.select({ robot: b.robot, index: null });
     }
     const shown = new Set(b.shown);
     const sctx = this.scratch.getContext('2d');
@@ -155,8 +217,9 @@ export class CameraPanel {
       t.width = THUMB_W;
       t.height = THUMB_H;
       t.dataset.index = String(m.index);
-      t.tabIndex = 0;
-      t.setAttribute('role', 'listitem');
+      t.tabIndex = -1;
+      t.setAttribute('role', 'option');
+      t.setAttribute('aria-selected', 'false');
       t.setAttribute('aria-label', `frame ${m.index} at ${m.time_s.toFixed(0)} s`);
       t.title = `frame ${m.index} · t = ${m.time_s.toFixed(1)} s — click to view it and see where it was taken`;
       t.getContext('2d').drawImage(this.scratch, 0, 0, THUMB_W, THUMB_H);
@@ -165,6 +228,7 @@ export class CameraPanel {
       t.addEventListener('keydown', (e) => {
         if (e.key === 'Enter' || e.key === ' ') {
           e.preventDefault();
+          e.stopPropagation();
           pick();
         }
       });
@@ -172,6 +236,10 @@ export class CameraPanel {
       b.shown.push(m.index);
     }
     b.empty.hidden = b.shown.length > 0;
+    b.strip.dataset.frames = String(b.shown.length);
+    b.goto.hidden = b.shown.length === 0;
+    b.goto.max = String(Math.max(0, ...b.shown));
+    this.rove(b);
     if (atEnd) b.strip.scrollLeft = b.strip.scrollWidth;
   }
 }

@@ -10,6 +10,8 @@ import { fmt } from './dom.js';
 import { setStatus } from './status.js';
 import { MAX_ROBOTS } from './state.js';
 
+
+const ROBOT_GAP_M = 1.5; // a new robot's least distance from the others
 export class Editor {
   /**
    * @param {import('./state.js').Store} store
@@ -123,12 +125,16 @@ export class Editor {
     this.reportProblems();
   }
 
-  /** The scenario with `robot` on the first free spot of a spiral around (cx, cy), or null. */
+  /** The scenario with `robot` on the first free spot of a spiral around
+   *  (cx, cy), at least ROBOT_GAP_M from every other robot (so that the
+   *  robots and their names stay apart), or null. */
   freeSpot(robot, cx, cy) {
-    for (let ring = 0; ring <= 12; ring++) {
+    const others = this.store.scenario.robots.map((r) => r.start);
+    for (let ring = 0; ring <= 16; ring++) {
       for (let a = 0; a < Math.max(1, ring * 6); a++) {
         const th = (2 * Math.PI * a) / Math.max(1, ring * 6);
         const p = [snap(cx + 0.5 * ring * Math.cos(th)), snap(cy + 0.5 * ring * Math.sin(th))];
+        if (others.some((o) => Math.hypot(o[0] - p[0], o[1] - p[1]) < ROBOT_GAP_M)) continue;
         const trial = this.store.draft();
         trial.robots.push({ ...robot, start: [p[0], p[1], 0] });
         try {

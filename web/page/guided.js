@@ -21,7 +21,7 @@
 // show anyway. Keyboard: every control is a button; Escape closes (app.js).
 import { deg, el, fmt } from './dom.js';
 
-const REFRESH_MS = 250;
+const REFRESH_MS = 100; // the live text follows the clock closely
 
 const int = (n) => Number(n).toLocaleString('en-US');
 
@@ -37,31 +37,31 @@ const STEPS = [
       'Two robots explore the thesis\u2019s map (Figure 17) by following walls: <b>robot1</b> keeps 0.6 m from the ' +
       'wall on its left, <b>robot2</b> 0.6 m from the wall on its right, steering on its side sonar. Every 0.1 s each ' +
       'robot logs its odometry pose, its eight sonars and 181 laser ranges and builds its own map, in its own frame; ' +
-      'once a second its camera takes a picture (the thesis used Fraps screenshots). Those pictures are what the ' +
+      'once a second its camera takes a frame (the thesis used Fraps screenshots). Those frames are what the ' +
       'merge will compare.',
     formula: [
       'steer so that  e = s₁ − 0.6 m → 0   (robot1; s₈ for robot2)',
-      'one picture per simulated second:  147 s → 148 pictures per robot (the thesis: 134 and 147)',
+      'one frame per simulated second:  147 s → 148 frames per robot (the thesis: 134 and 147)',
     ],
   },
   {
     section: '6.2.2',
     title: 'Image selection',
     text:
-      'Matching every picture of one robot with every picture of the other is too much work, and most pairs could ' +
-      'not be used anyway. The thesis keeps only pictures taken while the robot faced a wall <b>squarely</b>: then ' +
+      'Matching every frame of one robot with every frame of the other is too much work, and most pairs could ' +
+      'not be used anyway. The thesis keeps only frames taken while the robot faced a wall <b>squarely</b>: then ' +
       'moving the camera only shrinks and shifts the view of the wall, without turning it (§5.6). A robot faces a ' +
       'wall squarely when its two forward sonars, 4 and 5 (10° either side of straight ahead), read the same range. ' +
       'Many such positions lie close together, so only one of each close group is kept.',
-    formula: ['keep a picture if  |s₄ − s₅| ≤ tol  (and the robot is not turning)', 'then drop pictures taken < d from one already kept'],
+    formula: ['keep a frame if  |s₄ − s₅| ≤ tol  (and the robot is not turning)', 'then drop frames taken < d from one already kept'],
   },
   {
     section: '6.2.3',
     title: 'Image matching',
     text:
-      'Every kept picture of robot1 is matched with every kept picture of robot2 (the thesis: 5 × 19 matchings, its ' +
-      'Table 1). For each pair, SURF finds and describes interest points in both pictures; a point is paired with its ' +
-      'nearest neighbour in the other picture when that one is clearly nearer than the second nearest; MSAC then fits ' +
+      'Every kept frame of robot1 is matched with every kept frame of robot2 (the thesis: 5 × 19 matchings, its ' +
+      'Table 1). For each pair, SURF finds and describes interest points in both frames; a point is paired with its ' +
+      'nearest neighbour in the other frame when that one is clearly nearer than the second nearest; MSAC then fits ' +
       'a homography and throws out the pairs that disagree with it. The inliers left fill the table\u2019s cell: many ' +
       'inliers mean the two robots saw the same piece of wall from nearly the same place.',
     formula: ['match if  d₁ < 0.8 · d₂   (nearest vs second-nearest descriptor)', 'x₂ ≃ H · x₁  (MSAC);  cell = number of inliers'],
@@ -70,7 +70,7 @@ const STEPS = [
     section: '6.2.4',
     title: 'Distance between the robots',
     text:
-      'Two pairs share one picture of one robot: that robot stood at <b>A\u2032</b>, the other at <b>D</b> and, ' +
+      'Two pairs share one frame of one robot: that robot stood at <b>A\u2032</b>, the other at <b>D</b> and, ' +
       'later, at <b>E</b>, all facing the same wall (Figure 18). B\u2032C\u2032 is A\u2032\u2019s view in pixels (the ' +
       'image width); the homographies give the views at D and E in the same pixels, FJ and GH; DE comes from the ' +
       'second robot\u2019s own odometry; θ is the camera\u2019s horizontal view angle. The two equations below then ' +
@@ -91,7 +91,7 @@ const STEPS = [
       'two maps are now one, in robot1\u2019s frame. The simulator knows where each robot really started, so the lab ' +
       'can score the transform, which the thesis could only judge by eye (Figure 19).',
     formula: [
-      'T = P_A\u2032 ⊕ (AD, AA\u2032, 0) ⊕ P_D⁻¹   (P: a robot\u2019s own pose at its picture; ⊕: pose composition)',
+      'T = P_A\u2032 ⊕ (AD, AA\u2032, 0) ⊕ P_D⁻¹   (P: a robot\u2019s own pose at its frame; ⊕: pose composition)',
       'x₁ = R(θ_T) · x₂ + t_T,   θ_T = θ_A\u2032 − θ_D  (the thesis\u2019s θ₂ − θ₁)',
       'error = ‖t_T − t_true‖ and |θ_T − θ_true|',
     ],
@@ -410,20 +410,20 @@ export class GuidedTour {
     const frames = run.robots.map((name, i) => `${name} ${int(lab.frameCount(i))}`).join(', ');
     if (!run.finished) {
       lines.push(`${run.running ? 'Running' : 'Paused'}: t = ${fmt(run.time_s, 1)} s of ${fmt(run.duration_s, 0)} s.`);
-      lines.push(`Pictures taken so far: ${frames}.`);
+      lines.push(`Frames taken so far: ${frames}.`);
       lines.push(run.running
         ? 'Watch the robots follow their walls; the Speed slider above fast-forwards (up to 50×).'
         : 'Press Run (Space) to let the robots finish their run.');
       return this.setLive(lines, false, '');
     }
-    lines.push(`Run finished at t = ${fmt(run.time_s, 1)} s. Pictures: ${frames}.`);
+    lines.push(`Run finished at t = ${fmt(run.time_s, 1)} s. Frames: ${frames}.`);
     const ate = run.robots.map((name, i) => {
       const f = lab.slamFigures(i);
       return `${name} ${fmt(f.ate_m)} m (odometry alone ${fmt(f.odometry_ate_m)} m)`;
     });
     lines.push(`How far each robot\u2019s own position estimate was from the truth (RMS): ${ate.join('; ')}. ` +
       'The Maps panel plots it over time.');
-    lines.push({ class: 'thesis-note', text: 'Thesis: robot1 logged 1,079 groups of data and 134 pictures, robot2 1,020 and 147.' });
+    lines.push({ class: 'thesis-note', text: 'Thesis: robot1 logged 1,079 groups of data and 134 frames, robot2 1,020 and 147.' });
     this.setLive(lines, run.robots.length >= 2, run.robots.length >= 2
       ? 'Data collected: press Next.'
       : 'The merge needs at least two robots.');
@@ -444,16 +444,16 @@ export class GuidedTour {
     ];
     for (const r of sel.robots) {
       const ex = r.selected[0];
-      lines.push(`${r.name}: ${int(r.captured)} pictures → ${int(r.square)} facing a wall squarely → ${int(r.selected.length)} kept` +
-        (ex ? ` (e.g. picture ${ex.frame}, t = ${fmt(ex.step / 10, 0)} s: s₄ = ${fmt(ex.sonar4_m, 3)} m, s₅ = ${fmt(ex.sonar5_m, 3)} m).` : '.'));
+      lines.push(`${r.name}: ${int(r.captured)} frames → ${int(r.square)} facing a wall squarely → ${int(r.selected.length)} kept` +
+        (ex ? ` (e.g. frame ${ex.frame}, t = ${fmt(ex.step / 10, 0)} s: s₄ = ${fmt(ex.sonar4_m, 3)} m, s₅ = ${fmt(ex.sonar5_m, 3)} m).` : '.'));
     }
     const [a, b] = sel.robots;
     const ok = a && b && a.selected.length > 0 && b.selected.length > 0;
     if (ok) lines.push(`Pairs to match: ${int(a.selected.length)} × ${int(b.selected.length)} = ${int(a.selected.length * b.selected.length)}.`);
-    lines.push('On the map: a small triangle where each kept picture was taken, in the robot\u2019s colour, pointing the way the camera looked.');
+    lines.push('On the map: a small triangle where each kept frame was taken, in the robot\u2019s colour, pointing the way the camera looked.');
     lines.push({ class: 'thesis-note', text: 'Thesis: 21 → 5 positions for robot1 and 148 → 19 for robot2; 5 × 19 = 95 pairs.' });
-    this.setLive(lines, ok, ok ? 'Pictures selected: press Next to match them.'
-      : 'A robot kept no picture: it never faced a wall squarely, so this method cannot go on.');
+    this.setLive(lines, ok, ok ? 'Frames selected: press Next to match them.'
+      : 'A robot kept no frame: it never faced a wall squarely, so this method cannot go on.');
   }
 
   refreshMatching() {
@@ -462,14 +462,14 @@ export class GuidedTour {
     const t = v.tables[0];
     const p = v.progress;
     const lines = [];
-    if (p.stage === 'features') lines.push(`Describing the kept pictures with SURF: ${int(p.done)} of ${int(p.total)}.`);
+    if (p.stage === 'features') lines.push(`Describing the kept frames with SURF: ${int(p.done)} of ${int(p.total)}.`);
     else if (t) lines.push(`Pairs checked: ${int(t.cells.length)} of ${int(t.planned)}.`);
     const best = t?.best ? t.cells.find((c) => c[0] === t.best[0] && c[1] === t.best[1]) : null;
     if (best) {
       const fa = v.robots[t.a].frames[best[0]];
       const fb = v.robots[t.b].frames[best[1]];
-      lines.push(`Best pair so far: row ${best[0] + 1} × column ${best[1] + 1} (${v.robots[t.a].name}\u2019s picture ${fa}, ` +
-        `${v.robots[t.b].name}\u2019s picture ${fb}): ${int(best[2])} inliers of ${int(best[3])} matches. ` +
+      lines.push(`Best pair so far: row ${best[0] + 1} × column ${best[1] + 1} (${v.robots[t.a].name}\u2019s frame ${fa}, ` +
+        `${v.robots[t.b].name}\u2019s frame ${fb}): ${int(best[2])} inliers of ${int(best[3])} matches. ` +
         'The orange box marks it in the table; click any cell to see its matches.');
     }
     if (this.pairButton) this.pairButton.disabled = !best;
@@ -514,10 +514,10 @@ export class GuidedTour {
     if (!d) {
       return this.setLive([{ class: 'warn', text: `No distance: ${pair.reason}.` },
         'The method needs both robots to face the same wall squarely, with overlapping views, and the second robot to ' +
-        'move towards it between two kept pictures.'], true, 'No merge with this method on this run.');
+        'move towards it between two kept frames.'], true, 'No merge with this method on this run.');
     }
     const names = v.robots.map((r) => r.name);
-    const frame = ([r, k]) => `${names[r]}\u2019s picture ${v.robots[r].frames[k]}`;
+    const frame = ([r, k]) => `${names[r]}\u2019s frame ${v.robots[r].frames[k]}`;
     const th = fmt(d.tan_half_fov, 4);
     const half = (x) => fmt(x / 2, 1);
     const lines = [

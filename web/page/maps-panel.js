@@ -7,10 +7,12 @@
 // the ground truth, which the mappers never see).
 
 import { robotColour } from './palette.js';
+import { fitCanvas } from './hidpi.js';
 
 const REFRESH_MS = 500;
 const MAP_W = 300;
 const MAP_H = 210;
+const PLOT_H = 70;
 
 export class MapsPanel {
   /**
@@ -82,7 +84,7 @@ export class MapsPanel {
     const plot = document.createElement('canvas');
     plot.className = 'map-plot';
     plot.width = MAP_W;
-    plot.height = 70;
+    plot.height = PLOT_H;
     plot.setAttribute('role', 'img');
     plot.setAttribute('aria-label', `${name}'s position error over time`);
     const links = document.createElement('div');
@@ -99,7 +101,7 @@ export class MapsPanel {
     links.append(pgm, png);
     el.append(title, canvas, figures, plot, links);
     this.host.append(el);
-    return { el, ctx: canvas.getContext('2d'), figures, plot, robot: i, name };
+    return { el, canvas, figures, plot, robot: i, name };
   }
 
   /** The position-error plots shown now, for the run summary: `[{name, src}]` (PNG data URLs). */
@@ -114,6 +116,9 @@ export class MapsPanel {
     }
   }
 
+  /** Redraws every map, figure and plot now: called when a run finishes,
+   *  pauses or steps, so the panel shows the final state, not the one of
+   *  up to REFRESH_MS ago. */
   refresh() {
     const lab = this.hooks.lab();
     if (!lab || !this.blocks.length) return;
@@ -123,13 +128,20 @@ export class MapsPanel {
       for (const b of this.blocks) {
         b.el.hidden = !started;
         if (!started) continue;
-        lab.drawMap(b.ctx, b.robot, this.mapper, MAP_W, MAP_H);
+        const ctx = fitCanvas(b.canvas, MAP_W, MAP_H);
+        lab.drawMap(ctx, b.robot, this.mapper, b.canvas.width, b.canvas.height);
         const f = lab.slamFigures(b.robot);
         const pct = (x) => `${(100 * x).toFixed(0)} %`;
         b.figures.innerHTML =
           `<span>position error (ATE): <b>SLAM ${f.ate_m.toFixed(2)} m</b> · odometry ${f.odometry_ate_m.toFixed(2)} m</span>` +
-          `<span>cells on a real wall: SLAM ${pct(f.occupied_precision)} · odometry ${pct(f.odometry_occupied_precision)}</span>`;
-        this.plot(b, lab.slamErrors(b.robot, 150).rows);
+          `<span>cells on a real wall: SLAM ${pct(f.occupied_precision)} · odometry ${pct(f.odometry_occupied_precision)}</span>` +
+          `<span title="Share of the building's walls (their length) that the map shows">` +
+          `walls mapped: SLAM ${pct(f.wall_coverage)} · odometry ${pct(f.odometry_wall_coverage)}</span>`;
+        const rows = lab.slamErrors(b.robot, 150).rows;
+        // The series is sampled every few steps: end it at the last step.
+        const t = lab.timeS();
+        if (rows.length && rows[rows.length - 1][0] < t - 1e-9) rows.push([t, f.final_error_m, f.odometry_final_error_m]);
+        this.plot(b, rows);
       }
     } catch (e) {
       this.hooks.onError(e);
@@ -138,11 +150,13 @@ export class MapsPanel {
 
   /** Position error over time: SLAM solid, odometry dashed. */
   plot(b, rows) {
-    const c = b.plot.getContext('2d');
-    const { width: w, height: h } = b.plot;
+    const c = fitCanvas(b.plot, MAP_W, PLOT_H);
+    const [w, h] = [MAP_W, PLOT_H];
     c.clearRect(0, 0, w, h);
     c.fillStyle = '#fff';
     c.fillRect(0, 0, w, h);
+    const last = rows[rows.length - 1];
+    b.plot.dataset.last = last ? JSON.stringify(last) : '';
     if (rows.length < 2) return;
     const tMax = rows[rows.length - 1][0] || 1;
     const eMax = Math.max(0.1, ...rows.map((r) => Math.max(r[1], r[2])));

@@ -5,12 +5,15 @@
 // milliseconds per frame), so the page stays responsive while the
 // matched-pair table fills in: one row per frame of the first robot, one
 // column per frame of the second, each checked pair a cell coloured by its
-// inlier count (the thesis's Table 1). Clicking a cell opens the two frames
+// inlier count (the thesis's Table 1; web/page/match-table.js draws it, with
+// its legend and keyboard cursor). Clicking a cell opens the two frames
 // with their matches and the matched-region quad (thesis Figure 8;
 // web/page/pair-view.js). At the
 // end the verdict appears with its reason, the transform of each robot's map
 // frame, its error against the ground truth, and the merged map with
-// downloads (PNG, ROS map_server PGM + YAML, report JSON).
+// downloads (PNG, ROS map_server PGM + YAML, report JSON). A merge the
+// ground truth puts more than 0.5 m or 5° off is called a wrong merge, in
+// red, however confident the method was (web/page/merge-words.js).
 //
 // The panel remembers each method's result on the current run, and a small
 // chart compares their transform errors (position and heading against the
@@ -21,18 +24,20 @@
 import { robotColour } from './palette.js';
 import { deg, el, fmt } from './dom.js';
 import { PairView } from './pair-view.js';
+import { MatchTable } from './match-table.js';
+import { fitCanvas } from './hidpi.js';
+import { isWrong, plainReason, verdictTitle, worstError, wrongMerge, wrongWords } from './merge-words.js';
 
 const SLICE_MS = 12;
-const TABLE_W = 330;
 const MAP_W = 330;
 const MAP_H = 240;
 const CHART_W = 330;
 const CHART_H = 104;
 
 const METHODS = [
-  ['auto', 'Automatic (any view, verified)'],
-  ['thesis', 'Thesis §6.2 (square views)'],
-  ['map-only', 'Map-only baseline (grid features)'],
+  ['auto', 'Automatic (verified)'],
+  ['thesis', 'Thesis §6.2'],
+  ['map-only', 'Map-only baseline'],
 ];
 
 export class MergePanel {
@@ -58,7 +63,9 @@ export class MergePanel {
   }
 
   build() {
-    const select = el('select', { id: 'merge-method', 'aria-label': 'Merge method' });
+    const select = el('select', { id: 'merge-method', 'aria-label': 'Merge method',
+      title: 'Automatic: any view, several places must agree. Thesis §6.2: square views, the best-matched pair. ' +
+        'Map-only: the occupancy grids alone.' });
     for (const [value, text] of METHODS) {
       const o = el('option', { value, text });
       if (value === this.method) o.selected = true;
@@ -73,21 +80,11 @@ export class MergePanel {
     this.progress = el('progress', { id: 'merge-progress', max: '1', value: '0', 'aria-label': 'Merge progress' });
     this.stageText = el('span', { class: 'hint', id: 'merge-stage', text: '' });
     this.hint = el('p', { class: 'hint', id: 'merge-hint' });
-    this.tableTitle = el('div', { class: 'map-title', text: 'Matched-pair table' });
-    this.table = el('canvas', {
-      id: 'merge-table', class: 'merge-table', width: String(TABLE_W), height: '60',
-      role: 'img', tabindex: '0', 'aria-label': 'Matched-pair table: inlier counts per frame pair',
+    this.matchTable = new MatchTable({
+      open: (row, col) => this.openPair(row, col),
+      say: (text) => this.hooks.setStatus(text, 'info'),
     });
-    this.tableHint = el('p', { class: 'hint', id: 'merge-table-hint' });
-    this.table.addEventListener('mousemove', (e) => this.hover(e));
-    this.table.addEventListener('click', (e) => this.clickCell(e));
-    this.table.addEventListener('keydown', (e) => {
-      if (e.key !== 'Enter' || !this.bestCell()) return;
-      // Without this the same Enter would press the Close button that
-      // receives the focus when the pair view opens.
-      e.preventDefault();
-      this.openPair(...this.bestCell());
-    });
+    this.table = this.matchTable.canvas;
     this.verdict = el('div', { id: 'merge-verdict', class: 'merge-verdict', role: 'status', 'aria-live': 'polite' });
     this.transforms = el('table', { id: 'merge-transforms', class: 'merge-transforms' });
     this.distance = el('div', { id: 'merge-distance', class: 'merge-distance', hidden: '' });
@@ -100,7 +97,12 @@ export class MergePanel {
     this.mapNote = el('p', { class: 'hint merge-map-note' });
     this.downloads = el('div', { class: 'merge-downloads' });
     for (const [label, fn] of [
-      ['Merged map PNG', () => this.hooks.download('merged.png', this.lab().mergedPng(), 'image/png')],
+      // The picture the panel shows (map and every robot's path), at 4 × its size.
+      ['Merged map PNG', () => {
+        const c = el('canvas', { width: String(4 * MAP_W), height: String(4 * MAP_H) });
+        this.lab().drawMerged(c.getContext('2d'), c.width, c.height);
+        c.toBlob((blob) => this.hooks.download('merged.png', blob, 'image/png'), 'image/png');
+      }],
       ['ROS map (PGM + YAML)', () => {
         this.hooks.download('merged.pgm', this.lab().mergedPgm(), 'image/x-portable-graymap');
         this.hooks.download('merged.yaml', this.lab().mergedYaml('merged.pgm'), 'text/yaml');
@@ -125,7 +127,7 @@ export class MergePanel {
     this.chartNote = el('p', { class: 'hint', id: 'merge-methods-note' });
     this.chartBox = el('div', { class: 'merge-chart-box', hidden: '' },
       el('div', { class: 'map-title', text: 'Transform error of each method (this run)' }), this.chart, this.chartNote);
-    this.tableBox = el('div', { class: 'merge-table-box', hidden: '' }, this.tableTitle, this.table, this.tableHint);
+    this.tableBox = this.matchTable.box;
     this.host.replaceChildren(
       el('div', { class: 'merge-controls' }, select, this.button),
       el('div', { class: 'merge-progress-row' }, this.progress, this.stageText),
@@ -177,6 +179,7 @@ export class MergePanel {
     this.view = null;
     this.results = {};
     this.drawChart();
+    this.matchTable.reset();
     this.tableBox.hidden = true;
     this.result.hidden = true;
     this.progress.value = 0;
@@ -191,7 +194,9 @@ export class MergePanel {
     if (!this.view && !this.active) {
       this.hint.textContent = can
         ? 'Merge the robots\u2019 maps now, or let them run longer first: the more they have seen in common, the better.'
-        : 'Run the robots (or pause them) to merge their maps.';
+        : this.hooks.robotCount() < 2
+          ? 'Merging needs at least two robots: Reset (R), then Add robot.'
+          : 'Run the robots (or pause them) to merge their maps.';
     }
   }
 
@@ -220,6 +225,7 @@ export class MergePanel {
       this.active = true;
       this.view = null;
       this.result.hidden = true;
+      this.matchTable.reset();
       this.tableBox.hidden = this.method === 'map-only';
       this.hint.textContent = '';
       this.closePair();
@@ -268,105 +274,19 @@ export class MergePanel {
     return this.view?.tables?.[0] ?? null;
   }
 
-  geometry() {
-    const t = this.table0();
-    if (!t) return null;
-    const rows = Math.max(1, t.rows);
-    const cols = Math.max(1, t.cols);
-    const cell = Math.max(1, Math.min(16, Math.floor((TABLE_W - 24) / cols)));
-    const cellH = Math.max(1, Math.min(16, Math.floor(260 / rows), cell * 2));
-    return { t, rows, cols, cell, cellH, x0: 20, y0: 14 };
-  }
-
   drawTable() {
-    const g = this.geometry();
-    if (!g) return;
-    const { t, rows, cols, cell, cellH, x0, y0 } = g;
-    const h = y0 + rows * cellH + 4;
-    if (this.table.height !== h) this.table.height = h;
-    const ctx = this.table.getContext('2d');
-    ctx.fillStyle = '#fff';
-    ctx.fillRect(0, 0, this.table.width, this.table.height);
-    ctx.fillStyle = '#eee';
-    ctx.fillRect(x0, y0, cols * cell, rows * cellH);
-    const max = Math.max(1, ...t.cells.map((c) => c[2]));
-    for (const [r, c, inl] of t.cells) {
-      const v = inl / max;
-      // white (0) → deep blue (max), checked-but-empty cells pale grey
-      const light = inl === 0 ? 92 : 95 - 60 * v;
-      ctx.fillStyle = inl === 0 ? 'hsl(0 0% 86%)' : `hsl(215 70% ${light}%)`;
-      ctx.fillRect(x0 + c * cell, y0 + r * cellH, Math.max(1, cell - (cell > 3 ? 1 : 0)), Math.max(1, cellH - (cellH > 3 ? 1 : 0)));
-      if (cell >= 14 && cellH >= 10 && inl > 0) {
-        ctx.fillStyle = v > 0.55 ? '#fff' : '#123';
-        ctx.font = '8px system-ui, sans-serif';
-        ctx.textAlign = 'center';
-        ctx.fillText(String(inl), x0 + c * cell + cell / 2, y0 + r * cellH + cellH / 2 + 3);
-      }
-    }
-    if (t.best) {
-      const [r, c] = t.best;
-      ctx.strokeStyle = '#e6550d';
-      ctx.lineWidth = 2;
-      ctx.strokeRect(x0 + c * cell - 1, y0 + r * cellH - 1, cell + 1, cellH + 1);
-    }
-    const names = this.view.robots;
-    ctx.fillStyle = robotColour(t.a);
-    ctx.font = '10px system-ui, sans-serif';
-    ctx.textAlign = 'left';
-    ctx.save();
-    ctx.translate(10, y0 + 2);
-    ctx.rotate(Math.PI / 2);
-    ctx.fillText(`${names[t.a].name} frames ↓`, 0, 0);
-    ctx.restore();
-    ctx.fillStyle = robotColour(t.b);
-    ctx.fillText(`${names[t.b].name} frames →`, x0, 10);
-    const checked = t.cells.length;
-    const planned = t.planned;
-    const extra = this.view.tables.length > 1 ? ` (first of ${this.view.tables.length} robot pairs)` : '';
-    this.tableHint.textContent =
-      `${rows} × ${cols} frames, ${checked} of ${planned} pairs checked${extra}. ` +
-      (this.view.method === 'thesis'
-        ? 'Cells: MSAC homography inliers, as the thesis\u2019s Table 1. '
-        : 'Cells: matches that agree on one rigid transform (laser-lifted keypoints). ') +
-      'Click a cell to see its matches; orange box: the best pair.';
-  }
-
-  cellAt(e) {
-    const g = this.geometry();
-    if (!g) return null;
-    const r = this.table.getBoundingClientRect();
-    const x = ((e.clientX - r.left) * this.table.width) / r.width;
-    const y = ((e.clientY - r.top) * this.table.height) / r.height;
-    const col = Math.floor((x - g.x0) / g.cell);
-    const row = Math.floor((y - g.y0) / g.cellH);
-    if (row < 0 || col < 0 || row >= g.rows || col >= g.cols) return null;
-    const found = g.t.cells.find((c) => c[0] === row && c[1] === col);
-    return { row, col, found };
-  }
-
-  hover(e) {
-    const c = this.cellAt(e);
-    if (!c) {
-      this.table.title = '';
-      return;
-    }
-    const names = this.view.robots;
-    const t = this.table0();
-    const fa = names[t.a].frames[c.row];
-    const fb = names[t.b].frames[c.col];
-    this.table.title = c.found
-      ? `${names[t.a].name} frame ${fa} × ${names[t.b].name} frame ${fb}: ${c.found[2]} inliers of ${c.found[3]} matches`
-      : `${names[t.a].name} frame ${fa} × ${names[t.b].name} frame ${fb}: not checked`;
+    this.matchTable.show(this.view);
   }
 
   bestCell() {
-    const t = this.table0();
-    return t?.best ? [t.best[0], t.best[1]] : null;
+    return this.matchTable.best();
   }
 
-  clickCell(e) {
-    const c = this.cellAt(e);
-    if (c?.found) this.openPair(c.row, c.col);
+  /** Scrolls the panel into view and focuses Merge maps: the next step once a run has finished. */
+  reveal() {
+    this.refreshIdle();
+    this.host.closest('.panel')?.scrollIntoView({ block: 'start' });
+    if (!this.button.disabled) this.button.focus({ preventScroll: true });
   }
 
   /** Opens the two frames of a table cell with their matches and the quad (web/page/pair-view.js). */
@@ -409,10 +329,13 @@ export class MergePanel {
     if (!r) return;
     this.result.hidden = false;
     const merged = r.status === 'merged';
-    this.verdict.className = `merge-verdict ${merged ? 'ok' : 'no'}`;
+    const wrong = wrongMerge(r);
+    this.verdict.className = `merge-verdict ${wrong ? 'wrong' : merged ? 'ok' : 'no'}`;
     this.verdict.replaceChildren(
-      el('b', { text: merged ? `Merged (confidence ${fmt(r.confidence)})` : 'No merge' }),
-      el('span', { text: merged ? `: ${r.reason}` : `, because ${r.reason}` }),
+      el('b', { text: verdictTitle(r, fmt) }),
+      wrong ? el('span', { text: '. The method trusted what the robots saw; the ground truth, which it never sees, says ' +
+        `it joined the wrong places. Its reason: ${plainReason(r.reason)}` })
+        : el('span', { text: merged ? `: ${plainReason(r.reason)}` : `, because ${plainReason(r.reason)}` }),
     );
     const head = el('tr', {}, ...['robot', 'x (m)', 'y (m)', 'θ (°)', 'error'].map((t) => el('th', { text: t })));
     const rows = r.transforms.map((t) => {
@@ -422,7 +345,7 @@ export class MergePanel {
       name.style.color = robotColour(i);
       return el('tr', {}, name, el('td', { text: fmt(t.pose[0]) }), el('td', { text: fmt(t.pose[1]) }),
         el('td', { text: fmt(deg(t.pose[2]), 1) }),
-        el('td', { text: e ? `${fmt(e.error_m, 3)} m, ${fmt(e.error_deg, 2)}°` : '–' }));
+        el('td', { class: isWrong(e) && i > 0 ? 'bad' : '', text: e ? `${fmt(e.error_m, 3)} m, ${fmt(e.error_deg, 2)}°` : '–' }));
     });
     this.transforms.replaceChildren(
       el('caption', { text: 'Each robot\u2019s map frame in the merged frame (the first robot\u2019s); error against the ground truth' }),
@@ -440,27 +363,24 @@ export class MergePanel {
     });
     if (merged) {
       try {
-        this.lab().drawMerged(this.map.getContext('2d'), MAP_W, MAP_H);
+        fitCanvas(this.map, MAP_W, MAP_H);
+        this.lab().drawMerged(this.map.getContext('2d'), this.map.width, this.map.height);
       } catch (e) {
         this.hooks.onError(e);
       }
     }
     this.remember(r);
     this.hooks.setStatus(
-      merged ? `Maps merged: ${r.transforms.length} robots joined.` : `No merge: ${r.reason}`,
-      merged ? 'ok' : 'warn',
+      wrong ? `Wrong merge: ${wrongWords(wrong)} (against the ground truth), though the method reports success.`
+        : merged ? `Maps merged: ${r.transforms.length} robots joined.` : `No merge: ${plainReason(r.reason)}`,
+      wrong ? 'error' : merged ? 'ok' : 'warn',
     );
   }
 
   /** Keeps this method's result for the comparison chart. With more than
    *  two robots the worst joined robot's error stands for the method. */
   remember(r) {
-    const first = this.view.robots[0]?.name;
-    let worst = null;
-    for (const e of r.errors) {
-      if (e.robot === first) continue;
-      if (!worst || e.error_m > worst.error_m) worst = e;
-    }
+    const worst = worstError(r);
     this.results[r.method] = r.status === 'merged' && worst
       ? { status: 'merged', error_m: worst.error_m, error_deg: worst.error_deg, robot: worst.robot, reason: r.reason }
       : { status: 'no_merge', reason: r.reason };
@@ -478,7 +398,7 @@ export class MergePanel {
     const any = entries.some(([, , r]) => r);
     this.chartBox.hidden = !any;
     if (!any) return;
-    const ctx = this.chart.getContext('2d');
+    const ctx = fitCanvas(this.chart, CHART_W, CHART_H);
     const W = CHART_W;
     ctx.fillStyle = '#fff';
     ctx.fillRect(0, 0, W, CHART_H);

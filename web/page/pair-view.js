@@ -3,7 +3,11 @@
 // method's fit, red: rejected), and, for the thesis method, the first
 // frame's outline mapped into the second by the homography (the
 // matched-region quad of thesis Figure 8). Opened from the merge panel's
-// matched-pair table (web/page/merge-panel.js) and by the guided mode.
+// matched-pair table (web/page/match-table.js) and by the guided mode.
+// Under the pictures: where each frame was really taken (the truth, which
+// the methods never see), so a false match between two look-alike walls
+// shows as two far-apart places. Closing it (Close or Esc) gives the focus
+// back to where it was when the view opened.
 import { deg, el, fmt } from './dom.js';
 
 const GAP_PX = 12;
@@ -25,6 +29,7 @@ export class PairView {
    */
   open(lab, table, method, row, col) {
     const pv = lab.mergePair(table.pair, row, col);
+    if (!this.isOpen) this.returnTo = document.activeElement;
     const { width: w, height: h } = lab.camera();
     const canvas = el('canvas', { width: String(2 * w + GAP_PX), height: String(h), class: 'pair-canvas', role: 'img',
       'aria-label': `Frame ${pv.a_frame} of ${pv.a} and frame ${pv.b_frame} of ${pv.b} with their matches` });
@@ -70,11 +75,20 @@ export class PairView {
       : 'This pair gives no transform on its own.';
     const close = el('button', { type: 'button', text: 'Close', 'aria-label': 'Close the pair view' });
     close.addEventListener('click', () => this.close());
+    const where = (robot, index, name) => {
+      const t = lab.frame(robot, index).truth;
+      return { t, text: `${name} took frame ${index} at x ${fmt(t[0], 1)} m, y ${fmt(t[1], 1)} m, facing ${fmt(deg(t[2]), 0)}°` };
+    };
+    const wa = where(table.a, pv.a_frame, pv.a);
+    const wb = where(table.b, pv.b_frame, pv.b);
+    const apart = Math.hypot(wa.t[0] - wb.t[0], wa.t[1] - wb.t[1]);
     this.host.replaceChildren(
       el('h2', { text: `${pv.a} frame ${pv.a_frame} ↔ ${pv.b} frame ${pv.b_frame}` }),
       canvas,
       el('p', { text: `${pv.matches.length} ratio-test matches, ${inliers} inliers (green; red: rejected). ` +
         (pv.quad ? 'Yellow: the first image\u2019s outline mapped into the second by the homography (thesis Figure 8). ' : '') + cand }),
+      el('p', { class: 'pair-where', text: `Where they were taken (ground truth, in the world): ${wa.text}; ${wb.text}; ` +
+        `${fmt(apart, 1)} m apart.` }),
       close,
     );
     this.host.hidden = false;
@@ -82,7 +96,11 @@ export class PairView {
   }
 
   close() {
+    const wasOpen = this.isOpen;
     this.host.hidden = true;
     this.host.replaceChildren();
+    const back = this.returnTo;
+    this.returnTo = null;
+    if (wasOpen && back?.isConnected && back !== document.body) back.focus({ preventScroll: true });
   }
 }

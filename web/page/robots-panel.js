@@ -16,6 +16,16 @@ import { robotColour } from './palette.js';
 
 const SONAR_COUNT = 8;
 
+/** What each of the wall follower's modes means (crate/src/follower.rs). */
+const MODE_WORDS = {
+  seek: 'no wall in reach: driving straight to find one',
+  follow: 'following its wall',
+  turn: 'turning in place at a corner',
+  recover: 'backing off after a bump',
+  yield: 'waiting while an oncoming robot goes around',
+  pass: 'going around an oncoming robot',
+};
+
 export class RobotsPanel {
   /**
    * @param {HTMLElement} root    container for the cards
@@ -139,7 +149,7 @@ export class RobotsPanel {
       'dl',
       { class: 'readout' },
       el('dt', {}, 'mode'),
-      el('dd', { class: 'split' }, el('span', {}, value('mode'), bumps), log),
+      el('dd', { class: 'split' }, el('span', {}, value('mode'), bumps, (v.modeWords = el('span', { class: 'mode-words' }))), log),
       el('dt', {}, 'true pose'),
       el('dd', {}, value('truth')),
       el('dt', {}, 'odometry'),
@@ -174,6 +184,7 @@ export class RobotsPanel {
       const r = live ? live[i] : null;
       if (!r) {
         c.v.mode.textContent = 'not started';
+        c.v.modeWords.textContent = '';
         c.v.truth.textContent = '–';
         c.v.odometry.textContent = '–';
         c.v.error.textContent = '–';
@@ -188,6 +199,10 @@ export class RobotsPanel {
         return;
       }
       c.v.mode.textContent = r.mode.replace(/_/g, ' ');
+      c.v.mode.title = MODE_WORDS[r.mode] ?? '';
+      c.v.mode.dataset.words = MODE_WORDS[r.mode] ?? '';
+      // The rare modes are said in words on the card; every mode has its words as a tooltip.
+      c.v.modeWords.textContent = ['yield', 'pass', 'recover'].includes(r.mode) ? ` (${MODE_WORDS[r.mode]})` : '';
       c.v.truth.textContent = pose(r.truth);
       c.v.odometry.textContent = pose(r.odometry);
       c.v.error.textContent = `${fmt(r.odometry_error_m)} m`;

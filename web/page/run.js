@@ -117,10 +117,16 @@ export class RunController {
     this.hooks.refreshControls();
   }
 
+  /** The run reached its duration: every panel shows the final state, and
+   *  the status line says what comes next (merging the maps). */
   finish(st) {
     this.running = false;
-    const parts = st.robots.map((r) => `${r.name}: ${r.bumps} bumps, odometry off by ${fmt(r.odometry_error_m)} m`);
-    setStatus(`Run finished at t = ${fmt(st.time_s, 1)} s (the duration). ${parts.join('; ')}.`, 'ok');
+    this.hooks.refreshPanels();
+    const next = st.robots.length >= 2
+      ? 'Next: merge the robots\u2019 maps with Merge maps (Merge panel, on the right).'
+      : 'Merging needs two robots: Reset (R) and Add robot to try it.';
+    setStatus(`Run finished at t = ${fmt(st.time_s, 1)} s. ${next}`, 'ok');
+    this.hooks.finished?.(st);
   }
 
   /** Advances the simulation for one animation frame at `nowMs`. */

@@ -21,6 +21,22 @@ export const MAX_ROBOTS = 16;
 
 export const clone = (o) => JSON.parse(JSON.stringify(o));
 
+/**
+ * The Lab's placement problems (`{field, message, text}`, worded after the
+ * scenario format: "robots[1].start: robot 'robot2' starts inside or
+ * touching walls[4]") in the words a user reads, with the wall's index to
+ * highlight on the map: "robot2 overlaps a wall (marked in red on the map)".
+ */
+export function problemsInWords(problems) {
+  return problems.map((p) => {
+    const wall = /^robot '(.+)' starts inside or touching walls\[(\d+)\]$/.exec(p.message);
+    if (wall) return { ...p, text: `${wall[1]} overlaps a wall (marked in red on the map)`, wall: Number(wall[2]) };
+    const robot = /^robot '(.+)' overlaps robot '(.+)'$/.exec(p.message);
+    if (robot) return { ...p, text: `${robot[1]} overlaps ${robot[2]}` };
+    return p;
+  });
+}
+
 export class Store {
   /** `wasm`: the loaded wasm-bindgen module; `preset`: the preset the page starts from. */
   constructor(wasm, preset) {
@@ -48,7 +64,7 @@ export class Store {
   }
 
   changed(kind) {
-    this.problems = this.lab.problems();
+    this.problems = problemsInWords(this.lab.problems());
     const sel = this.selection;
     if (sel) {
       const list = sel.kind === 'wall' ? this.scenario.walls : this.scenario.robots;
@@ -86,7 +102,7 @@ export class Store {
   preview(next) {
     try {
       this.lab.setScenario(next);
-      this.problems = this.lab.problems();
+      this.problems = problemsInWords(this.lab.problems());
       return true;
     } catch {
       return false;
@@ -96,7 +112,7 @@ export class Store {
   /** Puts the Lab back on a scenario text shown before a preview (a cancelled drag). */
   revert(text) {
     this.lab.setScenario(text);
-    this.problems = this.lab.problems();
+    this.problems = problemsInWords(this.lab.problems());
   }
 
   /** Goes back one commit; false when there is nothing to undo. */

@@ -17,6 +17,7 @@
 // the data out.
 import { deg, el, fmt } from './dom.js';
 import { message, setStatus } from './status.js';
+import { isWrong, plainReason, verdictTitle, wrongMerge } from './merge-words.js';
 
 const pct = (x) => (Number.isFinite(x) ? `${(100 * x).toFixed(0)} %` : '–');
 
@@ -71,10 +72,10 @@ export function buildSummary(host, data, { onPrint, onClose }) {
   const robotRows = data.robots.map((r) => [
     r.name, `${r.follow} wall, ${fmt(r.distance, 2)} m`, r.frames, r.bumps,
     r.figures ? `${fmt(r.figures.ate_m)} m` : '–', r.figures ? `${fmt(r.figures.odometry_ate_m)} m` : '–',
-    r.figures ? pct(r.figures.occupied_precision) : '–',
+    r.figures ? pct(r.figures.occupied_precision) : '–', r.figures ? pct(r.figures.wall_coverage) : '–',
   ]);
   parts.push(table('Robots: position error (ATE, RMS against the ground truth) of SLAM and of odometry alone',
-    ['robot', 'follows', 'pictures', 'bumps', 'ATE SLAM', 'ATE odometry', 'map cells on a wall'], robotRows));
+    ['robot', 'follows', 'frames', 'bumps', 'ATE SLAM', 'ATE odometry', 'map cells on a wall', 'walls mapped (SLAM)'], robotRows));
   if (data.plots.length) {
     parts.push(el('div', { class: 'summary-figures' },
       ...data.plots.map((p) => figure(p.src, `${p.name}'s position error over time`,
@@ -88,8 +89,10 @@ export function buildSummary(host, data, { onPrint, onClose }) {
     const r = m.report;
     const merged = r.status === 'merged';
     parts.push(el('h2', { text: `Merge (${METHOD_NAMES[r.method] ?? r.method})` }));
-    parts.push(el('p', { class: `summary-verdict ${merged ? 'ok' : 'no'}`,
-      text: merged ? `Merged (confidence ${fmt(r.confidence)}): ${r.reason}.` : `No merge, because ${r.reason}.` }));
+    const wrong = wrongMerge(r);
+    parts.push(el('p', { class: `summary-verdict ${wrong ? 'wrong' : merged ? 'ok' : 'no'}`,
+      text: wrong ? `${verdictTitle(r, fmt)}, against the ground truth. The method’s reason: ${plainReason(r.reason)}.`
+        : merged ? `${verdictTitle(r, fmt)}: ${plainReason(r.reason)}.` : `No merge, because ${plainReason(r.reason)}.` }));
     if (r.transforms.length) {
       parts.push(table('Each robot\u2019s map frame in the merged frame, and its error against the ground truth',
         ['robot', 'x (m)', 'y (m)', 'θ (°)', 'error (m)', 'error (°)'],
@@ -117,7 +120,7 @@ export function buildSummary(host, data, { onPrint, onClose }) {
       ran.map((k) => {
         const x = results[k];
         return x.status === 'merged'
-          ? [METHOD_NAMES[k], 'merged', `${fmt(x.error_m, 3)} m`, `${fmt(Math.abs(x.error_deg), 2)}°`]
+          ? [METHOD_NAMES[k], isWrong(x) ? 'merged WRONG' : 'merged', `${fmt(x.error_m, 3)} m`, `${fmt(Math.abs(x.error_deg), 2)}°`]
           : [METHOD_NAMES[k], 'no merge', '–', '–'];
       })));
   }

@@ -40,6 +40,7 @@ export class WorldView {
     this.layers = { grid: true, laser: true, sonar: false, truth_path: true, odometry_path: true };
     this.marker = null; // where the camera frame picked in a film strip was taken
     this.guideMarkers = null; // selected frames the guided mode marks on the map
+    this.pickMarkers = []; // the frames picked in the film strips, one per robot at most
     this.dirty = true;
   }
 
@@ -102,7 +103,9 @@ export class WorldView {
       v.center = [10, 7.5];
       v.scale = Math.min(v.width / 22, v.height / 17);
     } else {
-      const r = this.lab.fitView(this.canvas.width, this.canvas.height);
+      // Keep a band clear at the top and bottom for the hint and the scale bar.
+      const band = Math.round(34 * this.dpr);
+      const r = this.lab.fitView(this.canvas.width, Math.max(1, this.canvas.height - 2 * band));
       v.center = r.center;
       v.scale = r.scale / this.dpr;
     }
@@ -198,6 +201,7 @@ export class WorldView {
     ctx.setTransform(this.dpr, 0, 0, this.dpr, 0, 0);
     ctx.font = '600 12px system-ui, sans-serif';
     ctx.textBaseline = 'alphabetic';
+    this.drawProblemWalls();
     this.drawGuideMarkers();
     // Robot names next to the robots.
     const poses = this.robotPoses();
@@ -231,12 +235,35 @@ export class WorldView {
     ctx.restore();
   }
 
+  /** Walls a robot overlaps (web/page/state.js `problemsInWords`), in red. */
+  drawProblemWalls() {
+    const walls = this.store.scenario.walls;
+    const ctx = this.ctx;
+    for (const p of this.store.problems) {
+      const w = walls[p.wall];
+      if (!w) continue;
+      const [ax, ay] = this.view.toPx(w.from);
+      const [bx, by] = this.view.toPx(w.to);
+      ctx.strokeStyle = 'rgba(214, 20, 20, 0.8)';
+      ctx.lineWidth = 7;
+      ctx.lineCap = 'round';
+      ctx.beginPath();
+      ctx.moveTo(ax, ay);
+      ctx.lineTo(bx, by);
+      ctx.stroke();
+    }
+    ctx.lineCap = 'butt';
+  }
+
   /** The guided mode's selected frames: a triangle where each kept picture
    *  was taken, pointing along the camera's axis; A', D and E labelled. */
   drawGuideMarkers() {
-    if (!this.guideMarkers) return;
+    const names = this.store.scenario.robots.map((r) => r.name);
+    const picks = this.pickMarkers.map((m) => ({ ...m, label: `${names[m.robot] ?? ''} #${m.index}` }));
+    const all = [...(this.guideMarkers ?? []), ...(picks.length > 1 ? picks : [])];
+    if (!all.length) return;
     const ctx = this.ctx;
-    for (const m of this.guideMarkers) {
+    for (const m of all) {
       const [px, py] = this.view.toPx(m.pose);
       const r = m.label ? 10 : 6;
       const [dx, dy] = [Math.cos(m.pose[2]), -Math.sin(m.pose[2])]; // screen y points down
@@ -309,7 +336,8 @@ export class WorldView {
     const sel = this.store.selection;
     if (!this.hooks.editable()) {
       return this.hooks.state()?.finished
-        ? 'Run finished: press Reset (R) to run again or to edit the map.'
+        ? (scenario.robots.length >= 2 ? 'Run finished: merge the maps (Merge panel), or Reset (R) to run again or edit.'
+          : 'Run finished: press Reset (R) to run again or to edit the map.')
         : 'Paused: press Reset (R) to edit the map.';
     }
     if (this.hooks.tool() === 'wall') return 'Wall tool: drag to draw a wall (snaps to 0.1 m and 15°; Alt or Shift: any angle). Esc: back to Select.';
