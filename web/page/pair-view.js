@@ -4,11 +4,13 @@
 // frame's outline mapped into the second by the homography (the
 // matched-region quad of thesis Figure 8). Opened from the merge panel's
 // matched-pair table (web/page/match-table.js) and by the guided mode.
-// Under the pictures: where each frame was really taken (the truth, which
-// the methods never see), so a false match between two look-alike walls
-// shows as two far-apart places. Closing it (Close or Esc) gives the focus
+// Beside the pictures, a small map of the world with each frame's camera
+// (web/page/pair-map.js), and under them the same in words: where each
+// frame was really taken (the truth, which the methods never see), so a
+// false match between two look-alike walls shows as two far-apart places. Closing it (Close or Esc) gives the focus
 // back to where it was when the view opened.
 import { deg, el, fmt } from './dom.js';
+import { drawPairMap } from './pair-map.js';
 
 const GAP_PX = 12;
 
@@ -82,9 +84,14 @@ export class PairView {
     const wa = where(table.a, pv.a_frame, pv.a);
     const wb = where(table.b, pv.b_frame, pv.b);
     const apart = Math.hypot(wa.t[0] - wb.t[0], wa.t[1] - wb.t[1]);
+    const map = el('canvas', { class: 'pair-map', role: 'img',
+      'aria-label': `Map of the world: where ${pv.a} took frame ${pv.a_frame} and ${pv.b} took frame ${pv.b_frame}, with what each camera saw` });
+    const mapBox = el('figure', { class: 'pair-map-box' },
+      map,
+      el('figcaption', { text: 'Where each frame was taken (ground truth): the dot is the robot, the shade what its camera saw, the thick line that wall.' }));
     this.host.replaceChildren(
       el('h2', { text: `${pv.a} frame ${pv.a_frame} ↔ ${pv.b} frame ${pv.b_frame}` }),
-      canvas,
+      el('div', { class: 'pair-row' }, canvas, mapBox),
       el('p', { text: `${pv.matches.length} ratio-test matches, ${inliers} inliers (green; red: rejected). ` +
         (pv.quad ? 'Yellow: the first image\u2019s outline mapped into the second by the homography (thesis Figure 8). ' : '') + cand }),
       el('p', { class: 'pair-where', text: `Where they were taken (ground truth, in the world): ${wa.text}; ${wb.text}; ` +
@@ -92,6 +99,11 @@ export class PairView {
       close,
     );
     this.host.hidden = false;
+    const marks = [
+      { robot: table.a, name: pv.a, frame: pv.a_frame, pose: wa.t },
+      { robot: table.b, name: pv.b, frame: pv.b_frame, pose: wb.t },
+    ];
+    drawPairMap(map, lab.scenario().walls, marks, lab.camera().hfov_deg, map.clientWidth || 260);
     close.focus({ preventScroll: true });
   }
 
