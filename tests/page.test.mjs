@@ -403,6 +403,30 @@ test('issue 23: a wrong merge stands out; the pair table by keyboard; HiDPI side
   assert.equal(await page.locator('#pair-overlay h2').innerText(), `robot1 frame ${fa} ↔ robot2 frame ${fb}`);
   // Item 6: the pair view says where the two frames were taken.
   assert.match(await page.locator('#pair-overlay .pair-where').innerText(), /robot1 took frame \d+ at x -?\d+\.\d m, y -?\d+\.\d m[\s\S]*\d+\.\d m apart/);
+  // ... and shows it: a map beside the frames, at the pixel ratio, each robot's dot in its colour
+  // where its truth pose puts it (data-view: the map's world-to-canvas mapping).
+  const inset = await page.evaluate(async ([a, b, fa, fb]) => {
+    const colours = JSON.parse((await import('/web/pkg/slamlab.js')).robotColours());
+    const c = document.querySelector('#pair-overlay canvas.pair-map');
+    if (!c) return null;
+    const [x0, y0, scale] = c.dataset.view.split(',').map(Number);
+    const ratio = c.width / c.clientWidth;
+    const g = c.getContext('2d');
+    const dots = [[a, fa], [b, fb]].map(([robot, index]) => {
+      const [x, y] = JSON.parse(window.slamlab.lab.frameJson(robot, index)).truth;
+      const px = Math.round((x - x0) * scale * ratio);
+      const py = Math.round((y0 - y) * scale * ratio);
+      return { want: colours[robot], got: [...g.getImageData(px, py, 1, 1).data.slice(0, 3)], at: [px, py] };
+    });
+    return { w: c.width, css: c.getBoundingClientRect().width, h: c.height, cssH: c.getBoundingClientRect().height, dots };
+  }, [t.a, t.b, fa, fb]);
+  assert.ok(inset, 'the pair view has a map of where the frames were taken');
+  assert.ok(inset.css >= 150 && Math.abs(inset.w - 2 * inset.css) <= 1 && Math.abs(inset.h - 2 * inset.cssH) <= 1,
+    `the pair map: ${inset.w} × ${inset.h} device px for ${inset.css} × ${inset.cssH} CSS px`);
+  assert.notDeepEqual(inset.dots[0].at, inset.dots[1].at);
+  for (const d of inset.dots) {
+    assert.ok(d.got.every((v, k) => Math.abs(v - d.want[k]) <= 3), `pixel ${d.at}: ${d.got}, the robot's colour ${d.want}`);
+  }
   await page.keyboard.press('Escape');
   assert.equal(await page.locator('#pair-overlay').isHidden(), true);
   assert.equal(await page.evaluate(() => document.activeElement.id), 'merge-table', 'Esc gives the focus back to the table');
