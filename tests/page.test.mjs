@@ -341,6 +341,8 @@ test('issue 23: a wrong merge stands out; the pair table by keyboard; HiDPI side
   // Exercise 5: every wall the same texture; the thesis method joins two look-alike places.
   await page.setInputFiles('#import-file', path.join(ROOT, 'scenarios/ex-repeated.json'));
   await page.waitForFunction(() => window.slamlab.scenario().walls.every((w) => w.texture === 'brick'));
+  // The scenario select names the imported exercise, not "(your scenario)".
+  assert.equal(await page.locator('#preset option:checked').innerText(), '“ex-repeated”');
   await runToEnd(page);
 
   // Item 10: the method names fit their select.

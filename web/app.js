@@ -14,7 +14,8 @@
 //   summary.js      the printable summary, read from each panel's method
 //   palette.js      the robots' colours; status.js the status line and guard
 //   *-panel.js, guided.js  the side and bottom panels, the guided mode;
-//                   pair-view.js the merge's frame pair over the page,
+//                   pair-view.js the merge's frame pair over the page
+//                   (pair-map.js: where the two were taken),
 //                   match-table.js its matched-pair table; merge-words.js the
 //                   verdict in words; hidpi.js canvases at the pixel ratio
 // and web/lab.js, the facade over the wasm `Lab` the command line uses too.

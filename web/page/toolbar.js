@@ -62,6 +62,10 @@ export class Toolbar {
     const store = this.page.store;
     $('seed').value = String(store.scenario.seed);
     $('duration').value = String(store.scenario.duration_s);
+    // not a preset (imported, e.g. an exercise's file, or new): the select names it
+    const own = $('preset').querySelector('option[value=""]');
+    const name = store.scenario.name?.trim();
+    own.textContent = name ? `“${name.length > 22 ? `${name.slice(0, 21)}…` : name}”` : '(your scenario)';
     $('preset').value = store.preset;
   }
 
