@@ -1,0 +1,86 @@
+// How the page holds up on a big scenario (issue 22): frame rate, long
+// tasks and simulated-time rate while running in headless Chromium.
+//
+// Usage: node tests/bench/page_perf.mjs SCENARIO.json [--speed 50] [--seconds 10]
+//        [--width 1366 --height 768]
+// Imports the scenario through the page's Import button, sets the speed
+// slider, presses Run, and for `--seconds` of wall time counts animation
+// frames, records every long task (PerformanceObserver 'longtask') and reads
+// the simulated clock. Prints one JSON line:
+// {walls, robots, fps, frames, longtasks, longest_ms, sim_rate}, sim_rate =
+// simulated seconds per wall second. Needs ./build.sh build and Chromium.
+import path from 'node:path';
+import { readFile } from 'node:fs/promises';
+import { chromium } from 'playwright-core';
+import { CHROMIUM_FLAGS, serveRoot, waitReady } from '../support/browser.mjs';
+
+const args = process.argv.slice(2);
+const opt = (name, dflt) => {
+  const i = args.indexOf(`--${name}`);
+  return i >= 0 ? Number(args[i + 1]) : dflt;
+};
+const file = args[0];
+if (!file) {
+  console.error('usage: node tests/bench/page_perf.mjs SCENARIO.json [--speed 50] [--seconds 10]');
+  process.exit(2);
+}
+const speed = opt('speed', 50);
+const seconds = opt('seconds', 10);
+const viewport = { width: opt('width', 1366), height: opt('height', 768) };
+const body = await readFile(file);
+const scenario = JSON.parse(body);
+
+const { server, url } = await serveRoot();
+const browser = await chromium.launch({ executablePath: '/usr/bin/chromium', args: CHROMIUM_FLAGS });
+try {
+  const page = await (await browser.newContext({ viewport })).newPage();
+  page.on('pageerror', (e) => console.error(`page error: ${e.message}`));
+  await page.goto(url);
+  await waitReady(page);
+  await page.setInputFiles('#import-file', { name: path.basename(file), mimeType: 'application/json', buffer: body });
+  await page.waitForFunction((n) => window.slamlab.scenario().walls.length === n, scenario.walls.length, {
+    timeout: 60000,
+  });
+  await page.evaluate((v) => {
+    const s = document.getElementById('speed');
+    s.value = String(v);
+    s.dispatchEvent(new Event('input', { bubbles: true }));
+  }, speed);
+  await page.evaluate(() => {
+    window.__perf = { frames: 0, long: [] };
+    new PerformanceObserver((list) => {
+      for (const e of list.getEntries()) window.__perf.long.push(e.duration);
+    }).observe({ type: 'longtask' });
+    const tick = () => {
+      window.__perf.frames++;
+      requestAnimationFrame(tick);
+    };
+    requestAnimationFrame(tick);
+  });
+  const t0 = await page.evaluate(() => window.slamlab.state().time_s ?? window.slamlab.lab.timeS());
+  await page.click('#run');
+  const w0 = Date.now();
+  await page.evaluate(() => (window.__perf.frames = 0));
+  await page.waitForTimeout(seconds * 1000);
+  const out = await page.evaluate(() => ({
+    frames: window.__perf.frames,
+    long: window.__perf.long,
+    t: window.slamlab.lab.timeS(),
+  }));
+  const wall = (Date.now() - w0) / 1000;
+  console.log(
+    JSON.stringify({
+      walls: scenario.walls.length,
+      robots: scenario.robots.length,
+      speed,
+      fps: +(out.frames / wall).toFixed(1),
+      frames: out.frames,
+      longtasks: out.long.length,
+      longest_ms: Math.round(Math.max(0, ...out.long)),
+      sim_rate: +((out.t - t0) / wall).toFixed(1),
+    }),
+  );
+} finally {
+  await browser.close();
+  server.close();
+}
