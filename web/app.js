@@ -39,6 +39,7 @@ import { Persistence } from './page/persistence.js';
 import { Toolbar, download } from './page/toolbar.js';
 import { Summary } from './page/summary.js';
 import { setRobotColours } from './page/palette.js';
+import { fitStats } from './page/hidpi.js';
 import { makeGuard, message, reportUncaught, setStatus } from './page/status.js';
 import { RobotsPanel } from './page/robots-panel.js';
 import { CameraPanel } from './page/camera-panel.js';
@@ -264,6 +265,9 @@ async function main() {
     markers: () => clone(view.guideMarkers),
     /** The frames picked in the film strips and marked on the map: `[[robot, index]]`. */
     picks: () => view.pickMarkers.map((m) => [m.robot, m.index]),
+    /** Work counters for the page tests (issue 22): live camera renders per
+     *  robot, maps scored, canvas backing stores resized. */
+    perf: () => ({ liveDraws: [...cameraPanel.liveDraws], scored: mapsPanel.scored, resized: fitStats.resized }),
   };
   document.body.dataset.ready = 'true';
   requestAnimationFrame(frame);
