@@ -192,11 +192,14 @@ export class CameraPanel {
 
   /** Called every animation frame; `changed` when the world moved or was edited. */
   update(nowMs, changed) {
-    if (!this.blocks.length) return;
-    if (changed && nowMs - this.lastLiveMs >= LIVE_INTERVAL_MS) {
-      this.lastLiveMs = nowMs;
-      this.refresh(false);
-    }
+    if (!this.blocks.length || !changed) return;
+    // One on-screen block per turn, so that each refreshes about every
+    // LIVE_INTERVAL_MS and no single frame renders them all.
+    const shown = this.blocks.filter((b) => b.visible);
+    if (!shown.length || nowMs - this.lastLiveMs < LIVE_INTERVAL_MS / shown.length) return;
+    this.lastLiveMs = nowMs;
+    this.turn = ((this.turn ?? -1) + 1) % shown.length;
+    this.refreshBlock(shown[this.turn], false);
   }
 
   /** Redraws the live views and grows the strips: every block when
@@ -206,13 +209,23 @@ export class CameraPanel {
     if (!lab) return;
     try {
       for (const b of this.blocks) {
-        if (!force && !b.visible) continue;
-        if (b.selected === null) {
-          lab.drawCamera(b.robot, b.ctx);
-          this.liveDraws[b.robot]++;
-        }
-        this.syncStrip(lab, b, force);
+        if (force || b.visible) this.refreshBlock(b, force);
       }
+    } catch (e) {
+      this.hooks.onError(e);
+    }
+  }
+
+  /** Robot `b`'s live view (unless a frame is picked) and strip. */
+  refreshBlock(b, force) {
+    const lab = this.hooks.lab();
+    if (!lab) return;
+    try {
+      if (b.selected === null) {
+        lab.drawCamera(b.robot, b.ctx);
+        this.liveDraws[b.robot]++;
+      }
+      this.syncStrip(lab, b, force);
     } catch (e) {
       this.hooks.onError(e);
     }
