@@ -117,7 +117,7 @@ export class CameraPanel {
     el.append(head, body);
     this.host.append(el);
     this.seen?.observe(el);
-    return { el, visible: true, what, live, goto, view, ctx: view.getContext('2d'), strip, empty, shown: [], robot: i, selected: null };
+    return { el, visible: !this.seen, what, live, goto, view, ctx: view.getContext('2d'), strip, empty, shown: [], robot: i, selected: null };
   }
 
   /** Shows captured frame `index` in robot `robot`'s view (live again with

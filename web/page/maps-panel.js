@@ -118,7 +118,7 @@ export class MapsPanel {
     el.append(title, canvas, figures, plot, links);
     this.host.append(el);
     this.seen?.observe(el);
-    return { el, visible: true, html: '', canvas, figures, plot, robot: i, name };
+    return { el, visible: !this.seen, html: '', canvas, figures, plot, robot: i, name };
   }
 
   /** The position-error plots shown now, for the run summary: `[{name, src}]` (PNG data URLs). */
