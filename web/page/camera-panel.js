@@ -36,6 +36,7 @@ export class CameraPanel {
     this.blocks = [];
     this.key = '';
     this.lastLiveMs = 0;
+    this.turn = -1; // the on-screen block whose live view was refreshed last
     this.scratch = document.createElement('canvas');
     this.camera = { width: 320, height: 240, hfov_deg: 60 };
     /** Live renders per robot (for the page tests: hidden blocks render none while running). */
@@ -198,7 +199,7 @@ export class CameraPanel {
     const shown = this.blocks.filter((b) => b.visible);
     if (!shown.length || nowMs - this.lastLiveMs < LIVE_INTERVAL_MS / shown.length) return;
     this.lastLiveMs = nowMs;
-    this.turn = ((this.turn ?? -1) + 1) % shown.length;
+    this.turn = (this.turn + 1) % shown.length;
     this.refreshBlock(shown[this.turn], false);
   }
 
