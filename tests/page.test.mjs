@@ -525,3 +525,71 @@ test('issue 23: problems in words with the wall marked; one robot cannot merge; 
   assert.deepEqual(problems, [], 'no console errors or page errors');
   await context.close();
 });
+
+/** A 16-robot scenario: a 40 × 40 m room with a row of pillars, the robots on a 4 × 4 grid. */
+function crowdScenario() {
+  const walls = [[[0, 0], [40, 0]], [[40, 0], [40, 40]], [[40, 40], [0, 40]], [[0, 40], [0, 0]]];
+  for (const x of [10, 20, 30]) walls.push([[x, 8], [x, 32]]);
+  const robots = [];
+  for (let i = 0; i < 16; i++) {
+    const [cx, cy] = [5 + 10 * (i % 4), 5 + 10 * Math.floor(i / 4)];
+    robots.push({ name: `r${i + 1}`, start: [cx - 2.5, cy, 1.2], follow: i % 2 ? 'right' : 'left', distance: 0.6 });
+  }
+  return { name: 'crowd16', seed: 3, duration_s: 120, walls: walls.map(([from, to]) => ({ from, to })), robots };
+}
+
+test('issue 22: 16 robots at 20×: only on-screen panels render while running, canvases keep their size, all catch up on pause', { timeout: 180000 }, async () => {
+  const { context, page, problems } = await pageWith({ width: 1366, height: 768 });
+  const s = crowdScenario();
+  await page.setInputFiles('#import-file', { name: 'crowd.json', mimeType: 'application/json', buffer: Buffer.from(JSON.stringify(s)) });
+  await page.waitForFunction(() => window.slamlab.scenario().robots.length === 16);
+  assert.deepEqual(await page.evaluate(() => window.slamlab.problems()), []);
+  await page.locator('#speed').fill('20');
+  await page.locator('#speed').dispatchEvent('input');
+  await page.evaluate(() => {
+    window.__long = [];
+    new PerformanceObserver((l) => l.getEntries().forEach((e) => window.__long.push(e.duration))).observe({ type: 'longtask' });
+  });
+  await page.getByRole('button', { name: 'Run', exact: true }).click();
+  await page.waitForTimeout(1500); // the map blocks appear and take their size
+  const perf = () => page.evaluate(() => window.slamlab.perf());
+  const a = await perf();
+  const tA = await page.evaluate(() => performance.now());
+  await page.waitForTimeout(3000);
+  const b = await perf();
+  const secs = ((await page.evaluate(() => performance.now())) - tA) / 1000;
+  // Which camera blocks are on screen now (inside the window and their scrolling panel).
+  const onScreen = await page.evaluate(() => [...document.querySelectorAll('.cam-block')].map((el) => {
+    const r = el.getBoundingClientRect();
+    const p = el.closest('.cam-blocks').parentElement.getBoundingClientRect();
+    const top = Math.max(0, p.top);
+    const bottom = Math.min(window.innerHeight, p.bottom);
+    return r.bottom > top && r.top < bottom && r.right > 0 && r.left < window.innerWidth;
+  }));
+  const drew = b.liveDraws.map((n, i) => n - a.liveDraws[i]);
+  assert.ok(onScreen.some((v) => v) && onScreen.some((v) => !v), `some camera blocks on screen, some not: ${onScreen}`);
+  for (let i = 0; i < 16; i++) {
+    if (!onScreen[i]) assert.equal(drew[i], 0, `robot ${i + 1}'s camera is off screen but was rendered ${drew[i]} times`);
+  }
+  assert.ok(drew.some((n) => n > 0), `an on-screen camera view is live: ${drew}`);
+  assert.equal(b.resized, a.resized, 'no canvas backing store is reassigned while its size stays the same');
+  // The Maps panel scores at most every 0.5 s, and only the maps on screen.
+  assert.ok(b.scored - a.scored <= 16 * (secs / 0.5 + 1), `maps scored ${b.scored - a.scored} times in ${secs.toFixed(1)} s`);
+  const st = await state(page);
+  assert.ok(st.time_s > 1, `the simulated clock advances (t = ${st.time_s} s)`);
+  const longest = await page.evaluate(() => Math.max(0, ...window.__long));
+  assert.ok(longest < 3000, `no task blocks the page for seconds (longest ${longest.toFixed(0)} ms)`); // generous: CI is slow
+
+  // Pause: every strip and every map is brought up to the paused state.
+  await page.getByRole('button', { name: 'Pause', exact: true }).click();
+  const counts = await page.evaluate(() => {
+    const lab = window.slamlab.lab;
+    return [...document.querySelectorAll('.cam-strip')].map((el, i) => [Number(el.dataset.frames), lab.frameCount(i)]);
+  });
+  for (const [shown, have] of counts) assert.equal(shown, have, `every strip shows every frame on pause: ${JSON.stringify(counts)}`);
+  assert.ok(counts.every(([n]) => n > 0));
+  const maps = await page.evaluate(() => [...document.querySelectorAll('.map-block')].map((el) => !el.hidden && /ATE/.test(el.textContent)));
+  assert.deepEqual(maps, Array(16).fill(true), 'every robot\u2019s map figures are shown on pause');
+  assert.deepEqual(problems, []);
+  await context.close();
+});

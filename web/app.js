@@ -39,6 +39,7 @@ import { Persistence } from './page/persistence.js';
 import { Toolbar, download } from './page/toolbar.js';
 import { Summary } from './page/summary.js';
 import { setRobotColours } from './page/palette.js';
+import { fitStats } from './page/hidpi.js';
 import { makeGuard, message, reportUncaught, setStatus } from './page/status.js';
 import { RobotsPanel } from './page/robots-panel.js';
 import { CameraPanel } from './page/camera-panel.js';
@@ -198,14 +199,29 @@ function onChange(kind) {
   if (kind === 'load') view.fit();
 }
 
+const WORLD_FRAME_MS = 33; // the world view's redraw interval while running (about 30 per second)
+const WORLD_SHARE = 3; // ... and at most every 3 times its drawing time (a third of the time)
+let lastWorldMs = 0;
+let worldDrawMs = 0;
+
 /** One animation frame: advance the run, redraw what changed, let the panels follow. */
 function frame(now) {
   requestAnimationFrame(frame);
   if (!store.lab) return;
   try {
     if (runner.running) runner.advance(now);
-    const changed = view.dirty;
-    if (view.dirty) view.draw();
+    // While running, the world view is redrawn at most every WORLD_FRAME_MS
+    // and at most every WORLD_SHARE times what its last drawing took (issue 22:
+    // 16 robots' laser rays took 20-40 ms to draw, more than a frame's steps),
+    // so that drawing leaves most of the time to the simulation.
+    const gap = Math.max(WORLD_FRAME_MS, WORLD_SHARE * worldDrawMs);
+    const changed = view.dirty && (!runner.running || now - lastWorldMs >= gap);
+    if (changed) {
+      const t0 = performance.now();
+      view.draw();
+      worldDrawMs = performance.now() - t0;
+      lastWorldMs = now;
+    }
     cameraPanel.update(now, changed || runner.running);
     mapsPanel.update(now, changed || runner.running);
     mergePanel.update(now);
@@ -264,6 +280,9 @@ async function main() {
     markers: () => clone(view.guideMarkers),
     /** The frames picked in the film strips and marked on the map: `[[robot, index]]`. */
     picks: () => view.pickMarkers.map((m) => [m.robot, m.index]),
+    /** Work counters for the page tests (issue 22): live camera renders per
+     *  robot, maps scored, canvas backing stores resized. */
+    perf: () => ({ liveDraws: [...cameraPanel.liveDraws], scored: mapsPanel.scored, resized: fitStats.resized }),
   };
   document.body.dataset.ready = 'true';
   requestAnimationFrame(frame);

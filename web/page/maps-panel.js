@@ -5,6 +5,13 @@
 // by matching the scan against the map. The switch shows either; the small
 // plot shows both robots' position error over time for both mappers (against
 // the ground truth, which the mappers never see).
+//
+// Scoring a map against the truth (`slamFigures`) and drawing it cost a few
+// milliseconds per robot; with 16 robots that took over a frame (issue 22).
+// So while a run goes the panel refreshes at most every REFRESH_MS and
+// only the blocks on screen (an IntersectionObserver tells which); when the
+// run pauses, steps or ends, `refresh()` redraws and scores every block, so
+// the figures shown are the final ones.
 
 import { robotColour } from './palette.js';
 import { fitCanvas } from './hidpi.js';
@@ -27,6 +34,14 @@ export class MapsPanel {
     this.key = '';
     this.lastMs = 0;
     this.blocks = [];
+    /** Maps scored so far (for the page tests: bounded while running). */
+    this.scored = 0;
+    this.seen = typeof IntersectionObserver === 'undefined' ? null : new IntersectionObserver((entries) => {
+      for (const e of entries) {
+        const b = this.blocks.find((x) => x.el === e.target);
+        if (b) b.visible = e.isIntersecting;
+      }
+    });
   }
 
   sync(scenario) {
@@ -61,6 +76,7 @@ export class MapsPanel {
     this.empty.className = 'hint';
     this.empty.textContent = 'The maps grow here while the robots run.';
     this.host.append(bar, note, this.empty);
+    this.seen?.disconnect();
     this.blocks = scenario.robots.map((r, i) => this.makeBlock(r.name, i));
     this.refresh(true);
   }
@@ -101,7 +117,8 @@ export class MapsPanel {
     links.append(pgm, png);
     el.append(title, canvas, figures, plot, links);
     this.host.append(el);
-    return { el, canvas, figures, plot, robot: i, name };
+    this.seen?.observe(el);
+    return { el, visible: !this.seen, html: '', canvas, figures, plot, robot: i, name };
   }
 
   /** The position-error plots shown now, for the run summary: `[{name, src}]` (PNG data URLs). */
@@ -118,8 +135,9 @@ export class MapsPanel {
 
   /** Redraws every map, figure and plot now: called when a run finishes,
    *  pauses or steps, so the panel shows the final state, not the one of
-   *  up to REFRESH_MS ago. */
-  refresh() {
+   *  up to REFRESH_MS ago. `all === false` (while running): only the blocks
+   *  on screen. */
+  refresh(all = true) {
     const lab = this.hooks.lab();
     if (!lab || !this.blocks.length) return;
     const started = lab.timeS() > 0;
@@ -127,16 +145,18 @@ export class MapsPanel {
     try {
       for (const b of this.blocks) {
         b.el.hidden = !started;
-        if (!started) continue;
+        if (!started || (!all && !b.visible)) continue;
         const ctx = fitCanvas(b.canvas, MAP_W, MAP_H);
         lab.drawMap(ctx, b.robot, this.mapper, b.canvas.width, b.canvas.height);
         const f = lab.slamFigures(b.robot);
+        this.scored++;
         const pct = (x) => `${(100 * x).toFixed(0)} %`;
-        b.figures.innerHTML =
+        const html =
           `<span>position error (ATE): <b>SLAM ${f.ate_m.toFixed(2)} m</b> · odometry ${f.odometry_ate_m.toFixed(2)} m</span>` +
           `<span>cells on a real wall: SLAM ${pct(f.occupied_precision)} · odometry ${pct(f.odometry_occupied_precision)}</span>` +
           `<span title="Share of the building's walls (their length) that the map shows">` +
           `walls mapped: SLAM ${pct(f.wall_coverage)} · odometry ${pct(f.odometry_wall_coverage)}</span>`;
+        if (html !== b.html) b.figures.innerHTML = b.html = html;
         const rows = lab.slamErrors(b.robot, 150).rows;
         // The series is sampled every few steps: end it at the last step.
         const t = lab.timeS();

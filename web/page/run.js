@@ -25,7 +25,11 @@ export class RunController {
     this.speed = 10; // simulated seconds per real second
     this.lastFrameMs = 0;
     this.stepCarry = 0;
-    this.maxStepsPerFrame = 100;
+    // Steps a frame may take, from the measured cost of a step. It starts at
+    // one and at most doubles a frame, so that the first frame of a run (no
+    // measure yet) or one fast step cannot start a long task (issue 22: 20
+    // steps of 16 robots in the first frame took 300+ ms).
+    this.maxStepsPerFrame = 1;
     /** The run's state as last read (web/lab.js `state()`), or null. */
     this.state = null;
     for (const k of ['run', 'pause', 'step', 'reset']) this[k] = hooks.guard(this[k].bind(this));
@@ -144,7 +148,8 @@ export class RunController {
     const t0 = performance.now();
     const taken = this.lab.step(n);
     const perStep = (performance.now() - t0) / Math.max(1, taken);
-    this.maxStepsPerFrame = clamp(Math.floor(FRAME_BUDGET_MS / Math.max(perStep, 1e-3)), 1, 1000);
+    const fit = Math.floor(FRAME_BUDGET_MS / Math.max(perStep, 1e-3));
+    this.maxStepsPerFrame = clamp(fit, 1, Math.min(1000, 2 * this.maxStepsPerFrame));
     this.hooks.invalidate();
     if (taken < n) this.afterSteps(taken, n);
     else if (this.lab.timeS() + 1e-9 >= this.store.scenario.duration_s) this.afterSteps(taken, taken + 1);
