@@ -6,7 +6,10 @@
 //! `SLAMLAB_BLESS=1 cargo test -p slamlab --test render`.
 
 use slamlab::lab::Lab;
-use slamlab::render::{grid_step_m, scale_bar_m, Layers, RenderOptions};
+use slamlab::render::{
+    grid_step_m, render_world, render_world_cached, scale_bar_m, Layers, RenderOptions, WallLayer,
+};
+use slamlab::scenario::Scenario;
 use wasm_bindgen_test::wasm_bindgen_test;
 
 const THESIS: &str = include_str!("../scenarios/thesis.json");
@@ -125,4 +128,46 @@ fn grid_and_scale_bar_steps_are_round_numbers() {
     assert_eq!(grid_step_m(10.0), 5.0);
     assert_eq!(scale_bar_m(40.0), 2.0);
     assert_eq!(scale_bar_m(200.0), 0.5);
+}
+
+#[test]
+#[wasm_bindgen_test]
+fn cached_walls_draw_as_fresh_ones_and_follow_an_edit() {
+    let mut scenario = Scenario::from_json(THESIS).unwrap();
+    let mut o = RenderOptions {
+        width: 320,
+        height: 240,
+        ..RenderOptions::default()
+    };
+    o.fit(&scenario);
+    let fresh = |sc: &Scenario, o: &RenderOptions| {
+        let mut pm = tiny_skia::Pixmap::new(o.width, o.height).unwrap();
+        render_world(&mut pm, sc, None, o);
+        pm.data().to_vec()
+    };
+    let mut cache = WallLayer::default();
+    let mut pm = tiny_skia::Pixmap::new(o.width, o.height).unwrap();
+    let mut cached = |sc: &Scenario, o: &RenderOptions| {
+        render_world_cached(&mut pm, sc, None, o, &mut cache);
+        pm.data().to_vec()
+    };
+    // Drawn through the layer: as drawn straight (within rounding).
+    let first = cached(&scenario, &o);
+    compare(&fresh(&scenario, &o), &first);
+    // Drawn again from the layer: the same picture to the byte.
+    assert_eq!(cached(&scenario, &o), first);
+    // A wall moved: the layer is redrawn, not reused.
+    scenario.walls[0].to[1] += 3.0;
+    let moved = cached(&scenario, &o);
+    assert_ne!(moved, first, "the moved wall must show");
+    compare(&fresh(&scenario, &o), &moved);
+    // Panned: likewise.
+    o.center[0] += 1.0;
+    compare(&fresh(&scenario, &o), &cached(&scenario, &o));
+}
+
+/// Two RGBA pictures equal up to 8-bit rounding of the composed layer.
+fn compare(a: &[u8], b: &[u8]) {
+    let worst = a.iter().zip(b).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
+    assert!(worst <= 2, "cached walls differ from fresh ones by {worst} levels");
 }

@@ -23,8 +23,8 @@ use crate::sim::Simulation;
 use glam::DVec2;
 use serde::Deserialize;
 use tiny_skia::{
-    Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Rect, Stroke, StrokeDash,
-    Transform,
+    Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, PixmapPaint, Rect, Stroke,
+    StrokeDash, Transform,
 };
 
 /// Which layers to draw.
@@ -261,6 +261,66 @@ pub fn scale_bar_m(scale_px_per_m: f64) -> f64 {
     best
 }
 
+/// The walls drawn once on a transparent layer, kept while the view, the
+/// walls, the selection and the seed stay the same.
+///
+/// Walls do not move while robots run, but a world of thousands of walls
+/// costs far more to stroke than the rest of a frame; composing a cached
+/// layer costs one pass over the pixels whatever the number of walls.
+/// Source-over is associative, so walls drawn on a transparent layer and
+/// then laid over the picture look as walls drawn straight onto it (up to
+/// the rounding of 8-bit premultiplied colour).
+#[derive(Default)]
+pub struct WallLayer {
+    key: u64,
+    layer: Option<Pixmap>,
+}
+
+impl WallLayer {
+    /// What the layer depends on, hashed (`DefaultHasher::new()` has fixed
+    /// keys: the same inputs give the same key in every run).
+    fn key_of(scenario: &Scenario, o: &RenderOptions) -> u64 {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        (o.width, o.height, o.selected_wall, scenario.seed).hash(&mut h);
+        for v in [o.center[0], o.center[1], o.scale] {
+            v.to_bits().hash(&mut h);
+        }
+        for w in &scenario.walls {
+            for v in w.from.iter().chain(&w.to) {
+                v.to_bits().hash(&mut h);
+            }
+            w.texture.hash(&mut h);
+        }
+        h.finish()
+    }
+
+    /// Draws the walls onto `pm`, from the layer when it is still valid.
+    fn draw(&mut self, pm: &mut Pixmap, o: &RenderOptions, scenario: &Scenario) {
+        let key = Self::key_of(scenario, o);
+        let fits = matches!(&self.layer, Some(l) if l.width() == o.width && l.height() == o.height);
+        if !fits || self.key != key {
+            let Some(mut layer) = Pixmap::new(o.width, o.height) else {
+                draw_walls(pm, o, scenario);
+                return;
+            };
+            draw_walls(&mut layer, o, scenario);
+            self.layer = Some(layer);
+            self.key = key;
+        }
+        if let Some(layer) = &self.layer {
+            pm.draw_pixmap(
+                0,
+                0,
+                layer.as_ref(),
+                &PixmapPaint::default(),
+                Transform::identity(),
+                None,
+            );
+        }
+    }
+}
+
 /// Renders the scenario (and the running simulation, if any) into `pm`,
 /// which must be `opts.width × opts.height`. Layers go bottom to top: the
 /// grid, the trajectories, the walls, the sensors, the robots, the camera
@@ -271,6 +331,18 @@ pub fn render_world(
     sim: Option<&Simulation>,
     opts: &RenderOptions,
 ) {
+    render_world_cached(pm, scenario, sim, opts, &mut WallLayer::default());
+}
+
+/// [`render_world`] with the walls kept in `walls` between calls (the
+/// page's view redrawn every frame).
+pub fn render_world_cached(
+    pm: &mut Pixmap,
+    scenario: &Scenario,
+    sim: Option<&Simulation>,
+    opts: &RenderOptions,
+    walls: &mut WallLayer,
+) {
     pm.fill(Color::from_rgba8(250, 250, 247, 255));
     let o = opts;
     if o.layers.grid {
@@ -280,7 +352,8 @@ pub fn render_world(
     if let Some(sim) = sim {
         draw_paths(pm, o, sim);
     }
-    draw_walls(pm, o, scenario);
+    walls.draw(pm, o, scenario);
+    draw_preview_wall(pm, o);
     // Sensors, then robots on top.
     let poses: Vec<Pose2> = match sim {
         Some(sim) => sim.robots.iter().map(|r| r.truth).collect(),
@@ -418,7 +491,10 @@ fn draw_walls(pm: &mut Pixmap, o: &RenderOptions, scenario: &Scenario) {
             &stroke(wall_px),
         );
     }
+}
 
+/// The wall being drawn with the Wall tool, dashed.
+fn draw_preview_wall(pm: &mut Pixmap, o: &RenderOptions) {
     if let Some(p) = o.preview_wall {
         let mut s = stroke(3.0);
         s.dash = StrokeDash::new(vec![8.0, 5.0], 0.0);

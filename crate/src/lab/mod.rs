@@ -26,7 +26,7 @@
 use crate::camera::capture::CapturedFrame;
 use crate::camera::texture::{ImageTexture, TextureBank};
 use crate::camera::{render as render_camera, robot_boxes, CameraImage, PinholeCamera};
-use crate::render::{render_world, RenderOptions};
+use crate::render::{render_world_cached, RenderOptions, WallLayer};
 use crate::scenario::{Scenario, ScenarioError, MAX_DURATION_S};
 use crate::sensors::laser::beam_bearing;
 use crate::sim::{Simulation, LASER_LOG_NO_RETURN};
@@ -48,6 +48,8 @@ pub struct Lab {
     sim: Option<Simulation>,
     view: RenderOptions,
     pixmap: Option<Pixmap>,
+    /// The view's walls, drawn once while they and the view stay put.
+    walls: WallLayer,
     /// Texture cache and loaded pictures while no simulation holds them.
     textures: Option<TextureBank>,
     /// The world of the scenario being edited (for camera previews).
@@ -106,6 +108,7 @@ impl Lab {
             sim: None,
             view,
             pixmap: None,
+            walls: WallLayer::default(),
             textures: None,
             preview_world: None,
             merge: None,
@@ -328,7 +331,13 @@ impl Lab {
                 Some(Pixmap::new(w, h).ok_or_else(|| format!("cannot make a {w}x{h} image"))?);
         }
         let pm = self.pixmap.as_mut().ok_or("no image")?;
-        render_world(pm, &self.scenario, self.sim.as_ref(), &self.view);
+        render_world_cached(
+            pm,
+            &self.scenario,
+            self.sim.as_ref(),
+            &self.view,
+            &mut self.walls,
+        );
         Ok(pm)
     }
 
