@@ -165,3 +165,58 @@ fn drifting_odometry_follows_its_model() {
         drift_odometry(&reference, &m, 6)
     );
 }
+
+/// The point-by-point tables of `multires::field_from_points` against
+/// their definitions, computed by brute force: fine = max over points of
+/// `w(dx)·w(dy)` (|dx|, |dy| ≤ 2, `w(d) = exp(−d²/2)`), coarse = maximum of
+/// fine over the block `[c, c + k)²`.
+#[wasm_bindgen_test(unsupported = test)]
+fn point_tables_match_their_definition() {
+    use slamlab::slam::multires::field_from_points;
+    let w = |d: i64| match d.abs() {
+        0 => 1.0f32,
+        1 => 0.606_530_66,
+        2 => 0.135_335_28,
+        _ => 0.0,
+    };
+    let points: Vec<glam::DVec2> = [(0.01, 0.02), (0.12, 0.02), (0.33, -0.21), (-0.4, 0.5)]
+        .iter()
+        .map(|&(x, y)| glam::DVec2::new(x, y))
+        .collect();
+    let cells: Vec<[i64; 2]> = points
+        .iter()
+        .map(|p| [(p.x / 0.05).floor() as i64, (p.y / 0.05).floor() as i64])
+        .collect();
+    for k in [1usize, 4, 8] {
+        let f = field_from_points(&points, 0.05, k, 0.2);
+        let fine = |x: i64, y: i64| {
+            cells
+                .iter()
+                .map(|c| w(x - c[0]) * w(y - c[1]))
+                .fold(0f32, f32::max)
+        };
+        let mut nonzero = 0;
+        for y in 0..f.height as i64 {
+            for x in 0..f.width as i64 {
+                let (gx, gy) = (x + f.x0, y + f.y0);
+                assert_eq!(f.fine_at(x, y), fine(gx, gy), "fine ({gx}, {gy})");
+                let mut block = 0f32;
+                for yy in 0..k as i64 {
+                    for xx in 0..k as i64 {
+                        block = block.max(fine(gx + xx, gy + yy));
+                    }
+                }
+                assert_eq!(f.coarse_at(x, y), block, "coarse k={k} ({gx}, {gy})");
+                nonzero += (block > 0.0) as usize;
+            }
+        }
+        // Four 5 × 5 stamps, two of them overlapping by three columns: 85
+        // cells at k = 1, more for larger blocks.
+        assert!(nonzero >= 85, "k={k}: {nonzero} coarse cells set");
+        // The points' cells are inside, with room for the search margin.
+        for c in &cells {
+            assert!(c[0] - f.x0 >= 4 && c[1] - f.y0 >= 4);
+            assert!(c[0] - f.x0 < f.width as i64 - 4 && c[1] - f.y0 < f.height as i64 - 4);
+        }
+    }
+}

@@ -43,9 +43,13 @@ pub struct Outcome {
 
 /// Replays `log` (its odometry replaced by `odometry` when given) and
 /// returns every scan's final pose and the SLAM.
-pub fn replay(log: &CarmenLog, odometry: Option<&[Pose2]>) -> (Vec<Pose2>, LogSlam, f64) {
+pub fn replay(
+    log: &CarmenLog,
+    odometry: Option<&[Pose2]>,
+    cfg: &LogSlamConfig,
+) -> (Vec<Pose2>, LogSlam, f64) {
     let t0 = Instant::now();
-    let mut slam = LogSlam::new(LogSlamConfig::default());
+    let mut slam = LogSlam::new(cfg.clone());
     for (k, scan) in log.scans.iter().enumerate() {
         match odometry {
             Some(o) => {
@@ -68,6 +72,11 @@ pub const RANDOM_PAIRS: usize = 1000;
 
 /// A corrected log: its poses are the reference; odometry drifted from them.
 pub fn corrected(name: &str) -> Outcome {
+    corrected_with(name, &LogSlamConfig::default())
+}
+
+/// [`corrected`] with other SLAM settings.
+pub fn corrected_with(name: &str, cfg: &LogSlamConfig) -> Outcome {
     let log = load(name);
     let reference: Vec<Pose2> = log
         .scans
@@ -75,7 +84,7 @@ pub fn corrected(name: &str) -> Outcome {
         .map(|s| s.logged_pose.expect("FLASER pose"))
         .collect();
     let odom = drift_odometry(&reference, &DriftModel::default(), DRIFT_SEED);
-    let (est, slam, seconds) = replay(&log, Some(&odom));
+    let (est, slam, seconds) = replay(&log, Some(&odom), cfg);
     Outcome {
         ours: relation_errors(&est, &reference, RANDOM_PAIRS, 1),
         odometry: relation_errors(&odom, &reference, RANDOM_PAIRS, 1),
@@ -88,6 +97,11 @@ pub fn corrected(name: &str) -> Outcome {
 
 /// The raw MIT CSAIL log against GMapping's poses for 406 of its scans.
 pub fn csail_raw() -> (Outcome, f64) {
+    csail_raw_with(&LogSlamConfig::default())
+}
+
+/// [`csail_raw`] with other SLAM settings.
+pub fn csail_raw_with(cfg: &LogSlamConfig) -> (Outcome, f64) {
     let log = load("mit-csail.clf.gz");
     let path = data_dir().join("carmen/mit-csail_gmapping_reference.txt");
     let text = std::fs::read_to_string(&path).expect("reference file");
@@ -104,7 +118,7 @@ pub fn csail_raw() -> (Outcome, f64) {
         idx.push(f[0] as usize);
         reference.push(Pose2::new(f[5], f[6], f[7]));
     }
-    let (est, slam, seconds) = replay(&log, None);
+    let (est, slam, seconds) = replay(&log, None, cfg);
     let ours: Vec<Pose2> = idx.iter().map(|&i| est[i]).collect();
     let odom: Vec<Pose2> = idx.iter().map(|&i| log.scans[i].odometry).collect();
     let recorded = log.scans.last().unwrap().time - log.scans[0].time;

@@ -79,21 +79,40 @@ pub fn search(
     let nt = (cfg.angular_window_rad / cfg.angular_step_rad).round() as i64;
     let n_theta = (2 * nt + 1) as usize;
     let n = points.len();
-    // Window cells of every point for every rotation.
+    // Window cells of every point for every rotation, as indices into the
+    // tables when every offset the search reads (±w cells, plus a coarse
+    // block) stays inside the window, so the sums below need no bounds
+    // tests; rotations where some point comes nearer an edge keep the
+    // checked reads. Both read the same values in the same order.
     let mut cells = Vec::with_capacity(n * n_theta);
+    let mut inside = Vec::with_capacity(n_theta);
+    let mut index = Vec::with_capacity(n * n_theta);
+    let (wd, ht) = (field.width as i64, field.height as i64);
     for t in -nt..=nt {
         let theta = prior.theta + t as f64 * cfg.angular_step_rad;
         let pose = Pose2::new(prior.x, prior.y, theta);
+        let mut all = true;
         for &p in points {
-            cells.push(field.cell_of(pose.transform_point(p)));
+            let c = field.cell_of(pose.transform_point(p));
+            all &= c[0] - w >= 0 && c[1] - w >= 0 && c[0] + w + k < wd && c[1] + w + k < ht;
+            cells.push(c);
+            index.push(c[1] * wd + c[0]);
         }
+        inside.push(all);
     }
+    let score_at = |table: &[f32], ti: usize, ox: i64, oy: i64| -> f32 {
+        let off = oy * wd + ox;
+        index[ti * n..(ti + 1) * n]
+            .iter()
+            .fold(0f32, |a, &i| a + table[(i + off) as usize])
+    };
     // Coarse candidates.
     struct Candidate {
         score: f32,
         t: i64,
         ox: i64,
         oy: i64,
+        order: u32,
     }
     let mut candidates = Vec::new();
     let starts: Vec<i64> = (0..).map(|i| -w + i * k).take_while(|&o| o <= w).collect();
@@ -101,15 +120,26 @@ pub fn search(
         let pc = &cells[ti * n..(ti + 1) * n];
         for &oy in &starts {
             for &ox in &starts {
-                let score: f32 = pc
-                    .iter()
-                    .map(|c| field.coarse_at(c[0] + ox, c[1] + oy))
-                    .sum();
-                candidates.push(Candidate { score, t, ox, oy });
+                let score: f32 = if inside[ti] {
+                    score_at(&field.coarse, ti, ox, oy)
+                } else {
+                    pc.iter()
+                        .map(|c| field.coarse_at(c[0] + ox, c[1] + oy))
+                        .sum()
+                };
+                let order = candidates.len() as u32;
+                candidates.push(Candidate {
+                    score,
+                    t,
+                    ox,
+                    oy,
+                    order,
+                });
             }
         }
     }
-    candidates.sort_by(|a, b| b.score.total_cmp(&a.score));
+    // Best first; equal scores in the order scored (as a stable sort would).
+    candidates.sort_unstable_by(|a, b| b.score.total_cmp(&a.score).then(a.order.cmp(&b.order)));
     // Branch and bound at fine resolution.
     let dist = |t: i64, x: i64, y: i64| t.abs() + x.abs() + y.abs();
     let mut best: Option<(f32, i64, i64, i64)> = None;
@@ -124,7 +154,11 @@ pub fn search(
         let pc = &cells[ti * n..(ti + 1) * n];
         for oy in c.oy..(c.oy + k).min(w + 1) {
             for ox in c.ox..(c.ox + k).min(w + 1) {
-                let s: f32 = pc.iter().map(|q| field.fine_at(q[0] + ox, q[1] + oy)).sum();
+                let s: f32 = if inside[ti] {
+                    score_at(&field.fine, ti, ox, oy)
+                } else {
+                    pc.iter().map(|q| field.fine_at(q[0] + ox, q[1] + oy)).sum()
+                };
                 evaluations += 1;
                 let better = match best {
                     None => true,

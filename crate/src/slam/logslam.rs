@@ -68,6 +68,9 @@ pub struct LogSlamConfig {
     pub confirm_m: f64,
     pub confirm_rad: f64,
     pub max_closure_chi2: f64,
+    /// Standard deviations of a matched key-to-key edge (m, rad).
+    pub key_sigma_m: f64,
+    pub key_sigma_rad: f64,
 }
 
 impl Default for LogSlamConfig {
@@ -96,6 +99,8 @@ impl Default for LogSlamConfig {
             confirm_m: 0.3,
             confirm_rad: 3f64.to_radians(),
             max_closure_chi2: 50.0,
+            key_sigma_m: 0.05,
+            key_sigma_rad: 1f64.to_radians(),
         }
     }
 }
@@ -274,7 +279,7 @@ impl LogSlam {
             let (sm, sr) = if self.unmatched_since_key {
                 (0.3, 5f64.to_radians())
             } else {
-                (0.05, 1f64.to_radians())
+                (self.config.key_sigma_m, self.config.key_sigma_rad)
             };
             self.graph.edges.push(Edge::new(p, id, z, sm, sr));
         }

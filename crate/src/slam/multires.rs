@@ -36,40 +36,54 @@ const BLUR: [f32; 3] = [1.0, 0.606_530_66, 0.135_335_28];
 /// Builds the fine and coarse tables over the points (world frame), with
 /// cells of `resolution_m`, coarse blocks of `k` cells and a margin of
 /// `margin_m` around the points' bounding box (the search reaches there).
+///
+/// Both tables are maxima of per-point stamps, so they are written point by
+/// point rather than by passes over the whole window: a real laser's 20 m
+/// beams make the window up to a million cells, of which the points touch a
+/// few per cent. A point's fine stamp is `w(dx)·w(dy)` for `|dx|, |dy| ≤ 2`
+/// (the separable blur, maxima taken where stamps overlap). Its coarse stamp
+/// at block `[c, c + k)²` is the largest fine value inside the block, the
+/// stamp's weight at the block cell nearest the point on each axis.
 pub fn field_from_points(
     points: &[DVec2],
     resolution_m: f64,
     k: usize,
     margin_m: f64,
 ) -> LikelihoodField {
-    let cell = |p: DVec2| {
-        [
-            (p.x / resolution_m).floor() as i64,
-            (p.y / resolution_m).floor() as i64,
-        ]
-    };
-    let (mut lo, mut hi) = ([i64::MAX; 2], [i64::MIN; 2]);
-    for &p in points {
-        let c = cell(p);
-        for a in 0..2 {
-            lo[a] = lo[a].min(c[a]);
-            hi[a] = hi[a].max(c[a]);
+    let k = k.max(1);
+    let mut marks: Vec<[i64; 2]> = points
+        .iter()
+        .map(|p| {
+            [
+                (p.x / resolution_m).floor() as i64,
+                (p.y / resolution_m).floor() as i64,
+            ]
+        })
+        .collect();
+    marks.sort_unstable();
+    marks.dedup();
+    let (mut lo, mut hi) = ([0i64; 2], [0i64; 2]);
+    if let Some(first) = marks.first() {
+        (lo, hi) = (*first, *first);
+        for c in &marks {
+            for a in 0..2 {
+                lo[a] = lo[a].min(c[a]);
+                hi[a] = hi[a].max(c[a]);
+            }
         }
     }
-    if points.is_empty() {
-        (lo, hi) = ([0, 0], [0, 0]);
-    }
-    let m = (margin_m / resolution_m).ceil() as i64 + 3;
+    let m = (margin_m / resolution_m).ceil() as i64 + 3 + k as i64;
     let (x0, y0) = (lo[0] - m, lo[1] - m);
     let width = (hi[0] - lo[0] + 1 + 2 * m) as usize;
     let height = (hi[1] - lo[1] + 1 + 2 * m) as usize;
-    let mut raw = vec![0f32; width * height];
-    for &p in points {
-        let c = cell(p);
-        raw[(c[1] - y0) as usize * width + (c[0] - x0) as usize] = 1.0;
+    let mut fine = vec![0f32; width * height];
+    let mut coarse = vec![0f32; width * height];
+    let near = coarse_weights(k);
+    for c in &marks {
+        let (x, y) = ((c[0] - x0) as usize, (c[1] - y0) as usize);
+        stamp(&mut fine, width, x - 2, y - 2, &BLUR_ROW);
+        stamp(&mut coarse, width, x + 1 - k - 2, y + 1 - k - 2, &near);
     }
-    let fine = blur(&raw, width, height);
-    let coarse = block_max(&fine, width, height, k.max(1));
     LikelihoodField {
         x0,
         y0,
@@ -77,80 +91,43 @@ pub fn field_from_points(
         height,
         fine,
         coarse,
-        k: k.max(1),
+        k,
         resolution_m,
     }
 }
 
-/// Spreads marks by a separable Gaussian of σ = 1 cell, radius 2, taking
-/// the maximum where spreads overlap: a point's own cell scores 1, as a
-/// confident wall does in the grid's field.
-fn blur(raw: &[f32], width: usize, height: usize) -> Vec<f32> {
-    let mut rows = vec![0f32; width * height];
-    for y in 0..height {
-        for x in 0..width {
-            let v = raw[y * width + x];
-            if v == 0.0 {
-                continue;
-            }
-            for d in 0..3usize {
-                let w = v * BLUR[d];
-                if x + d < width {
-                    let o = &mut rows[y * width + x + d];
-                    *o = o.max(w);
-                }
-                if x >= d {
-                    let o = &mut rows[y * width + x - d];
-                    *o = o.max(w);
-                }
-            }
-        }
-    }
-    let mut out = vec![0f32; width * height];
-    for y in 0..height {
-        for x in 0..width {
-            let v = rows[y * width + x];
-            if v == 0.0 {
-                continue;
-            }
-            for d in 0..3usize {
-                let w = v * BLUR[d];
-                if y + d < height {
-                    let o = &mut out[(y + d) * width + x];
-                    *o = o.max(w);
-                }
-                if y >= d {
-                    let o = &mut out[(y - d) * width + x];
-                    *o = o.max(w);
-                }
-            }
-        }
-    }
-    out
+/// The fine stamp's weights along one axis, offsets −2..=2.
+const BLUR_ROW: [f32; 5] = [BLUR[2], BLUR[1], BLUR[0], BLUR[1], BLUR[2]];
+
+/// The coarse stamp's weights along one axis: for block starts from
+/// `k + 1` cells before the point to 2 after, the weight of the block cell
+/// nearest the point (0 cells inside the block).
+fn coarse_weights(k: usize) -> Vec<f32> {
+    (0..k + 4)
+        .map(|i| {
+            // Block [s, s + k) with s = i − (k − 1) − 2 relative to the point.
+            let s = i as i64 - (k as i64 - 1) - 2;
+            let d = if s > 0 {
+                s
+            } else if s + k as i64 - 1 < 0 {
+                -(s + k as i64 - 1)
+            } else {
+                0
+            };
+            BLUR[d as usize]
+        })
+        .collect()
 }
 
-/// Maxima of `fine` over the blocks `[x, x + k) × [y, y + k)`.
-fn block_max(fine: &[f32], width: usize, height: usize, k: usize) -> Vec<f32> {
-    let mut cx = vec![0f32; width * height];
-    for y in 0..height {
-        let row = &fine[y * width..(y + 1) * width];
-        for x in 0..width {
-            cx[y * width + x] = row[x..(x + k).min(width)]
-                .iter()
-                .fold(0f32, |a, &b| a.max(b));
+/// Writes the maximum of `table` and the outer product `w ⊗ w` into the
+/// square of `w.len()` cells starting at `(x, y)`.
+fn stamp(table: &mut [f32], width: usize, x: usize, y: usize, w: &[f32]) {
+    for (j, &wy) in w.iter().enumerate() {
+        let row = &mut table[(y + j) * width + x..(y + j) * width + x + w.len()];
+        for (o, &wx) in row.iter_mut().zip(w) {
+            *o = o.max(wx * wy);
         }
     }
-    let mut out = vec![0f32; width * height];
-    for y in 0..height {
-        for x in 0..width {
-            let mut m = 0f32;
-            for yy in y..(y + k).min(height) {
-                m = m.max(cx[yy * width + x]);
-            }
-            out[y * width + x] = m;
-        }
-    }
-    out
 }
 
 /// A search window for [`match_scan`].
