@@ -169,5 +169,8 @@ fn cached_walls_draw_as_fresh_ones_and_follow_an_edit() {
 /// Two RGBA pictures equal up to 8-bit rounding of the composed layer.
 fn compare(a: &[u8], b: &[u8]) {
     let worst = a.iter().zip(b).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
-    assert!(worst <= 2, "cached walls differ from fresh ones by {worst} levels");
+    assert!(
+        worst <= 2,
+        "cached walls differ from fresh ones by {worst} levels"
+    );
 }

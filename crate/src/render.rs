@@ -23,8 +23,8 @@ use crate::sim::Simulation;
 use glam::DVec2;
 use serde::Deserialize;
 use tiny_skia::{
-    Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, PixmapPaint, Rect, Stroke,
-    StrokeDash, Transform,
+    Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Rect, Stroke, StrokeDash,
+    Transform,
 };
 
 /// Which layers to draw.
@@ -309,14 +309,27 @@ impl WallLayer {
             self.key = key;
         }
         if let Some(layer) = &self.layer {
-            pm.draw_pixmap(
-                0,
-                0,
-                layer.as_ref(),
-                &PixmapPaint::default(),
-                Transform::identity(),
-                None,
-            );
+            over(pm.data_mut(), layer.data());
+        }
+    }
+}
+
+/// `dst = src over dst` for premultiplied RGBA8 pixels of the same size:
+/// `dst + src − dst·αsrc/255` per channel, rounded. Written out rather than
+/// through tiny-skia's pattern pipeline (which samples the layer as an
+/// image) because most of a wall layer is empty and is skipped here, and a
+/// covered pixel is copied.
+fn over(dst: &mut [u8], src: &[u8]) {
+    for (d, s) in dst.chunks_exact_mut(4).zip(src.chunks_exact(4)) {
+        match s[3] {
+            0 => {}
+            255 => d.copy_from_slice(s),
+            a => {
+                let keep = 255 - a as u32;
+                for (dc, sc) in d.iter_mut().zip(s) {
+                    *dc = (*sc as u32 + (*dc as u32 * keep + 127) / 255) as u8;
+                }
+            }
         }
     }
 }
