@@ -42,6 +42,7 @@ import { CameraPanel } from './page/camera-panel.js';
 import { MapsPanel } from './page/maps-panel.js';
 import { MergePanel } from './page/merge-panel.js';
 import { GuidedTour } from './page/guided.js';
+import { RealMaps } from './page/real/panel.js';
 
 const $ = (id) => document.getElementById(id);
 const canvas = $('world');
@@ -147,6 +148,7 @@ const summary = new Summary($('summary'), $('summary-open'), {
   maps: mapsPanel,
   merge: mergePanel,
 });
+const realMaps = new RealMaps($('real'), $('real-open'), { download });
 const toolbar = new Toolbar({ guard, store, runner, editor, view, persistence, robotsPanel, canvas });
 const keys = new Keys({
   guard, store, runner, editor, view, pointer, toolbar, summary, merge: mergePanel, guide, refreshPanels, refreshControls,
@@ -221,6 +223,7 @@ async function main() {
   view.restoreLayers();
   toolbar.wire();
   $('guided-open').addEventListener('click', () => guide.toggle());
+  realMaps.wire();
   pointer.listen();
   keys.listen();
   persistence.listen();
@@ -250,6 +253,7 @@ async function main() {
     guide,
     mergePanel,
     markers: () => clone(view.guideMarkers),
+    realMaps,
   };
   document.body.dataset.ready = 'true';
   requestAnimationFrame(frame);
