@@ -5,7 +5,8 @@
 // gives bare file names, no folders, so each YAML's image is matched to a
 // picked file by its last path component. An image no YAML names becomes a
 // map of its own at the resolution the user typed (origin 0, thresholds as
-// map_server's defaults). Every problem is a message that names the file
+// map_server's defaults); an image with the stem of a YAML that could not
+// be read is left out with it. Every problem is a message that names the file
 // and the field, and the files that are fine still load.
 
 const YAML = /\.ya?ml$/i;
@@ -46,6 +47,9 @@ export function groupFiles(files, imageOf, resolution) {
       image = imageOf(f.name, yaml);
     } catch (e) {
       errors.push(e instanceof Error ? e.message : String(e));
+      // Its image (by the usual same stem) is not a map of its own.
+      const stem = f.name.replace(YAML, '');
+      for (const n of images.keys()) if (n.replace(IMAGE, '') === stem) used.add(n);
       continue;
     }
     const picked = images.get(baseName(image));

@@ -5,18 +5,26 @@
 // files' bytes; it reads them into maps (files.js matches each YAML to its
 // image), draws each map into a small coloured picture for the page
 // (preview.js), merges on request (the whole merge runs here, so the page
-// never waits on it) and hands back the report and the merged map's PGM,
-// PNG and YAML. Messages in: `{id, type: 'add', files, resolution}`,
-// `{id, type: 'merge'}`, `{id, type: 'clear'}`; out: `{id, ok, ...}` or
+// never waits on it), hands back the report and the merged map's PGM,
+// PNG and YAML, and draws the merged overlay (overlay.js) into the page's
+// canvas, which the page hands over once. Messages in:
+// `{id, type: 'add', files, resolution, colours}`, `{id, type: 'merge'}`,
+// `{id, type: 'canvas', canvas}`, `{id, type: 'draw', width, height, dpr,
+// alpha}`, `{id, type: 'clear'}`; out: `{id, ok, ...}` or
 // `{id, ok: false, error}`, and `{type: 'progress', text}` while merging.
 
 import init, * as wasm from '../../pkg/slamlab.js';
 import { groupFiles } from './files.js';
 import { previewOf } from './preview.js';
+import { drawPlaced } from './overlay.js';
 
 const ready = init();
 let merger = null;
 let colourIndex = 0;
+/** What the overlay needs of each map read (by name), the last merge's placing, the canvas. */
+let pictures = new Map();
+let placed = [];
+let overlay = null;
 
 function message(e) {
   return e instanceof Error ? e.message : String(e);
@@ -38,9 +46,10 @@ async function add({ files, resolution, colours }) {
     }
     const info = JSON.parse(merger.mapInfoJson(index));
     const colour = colours[colourIndex++ % colours.length];
-    const preview = await previewOf(merger.mapPixels(index), info.width, info.height, colour);
-    transfer.push(preview.bitmap);
-    added.push({ ...info, index, imageName: m.imageName, colour, preview });
+    const { thumb, ...preview } = await previewOf(merger.mapPixels(index), info.width, info.height, colour);
+    pictures.set(info.name, { ...info, preview });
+    transfer.push(thumb);
+    added.push({ ...info, index, imageName: m.imageName, colour, thumb });
   }
   return { result: { added, errors }, transfer };
 }
@@ -59,6 +68,9 @@ function merge(id) {
     transfer.push(pgm.buffer, png.buffer);
   }
   report.timings_ms = { merge: t1 - t0, write: performance.now() - t1 };
+  placed = report.merge.transforms
+    .filter((t) => pictures.has(t.map))
+    .map((t) => ({ map: pictures.get(t.map), pose: t.pose }));
   return { result: { report, files }, transfer };
 }
 
@@ -71,10 +83,18 @@ self.onmessage = async ({ data }) => {
     else if (type === 'merge') {
       if (!merger) throw new Error('open two or more maps first');
       out = merge(id);
+    } else if (type === 'canvas') {
+      overlay = data.canvas;
+      out = { result: {}, transfer: [] };
+    } else if (type === 'draw') {
+      if (overlay) drawPlaced(overlay, data, placed);
+      out = { result: {}, transfer: [] };
     } else if (type === 'clear') {
       merger?.free();
       merger = null;
       colourIndex = 0;
+      pictures = new Map();
+      placed = [];
       out = { result: {}, transfer: [] };
     } else throw new Error(`unknown request '${type}'`);
     postMessage({ id, ok: true, ...out.result }, out.transfer);

@@ -12,7 +12,6 @@
 // lab's own scenario and runs behind this view are never touched.
 
 import { MergeClient } from './client.js';
-import { drawPlaced } from './overlay.js';
 import { transformRows, transformsJson, verdictText } from './report.js';
 
 /** One colour per map (up to 16), told apart on white. */
@@ -54,6 +53,7 @@ const HTML = `
       <input id="real-alpha" type="range" min="15" max="100" value="85" aria-label="Opacity of the maps in the overlay">
     </div>
     <canvas id="real-overlay" class="real-overlay" aria-label="The joined maps overlaid in their colours"></canvas>
+    <p id="real-legend" class="real-legend"></p>
     <div class="real-downloads">
       <button type="button" data-file="pgm">Merged map PGM</button>
       <button type="button" data-file="yaml">Merged map YAML</button>
@@ -107,7 +107,8 @@ export class RealMaps {
     for (const b of root.querySelectorAll('.real-downloads button')) {
       b.addEventListener('click', () => this.save(b.dataset.file));
     }
-    new ResizeObserver(() => this.drawOverlay()).observe(q('#real-overlay'));
+    this.resizes = new ResizeObserver(() => this.drawOverlay());
+    this.resizes.observe(q('#real-overlay'));
     this.refresh();
   }
 
@@ -129,6 +130,7 @@ export class RealMaps {
   open(files) {
     if (!files.length) return this.queue;
     return this.enqueue(async () => {
+      performance.mark('real-open');
       const read = await Promise.all(files.map(async (f) => ({ name: f.name, bytes: await f.arrayBuffer() })));
       const resolution = this.root.querySelector('#real-resolution').value;
       this.setBusy(true, `reading ${files.length} file${files.length > 1 ? 's' : ''}…`);
@@ -138,11 +140,13 @@ export class RealMaps {
       } finally {
         this.setBusy(false, '');
       }
+      performance.mark('real-added');
       this.maps.push(...out.added);
       if (out.added.length) this.dropResult();
       if (out.errors.length) this.say(`Not opened: ${out.errors.join(' · ')}`, 'error');
       else this.say(`Opened ${out.added.map((m) => m.name).join(', ')}.`, 'ok');
       this.refresh();
+      performance.mark('real-listed');
       if (out.added.length && this.maps.length >= 2) await this.merge();
     });
   }
@@ -171,11 +175,13 @@ export class RealMaps {
       clearInterval(tick);
       this.setBusy(false, '');
     }
+    performance.mark('real-merged');
     this.report = out.report;
     this.files = out.files;
     this.mergeMs = performance.now() - t0;
     this.stage(`merged in ${(this.mergeMs / 1000).toFixed(2)} s (the merge itself ${(out.report.timings_ms.merge / 1000).toFixed(2)} s)`);
     this.showResult();
+    performance.mark('real-shown');
   }
 
   progress(text) {
@@ -196,7 +202,7 @@ export class RealMaps {
   setBusy(busy, text) {
     this.busy = busy;
     this.root.querySelector('#real-progress').hidden = !busy;
-    if (text) this.stage(text);
+    this.stage(text);
     this.refresh();
   }
 
@@ -214,7 +220,7 @@ export class RealMaps {
     q('#real-clear').disabled = this.busy || this.maps.length === 0;
     const list = q('#real-maps');
     if (list.childElementCount === this.maps.length) return;
-    list.replaceChildren(...this.maps.map((m) => card(m)));
+    list.replaceChildren(...this.maps.map((m) => (m.card ??= card(m))));
   }
 
   showResult() {
@@ -238,14 +244,60 @@ export class RealMaps {
     this.drawOverlay();
   }
 
-  /** The joined maps in the first map's frame, each in its colour. */
+  /**
+   * The joined maps in the first map's frame, each in its colour: drawn by
+   * the worker into the overlay canvas (handed over once per worker), one
+   * drawing at a time (a slider's many events make one more at most).
+   */
   drawOverlay() {
     if (!this.report || this.root.hidden) return;
+    if (this.drawing) {
+      this.redraw = true;
+      return;
+    }
+    let canvas = this.root.querySelector('#real-overlay');
+    if (this.canvasWorker !== this.client.worker || !this.client.worker) {
+      this.client.start();
+      if (this.canvasWorker) {
+        // A restarted worker needs a canvas of its own: control moves once.
+        const fresh = canvas.cloneNode();
+        canvas.replaceWith(fresh);
+        this.resizes.observe(fresh);
+        canvas = fresh;
+      }
+      const offscreen = canvas.transferControlToOffscreen();
+      this.client.request({ type: 'canvas', canvas: offscreen }, [offscreen]);
+      this.canvasWorker = this.client.worker;
+    }
+    const dpr = window.devicePixelRatio || 1;
+    const size = {
+      width: Math.max(1, Math.round(canvas.clientWidth * dpr)),
+      height: Math.max(1, Math.round(canvas.clientHeight * dpr)),
+      dpr,
+      alpha: this.root.querySelector('#real-alpha').value / 100,
+    };
+    this.drawing = true;
+    this.client
+      .request({ type: 'draw', ...size })
+      .catch((e) => this.say(e.message, 'error'))
+      .finally(() => {
+        this.drawing = false;
+        if (this.redraw) {
+          this.redraw = false;
+          this.drawOverlay();
+        }
+      });
+    this.legend();
+  }
+
+  legend() {
     const byName = new Map(this.maps.map((m) => [m.name, m]));
-    const placed = this.report.merge.transforms
-      .filter((t) => byName.has(t.map))
-      .map((t) => ({ map: byName.get(t.map), pose: t.pose }));
-    drawPlaced(this.root.querySelector('#real-overlay'), placed, this.root.querySelector('#real-alpha').value / 100);
+    const placed = this.report.merge.transforms.filter((t) => byName.has(t.map)).map((t) => ({ map: byName.get(t.map) }));
+    const legend = this.root.querySelector('#real-legend');
+    legend.replaceChildren(
+      ...placed.map(({ map }) => swatch(map.colour, map.name)),
+      placed.length > 1 ? 'Walls of two maps that fall on each other show dark.' : '',
+    );
   }
 
   save(kind) {
@@ -275,10 +327,12 @@ function card(m) {
   const div = document.createElement('figure');
   div.className = 'real-card';
   div.style.borderColor = m.colour;
+  // The worker made the thumbnail at its shown size (a large canvas shrunk
+  // by CSS would be shrunk again at every repaint of the page).
   const c = document.createElement('canvas');
-  c.width = m.preview.width;
-  c.height = m.preview.height;
-  c.getContext('2d').drawImage(m.preview.bitmap, 0, 0);
+  c.width = m.thumb.width;
+  c.height = m.thumb.height;
+  c.getContext('bitmaprenderer').transferFromImageBitmap(m.thumb);
   c.setAttribute('aria-label', `${m.name}, drawn in its colour`);
   const cap = document.createElement('figcaption');
   const o = m.origin.map((v) => Number(v.toFixed(3)));
@@ -286,6 +340,14 @@ function card(m) {
   cap.querySelector('b').textContent = m.imageName === m.name ? m.name : `${m.name} + ${m.imageName}`;
   div.append(c, cap);
   return div;
+}
+
+function swatch(colour, name) {
+  const s = document.createElement('span');
+  s.className = 'real-swatch';
+  s.style.setProperty('--c', colour);
+  s.textContent = name;
+  return s;
 }
 
 function fillTable(table, head, rows) {
