@@ -190,6 +190,7 @@ function onChange(kind) {
 
 /** One animation frame: advance the run, redraw what changed, let the panels follow. */
 function frame(now) {
+  if (realMaps.holdsFrames(runner.running, () => requestAnimationFrame(frame))) return;
   requestAnimationFrame(frame);
   if (!store.lab) return;
   try {

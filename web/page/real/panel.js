@@ -40,7 +40,7 @@ const HTML = `
   <div id="real-maps" class="real-maps" aria-label="The maps you opened"></div>
   <div class="real-merge-row">
     <button type="button" id="real-merge" class="primary">Merge maps</button>
-    <progress id="real-progress" hidden aria-label="Merge progress"></progress>
+    <span class="real-busy" aria-hidden="true"></span>
     <span id="real-stage" class="real-stage" aria-live="polite"></span>
   </div>
   <div id="real-result" class="real-result" hidden>
@@ -112,8 +112,26 @@ export class RealMaps {
     this.refresh();
   }
 
+  /**
+   * The lab's frame loop asks this each frame: while this view covers an
+   * idle lab, the loop stops (so the page's main thread has nothing to do
+   * while a merge runs) and `resume` restarts it when the view closes.
+   */
+  holdsFrames(labRunning, resume) {
+    if (this.root.hidden || labRunning) return false;
+    this.resume = resume;
+    return true;
+  }
+
   toggle(open) {
     this.root.hidden = !open;
+    // The lab behind is kept as it is but not painted while this view covers it.
+    document.body.classList.toggle('real-open', open);
+    if (!open && this.resume) {
+      const resume = this.resume;
+      this.resume = null;
+      resume();
+    }
     this.opener.setAttribute('aria-expanded', String(open));
     if (open) this.root.querySelector('.real-close').focus();
     else this.opener.focus();
@@ -131,6 +149,7 @@ export class RealMaps {
     if (!files.length) return this.queue;
     return this.enqueue(async () => {
       performance.mark('real-open');
+      this.attachCanvas();
       const read = await Promise.all(files.map(async (f) => ({ name: f.name, bytes: await f.arrayBuffer() })));
       const resolution = this.root.querySelector('#real-resolution').value;
       this.setBusy(true, `reading ${files.length} file${files.length > 1 ? 's' : ''}…`);
@@ -147,7 +166,10 @@ export class RealMaps {
       else this.say(`Opened ${out.added.map((m) => m.name).join(', ')}.`, 'ok');
       this.refresh();
       performance.mark('real-listed');
-      if (out.added.length && this.maps.length >= 2) await this.merge();
+      if (out.added.length && this.maps.length >= 2) {
+        await nextFrame();
+        await this.merge();
+      }
     });
   }
 
@@ -166,13 +188,13 @@ export class RealMaps {
     }
     const n = this.maps.length;
     const t0 = performance.now();
-    this.setBusy(true, `merging ${n} maps (${(n * (n - 1)) / 2} pairs)…`);
-    const tick = setInterval(() => this.stage(`merging ${n} maps… ${((performance.now() - t0) / 1000).toFixed(1)} s`), 250);
+    // Nothing ticks or animates while it runs: the page's main thread stays
+    // idle until the worker answers (a progress line comes after each pair).
+    this.setBusy(true, `merging ${n} maps (${(n * (n - 1)) / 2} pair${n > 2 ? 's' : ''})…`);
     let out;
     try {
       out = await this.client.merge();
     } finally {
-      clearInterval(tick);
       this.setBusy(false, '');
     }
     performance.mark('real-merged');
@@ -180,6 +202,7 @@ export class RealMaps {
     this.files = out.files;
     this.mergeMs = performance.now() - t0;
     this.stage(`merged in ${(this.mergeMs / 1000).toFixed(2)} s (the merge itself ${(out.report.timings_ms.merge / 1000).toFixed(2)} s)`);
+    await nextFrame();
     this.showResult();
     performance.mark('real-shown');
   }
@@ -201,7 +224,7 @@ export class RealMaps {
 
   setBusy(busy, text) {
     this.busy = busy;
-    this.root.querySelector('#real-progress').hidden = !busy;
+    this.root.classList.toggle('busy', busy);
     this.stage(text);
     this.refresh();
   }
@@ -241,7 +264,8 @@ export class RealMaps {
     for (const b of this.root.querySelectorAll('.real-downloads button')) {
       b.disabled = b.dataset.file !== 'json' && !this.files;
     }
-    this.drawOverlay();
+    // The overlay in a task of its own, after the tables are laid out.
+    nextFrame().then(() => this.drawOverlay());
   }
 
   /**
@@ -255,20 +279,7 @@ export class RealMaps {
       this.redraw = true;
       return;
     }
-    let canvas = this.root.querySelector('#real-overlay');
-    if (this.canvasWorker !== this.client.worker || !this.client.worker) {
-      this.client.start();
-      if (this.canvasWorker) {
-        // A restarted worker needs a canvas of its own: control moves once.
-        const fresh = canvas.cloneNode();
-        canvas.replaceWith(fresh);
-        this.resizes.observe(fresh);
-        canvas = fresh;
-      }
-      const offscreen = canvas.transferControlToOffscreen();
-      this.client.request({ type: 'canvas', canvas: offscreen }, [offscreen]);
-      this.canvasWorker = this.client.worker;
-    }
+    const canvas = this.attachCanvas();
     const dpr = window.devicePixelRatio || 1;
     const size = {
       width: Math.max(1, Math.round(canvas.clientWidth * dpr)),
@@ -288,6 +299,24 @@ export class RealMaps {
         }
       });
     this.legend();
+  }
+
+  /** Hands the overlay canvas to the worker (once per worker); returns the canvas. */
+  attachCanvas() {
+    let canvas = this.root.querySelector('#real-overlay');
+    if (this.canvasWorker === this.client.worker && this.client.worker) return canvas;
+    this.client.start();
+    if (this.canvasWorker) {
+      // A restarted worker needs a canvas of its own: control moves once.
+      const fresh = canvas.cloneNode();
+      canvas.replaceWith(fresh);
+      this.resizes.observe(fresh);
+      canvas = fresh;
+    }
+    const offscreen = canvas.transferControlToOffscreen();
+    this.client.request({ type: 'canvas', canvas: offscreen }, [offscreen]);
+    this.canvasWorker = this.client.worker;
+    return canvas;
   }
 
   legend() {
@@ -320,6 +349,11 @@ export class RealMaps {
       busy: this.busy,
     };
   }
+}
+
+/** Resolves after the next frame has been drawn (work split into short tasks). */
+function nextFrame() {
+  return new Promise((resolve) => requestAnimationFrame(() => setTimeout(resolve, 0)));
 }
 
 /** One opened map: its picture, name, size and resolution. */
