@@ -10,7 +10,10 @@
 // gives), feeds bad files (each message names the file and the field, and
 // the lab's own run and the maps already open are kept), and watches the
 // main thread with a PerformanceObserver('longtask') while two 2000 x 2000
-// maps are opened and merged.
+// maps are opened and merged. Then "Your log": a CARMEN log of a robot
+// driving twice round a ring corridor with drifting odometry
+// (tests/support/synthetic-log.mjs) is opened, stepped, played, paused,
+// closes a loop while it replays, and its map is downloaded.
 //
 // Needs the wasm build in web/pkg (`./build.sh build`). Run alone with
 //   node --test tests/page-real.test.mjs
@@ -21,6 +24,7 @@ import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { ARTIFACTS, newPage, useBrowser, waitReady } from './support/browser.mjs';
 import { centredFrame, floorPlan, mapImage, mapYaml } from './support/synthetic-maps.mjs';
+import { ringLog } from './support/synthetic-log.mjs';
 
 const env = useBrowser();
 const tmp = mkdtempSync(path.join(tmpdir(), 'slamlab-page-real-'));
@@ -235,6 +239,72 @@ test('your maps: opening and merging two 2000 x 2000 maps shows no long task ove
   assert.ok(Math.hypot(x - maps.truth[0], y - maps.truth[1]) < 0.1);
   await page.locator('#real-overlay').scrollIntoViewIfNeeded();
   await page.screenshot({ path: path.join(ARTIFACTS, 'page-real-large.png') });
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});
+
+test('your log: open a CARMEN log, step, play and pause it, see a loop closed, download the map', { timeout: 400000 }, async () => {
+  const file = path.join(tmp, 'ring.log');
+  writeFileSync(file, ringLog({ laps: 2, perLap: 140 }).text);
+  const { context, page, problems } = await newPage(env.browser);
+  await page.goto(env.baseUrl);
+  await waitReady(page);
+  const before = await page.evaluate(() => window.slamlab.scenario());
+  await page.getByRole('button', { name: 'Your log…' }).click();
+  await page.waitForSelector('#logview:not([hidden])');
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  await page.evaluate(() => {
+    window.longTasks = [];
+    window.longTaskObserver = new PerformanceObserver((list) => window.longTasks.push(...list.getEntries().map((e) => e.duration)));
+    window.longTaskObserver.observe({ type: 'longtask' });
+  });
+  const log = () => page.evaluate(() => window.slamlab.logView.snapshot());
+  await page.setInputFiles('#log-file', file);
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().records === 281, null, { timeout: 60000 });
+  assert.match(await page.locator('#log-name').innerText(), /ring\.log: 281 laser records/);
+
+  // Step: one step of as many scans as the speed says (5).
+  await page.getByRole('button', { name: 'Step', exact: true }).click();
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().done === 5, null, { timeout: 60000 });
+  assert.match(await page.locator('#log-progress').innerText(), /^scan 5 of 281 · 0 loop closures$/);
+
+  // Play fast until a loop is closed (the second lap meets the first).
+  await page.locator('#log-speed').fill('20');
+  await page.getByRole('button', { name: 'Play' }).click();
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().closures > 0, null, { timeout: 300000, polling: 100 });
+  const first = await log();
+  assert.ok(first.done > 100 && first.done <= 281, `the first loop closed at scan ${first.done}`);
+  await page.getByRole('button', { name: 'Pause' }).click();
+  // The step under way when Pause was pressed ends; no other starts.
+  await page.waitForFunction(() => !window.slamlab.logView.snapshot().busy);
+  const paused = (await log()).done;
+  await page.waitForTimeout(400);
+  assert.equal((await log()).done, paused, 'no scan is replayed while paused');
+  await page.screenshot({ path: path.join(ARTIFACTS, 'page-log-loop.png') });
+
+  await page.getByRole('button', { name: 'Play' }).click();
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().finished, null, { timeout: 300000, polling: 100 });
+  const done = await log();
+  assert.equal(done.done, 281);
+  assert.ok(done.closures >= first.closures, `${done.closures} loop closures`);
+  assert.match(await page.locator('#log-progress').innerText(), /^done: 281 scans, \d+ loop closures?; map \d+ × \d+ cells$/);
+  await page.screenshot({ path: path.join(ARTIFACTS, 'page-log-done.png') });
+
+  // The map: a binary PGM of the size the replay reports.
+  const [d] = await Promise.all([page.waitForEvent('download'), page.getByRole('button', { name: 'Map PGM' }).click()]);
+  assert.equal(d.suggestedFilename(), 'ring.pgm');
+  const bytes = readFileSync(await d.path());
+  const m = /^P5\n(?:#[^\n]*\n)*(\d+) (\d+)\n255\n/.exec(bytes.subarray(0, 200).toString('latin1'));
+  assert.ok(m, 'a binary PGM header');
+  assert.deepEqual([Number(m[1]), Number(m[2])], [done.summary.map.width, done.summary.map.height]);
+  assert.equal(bytes.length, m[0].length + done.summary.map.width * done.summary.map.height);
+  assert.ok(bytes.subarray(m[0].length).filter((v) => v === 0).length > 500, 'walls in the map');
+
+  const tasks = await page.evaluate(() => window.longTasks);
+  console.log(`log replay: ${done.closures} loop closures, the first at scan ${first.done}; long tasks ${tasks.map(Math.round)}`);
+  assert.ok(Math.max(0, ...tasks) <= 100, `long tasks while replaying: ${tasks.map(Math.round).join(', ')} ms`);
+  await page.getByRole('button', { name: /Close your log/ }).click();
+  assert.deepEqual(await page.evaluate(() => window.slamlab.scenario()), before, 'the lab keeps its scenario');
   assert.deepEqual(problems, [], 'no console errors or page errors');
   await context.close();
 });

@@ -42,7 +42,9 @@ import { CameraPanel } from './page/camera-panel.js';
 import { MapsPanel } from './page/maps-panel.js';
 import { MergePanel } from './page/merge-panel.js';
 import { GuidedTour } from './page/guided.js';
+import { Covers } from './page/real/cover.js';
 import { RealMaps } from './page/real/panel.js';
+import { LogView } from './page/real/log-panel.js';
 
 const $ = (id) => document.getElementById(id);
 const canvas = $('world');
@@ -148,7 +150,9 @@ const summary = new Summary($('summary'), $('summary-open'), {
   maps: mapsPanel,
   merge: mergePanel,
 });
-const realMaps = new RealMaps($('real'), $('real-open'), { download });
+const covers = new Covers();
+const realMaps = new RealMaps($('real'), $('real-open'), { download, covers });
+const logView = new LogView($('logview'), $('log-open'), { download, covers });
 const toolbar = new Toolbar({ guard, store, runner, editor, view, persistence, robotsPanel, canvas });
 const keys = new Keys({
   guard, store, runner, editor, view, pointer, toolbar, summary, merge: mergePanel, guide, refreshPanels, refreshControls,
@@ -190,7 +194,7 @@ function onChange(kind) {
 
 /** One animation frame: advance the run, redraw what changed, let the panels follow. */
 function frame(now) {
-  if (realMaps.holdsFrames(runner.running, () => requestAnimationFrame(frame))) return;
+  if (covers.holdsFrames(runner.running, () => requestAnimationFrame(frame))) return;
   requestAnimationFrame(frame);
   if (!store.lab) return;
   try {
@@ -225,6 +229,7 @@ async function main() {
   toolbar.wire();
   $('guided-open').addEventListener('click', () => guide.toggle());
   realMaps.wire();
+  logView.wire();
   pointer.listen();
   keys.listen();
   persistence.listen();
@@ -255,6 +260,7 @@ async function main() {
     mergePanel,
     markers: () => clone(view.guideMarkers),
     realMaps,
+    logView,
   };
   document.body.dataset.ready = 'true';
   requestAnimationFrame(frame);

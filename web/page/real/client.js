@@ -1,10 +1,12 @@
-// The page's side of the merge worker (merge-worker.js): requests as
-// promises, progress lines to a callback. The worker is started on first
-// use, so a page that never opens its own maps never loads a second wasm.
+// The page's side of its workers (merge-worker.js, log-worker.js):
+// requests as promises, progress lines to a callback. A worker is started
+// on first use, so a page that never opens its own maps or logs never
+// loads a second wasm.
 
-export class MergeClient {
-  /** `onProgress(text)`: a line from the merge as each pair is judged. */
-  constructor(onProgress) {
+export class WorkerClient {
+  /** `url`: the module worker; `onProgress(text)`: its progress lines. */
+  constructor(url, onProgress = () => {}) {
+    this.url = url;
     this.onProgress = onProgress;
     this.worker = null;
     this.next = 1;
@@ -13,7 +15,7 @@ export class MergeClient {
 
   start() {
     if (this.worker) return;
-    this.worker = new Worker(new URL('./merge-worker.js', import.meta.url), { type: 'module' });
+    this.worker = new Worker(this.url, { type: 'module' });
     this.worker.onmessage = ({ data }) => {
       if (data.type === 'progress') {
         this.onProgress(data.text);
@@ -26,7 +28,7 @@ export class MergeClient {
       else w.reject(new Error(data.error));
     };
     this.worker.onerror = (e) => {
-      const error = new Error(`the merge worker failed: ${e.message || 'could not load it (is web/pkg built?)'}`);
+      const error = new Error(`the page's worker failed: ${e.message || 'could not load it (is web/pkg built?)'}`);
       for (const w of this.waiting.values()) w.reject(error);
       this.waiting.clear();
       this.worker?.terminate();
@@ -41,6 +43,14 @@ export class MergeClient {
       this.waiting.set(id, { resolve, reject });
       this.worker.postMessage({ ...message, id }, transfer);
     });
+  }
+
+}
+
+/** The merge worker's requests. */
+export class MergeClient extends WorkerClient {
+  constructor(onProgress) {
+    super(new URL('./merge-worker.js', import.meta.url), onProgress);
   }
 
   /** Reads `files` ([{name, bytes: ArrayBuffer}]) into maps: `{added, errors}`. */

@@ -63,9 +63,13 @@ const HTML = `
   </div>`;
 
 export class RealMaps {
-  /** `root`: the view's element; `opener`: the toolbar button; `download(name, data, type)`. */
-  constructor(root, opener, { download }) {
+  /**
+   * `root`: the view's element; `opener`: the toolbar button;
+   * `download(name, data, type)`; `covers`: the views over the lab (cover.js).
+   */
+  constructor(root, opener, { download, covers }) {
     this.root = root;
+    this.covers = covers;
     this.opener = opener;
     this.download = download;
     this.maps = [];
@@ -112,26 +116,10 @@ export class RealMaps {
     this.refresh();
   }
 
-  /**
-   * The lab's frame loop asks this each frame: while this view covers an
-   * idle lab, the loop stops (so the page's main thread has nothing to do
-   * while a merge runs) and `resume` restarts it when the view closes.
-   */
-  holdsFrames(labRunning, resume) {
-    if (this.root.hidden || labRunning) return false;
-    this.resume = resume;
-    return true;
-  }
-
   toggle(open) {
     this.root.hidden = !open;
-    // The lab behind is kept as it is but not painted while this view covers it.
-    document.body.classList.toggle('real-open', open);
-    if (!open && this.resume) {
-      const resume = this.resume;
-      this.resume = null;
-      resume();
-    }
+    // The lab behind is kept as it is, but not painted nor animated while covered.
+    this.covers.set(this, open);
     this.opener.setAttribute('aria-expanded', String(open));
     if (open) this.root.querySelector('.real-close').focus();
     else this.opener.focus();
