@@ -137,6 +137,7 @@ export class LogView {
       const out = await this.client.request({ type: 'open', bytes }, [bytes]);
       this.state = { name: file.name, records: out.records, done: 0, total: out.records, closures: 0, left: out.records, finished: false };
       this.files = null;
+      this.refresh();
       await this.client.request({ type: 'step', n: 0, size });
     } catch (e) {
       this.state = { ...this.state, name: '', records: 0, left: 0 };
