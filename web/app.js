@@ -14,10 +14,9 @@
 //   summary.js      the printable summary, read from each panel's method
 //   palette.js      the robots' colours; status.js the status line and guard
 //   *-panel.js, guided.js  the side and bottom panels, the guided mode;
-//                   pair-view.js the merge's frame pair over the page
-//                   (pair-map.js: where the two were taken),
-//                   match-table.js its matched-pair table; merge-words.js the
-//                   verdict in words; hidpi.js canvases at the pixel ratio
+//                   pair-view.js (+ pair-map.js) the merge's frame pair,
+//                   match-table.js, merge-words.js, hidpi.js (pixel ratio)
+//   real/           your own maps and logs, merged and replayed in workers
 // and web/lab.js, the facade over the wasm `Lab` the command line uses too.
 //
 // Data flows one way: input handlers call the store or a controller; the
@@ -46,6 +45,9 @@ import { CameraPanel } from './page/camera-panel.js';
 import { MapsPanel } from './page/maps-panel.js';
 import { MergePanel } from './page/merge-panel.js';
 import { GuidedTour } from './page/guided.js';
+import { Covers } from './page/real/cover.js';
+import { RealMaps } from './page/real/panel.js';
+import { LogView } from './page/real/log-panel.js';
 
 const $ = (id) => document.getElementById(id);
 const canvas = $('world');
@@ -154,6 +156,9 @@ const summary = new Summary($('summary'), $('summary-open'), {
   maps: mapsPanel,
   merge: mergePanel,
 });
+const covers = new Covers();
+const realMaps = new RealMaps($('real'), $('real-open'), { download, covers });
+const logView = new LogView($('logview'), $('log-open'), { download, covers });
 const toolbar = new Toolbar({ guard, store, runner, editor, view, persistence, robotsPanel, canvas });
 const keys = new Keys({
   guard, store, runner, editor, view, pointer, toolbar, summary, merge: mergePanel, guide, refreshPanels, refreshControls,
@@ -206,6 +211,7 @@ let worldDrawMs = 0;
 
 /** One animation frame: advance the run, redraw what changed, let the panels follow. */
 function frame(now) {
+  if (covers.holdsFrames(runner.running, () => requestAnimationFrame(frame))) return;
   requestAnimationFrame(frame);
   if (!store.lab) return;
   try {
@@ -249,6 +255,8 @@ async function main() {
   view.restoreLayers();
   toolbar.wire();
   $('guided-open').addEventListener('click', () => guide.toggle());
+  realMaps.wire();
+  logView.wire();
   pointer.listen();
   keys.listen();
   persistence.listen();
@@ -283,6 +291,8 @@ async function main() {
     /** Work counters for the page tests (issue 22): live camera renders per
      *  robot, maps scored, canvas backing stores resized. */
     perf: () => ({ liveDraws: [...cameraPanel.liveDraws], scored: mapsPanel.scored, resized: fitStats.resized }),
+    realMaps,
+    logView,
   };
   document.body.dataset.ready = 'true';
   requestAnimationFrame(frame);

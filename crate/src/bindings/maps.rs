@@ -63,22 +63,57 @@ impl MapMerge {
         Ok(self.maps.len() as u32 - 1)
     }
 
-    /// Size and resolution of map `i` (JSON `{name, width, height, resolution}`).
+    /// Size, resolution and origin of map `i` (JSON `{name, width, height,
+    /// resolution, origin: [x, y, yaw]}`).
     #[wasm_bindgen(js_name = mapInfoJson)]
     pub fn map_info_json(&self, i: u32) -> Result<String, JsError> {
         let m = self
             .maps
             .get(i as usize)
             .ok_or_else(|| JsError::new("no such map"))?;
-        Ok(serde_json::json!({"name": m.name, "width": m.width, "height": m.height, "resolution": m.resolution}).to_string())
+        let o = m.origin;
+        Ok(serde_json::json!({"name": m.name, "width": m.width, "height": m.height, "resolution": m.resolution, "origin": [o.x, o.y, o.theta]}).to_string())
+    }
+
+    /// Map `i`'s cells as grey values for drawing, top row first (PGM
+    /// shades: free 254, occupied 0, unknown 205, `scale` values graded
+    /// between).
+    #[wasm_bindgen(js_name = mapPixels)]
+    pub fn map_pixels(&self, i: u32) -> Result<Vec<u8>, JsError> {
+        let m = self
+            .maps
+            .get(i as usize)
+            .ok_or_else(|| JsError::new("no such map"))?;
+        let mut out = Vec::with_capacity(m.data.len());
+        for row in m.data.chunks(m.width).rev() {
+            out.extend(row.iter().map(|&v| match v {
+                0..=100 => (254 - (v as i32 * 254) / 100) as u8,
+                _ => 205,
+            }));
+        }
+        Ok(out)
     }
 
     /// Merges the maps; returns the report's `maps` and `merge` as JSON.
     pub fn merge(&mut self) -> Result<String, JsError> {
+        self.run_merge(&mut |_| {})
+    }
+
+    /// The same as `merge`, calling `progress` with a line of text after
+    /// each pair (the page's worker forwards it as the merge's progress).
+    #[wasm_bindgen(js_name = mergeWithProgress)]
+    pub fn merge_with_progress(&mut self, progress: &js_sys::Function) -> Result<String, JsError> {
+        self.run_merge(&mut |line: &str| {
+            // A throwing callback only loses a progress line.
+            let _ = progress.call1(&JsValue::NULL, &JsValue::from_str(line));
+        })
+    }
+
+    fn run_merge(&mut self, progress: &mut dyn FnMut(&str)) -> Result<String, JsError> {
         if self.maps.len() < 2 {
             return Err(JsError::new("merge-maps needs at least two maps"));
         }
-        let result = merge_all(&self.maps, &OfflineConfig::default(), &mut |_| {});
+        let result = merge_all(&self.maps, &OfflineConfig::default(), progress);
         let report = result.report(&self.maps).to_string();
         self.result = Some(result);
         self.merged = None;

@@ -104,6 +104,12 @@ impl LogReplay {
         self.remaining()
     }
 
+    /// The laser records replayed so far (a page draws the map as it grows
+    /// from them with [`LogSlam::build_map`]).
+    pub fn replayed(&self) -> &[crate::carmen::LogScan] {
+        &self.log.scans[self.from..self.from + self.next]
+    }
+
     pub fn remaining(&self) -> usize {
         self.to + 1 - self.from - self.next
     }

@@ -1,0 +1,315 @@
+// End-to-end test of "Your maps" (web/page/real/), the page's merge of
+// saved ROS map_server maps, in headless Chromium (tests/support/browser.mjs).
+//
+// The maps are drawn here (tests/support/synthetic-maps.mjs): a floor plan
+// of rooms, one map of its west part in an axis-aligned frame with a
+// non-zero YAML origin, one of its east part turned by 0.9 rad, so the
+// true transform is known. The test opens them through the file input,
+// merges, reads the verdict and the transform (against the truth),
+// downloads the merged map (its PGM header against the size the truth
+// gives), feeds bad files (each message names the file and the field, and
+// the lab's own run and the maps already open are kept), and watches the
+// main thread with a PerformanceObserver('longtask') while two 2000 x 2000
+// maps are opened and merged. Then "Your log": a CARMEN log of a robot
+// driving twice round a ring corridor with drifting odometry
+// (tests/support/synthetic-log.mjs) is opened, stepped, played, paused,
+// closes a loop while it replays, and its map is downloaded.
+//
+// Needs the wasm build in web/pkg (`./build.sh build`). Run alone with
+//   node --test tests/page-real.test.mjs
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import path from 'node:path';
+import { ARTIFACTS, newPage, useBrowser, waitReady } from './support/browser.mjs';
+import { centredFrame, floorPlan, mapImage, mapYaml } from './support/synthetic-maps.mjs';
+import { ringLog } from './support/synthetic-log.mjs';
+
+const env = useBrowser();
+const tmp = mkdtempSync(path.join(tmpdir(), 'slamlab-page-real-'));
+const RES = 0.05;
+
+/**
+ * Two maps of one `w` x `h` m plan: A (nx x ny, seeing x <= 0.65 w) whose
+ * image's lower-left corner is at (-0.5, -0.5) in the plan and whose YAML
+ * origin is (-2, 1); B (n x n, seeing x >= 0.3 w) turned by 0.9 rad around
+ * (0.6 w, h / 2), YAML origin 0. Returns the files and B's map frame in
+ * A's map frame (the transform the merge should report for B).
+ */
+function twoMaps(tag, w, h, nx, ny, n, seed) {
+  const plan = floorPlan(w, h, seed);
+  const frameA = [-0.5, -0.5, 0], originA = [-2, 1, 0];
+  const frameB = centredFrame(0.6 * w, h / 2, 0.9, n, n);
+  const file = (name, data) => {
+    const p = path.join(tmp, name);
+    writeFileSync(p, data);
+    return p;
+  };
+  const files = [
+    file(`${tag}-a.yaml`, mapYaml(`${tag}-a.pgm`, originA)),
+    file(`${tag}-a.pgm`, mapImage(plan, frameA, nx, ny, ([x]) => x <= 0.65 * w)),
+    file(`${tag}-b.yaml`, mapYaml(`${tag}-b.pgm`)),
+    file(`${tag}-b.pgm`, mapImage(plan, frameB, n, n, ([x]) => x >= 0.3 * w)),
+  ];
+  // A's map frame in the plan is its image frame moved back by its origin (yaw 0 both).
+  const truth = [frameB[0] - (frameA[0] - originA[0]), frameB[1] - (frameA[1] - originA[1]), frameB[2]];
+  return { files, truth, sizeA: [nx, ny], sizeB: [n, n], originA };
+}
+
+/** Size of the merged grid: the box around A's image and B's image placed at `pose` (A's map frame). */
+function mergedSize({ sizeA, sizeB, originA }, [x, y, t]) {
+  const pts = [[0, 0], [1, 0], [1, 1], [0, 1]].flatMap(([u, v]) => {
+    const a = [originA[0] + u * sizeA[0] * RES, originA[1] + v * sizeA[1] * RES];
+    const bu = u * sizeB[0] * RES, bv = v * sizeB[1] * RES;
+    return [a, [x + Math.cos(t) * bu - Math.sin(t) * bv, y + Math.sin(t) * bu + Math.cos(t) * bv]];
+  });
+  const span = (k) => Math.max(...pts.map((p) => p[k])) - Math.min(...pts.map((p) => p[k]));
+  return [Math.ceil(span(0) / RES), Math.ceil(span(1) / RES)];
+}
+
+const snapshot = (page) => page.evaluate(() => window.slamlab.realMaps.snapshot());
+
+/** Records the duration of every long task of the page's main thread in `window.longTasks`. */
+function watchLongTasks(page) {
+  return page.evaluate(() => {
+    window.longTasks = [];
+    // Held by the window, so that no garbage collection ends it.
+    window.longTaskObserver = new PerformanceObserver((list) =>
+      window.longTasks.push(...list.getEntries().map((e) => e.duration)),
+    );
+    window.longTaskObserver.observe({ type: 'longtask' });
+  });
+}
+
+/** The observer does see a long task: a 150 ms loop in a task of the page. */
+async function observerWorks(page) {
+  const seen = await page.evaluate(async () => {
+    const n = window.longTasks.length;
+    setTimeout(() => {
+      const t = performance.now();
+      while (performance.now() - t < 150);
+    }, 0);
+    await new Promise((r) => setTimeout(r, 600));
+    return window.longTasks.slice(n);
+  });
+  assert.ok(seen.some((d) => d >= 150), `the observer saw ${seen}`);
+}
+
+async function openView(page) {
+  await page.goto(env.baseUrl);
+  await waitReady(page);
+  await page.getByRole('button', { name: 'Your maps…' }).click();
+  await page.waitForSelector('#real:not([hidden])');
+}
+
+/** Clicks a download button and returns the downloaded bytes. */
+async function downloaded(page, kind) {
+  const [d] = await Promise.all([page.waitForEvent('download'), page.click(`.real-downloads button[data-file="${kind}"]`)]);
+  return { name: d.suggestedFilename(), bytes: readFileSync(await d.path()) };
+}
+
+test('your maps: open two maps, merge them, read the verdict and the transform, download the merged map', { timeout: 180000 }, async () => {
+  const maps = twoMaps('floor', 30, 20, 640, 440, 640, 7);
+  const { context, page, problems } = await newPage(env.browser);
+  await openView(page);
+  await page.setInputFiles('#real-files', maps.files);
+  await page.waitForFunction(() => window.slamlab.realMaps.snapshot().report, null, { timeout: 120000 });
+  assert.equal(await page.locator('.real-card').count(), 2, 'a card per map');
+  assert.match(await page.locator('.real-card').first().innerText(), /floor-a\.yaml \+ floor-a\.pgm\s+640 × 440 cells · 0\.05 m · origin \[-2, 1, 0\]/);
+
+  const verdict = await page.locator('#real-verdict').innerText();
+  assert.match(verdict, /^Merged \(confidence (0\.\d\d|1\.00)\): the maps agree: .*\d/);
+  const report = (await snapshot(page)).report;
+  assert.deepEqual(report.merge.transforms[0], { map: 'floor-a.yaml', pose: [0, 0, 0] });
+  const [x, y, th] = report.merge.transforms[1].pose;
+  const [tx, ty, tt] = maps.truth;
+  assert.ok(Math.hypot(x - tx, y - ty) < 0.1, `B is off by ${Math.hypot(x - tx, y - ty)} m`);
+  assert.ok(Math.abs(th - tt) < (0.5 * Math.PI) / 180, `B is off by ${((th - tt) * 180) / Math.PI} deg`);
+
+  // The table shows the same transform in metres and degrees, and the
+  // static_transform_publisher arguments.
+  const row = await page.locator('#real-transforms tr').nth(2).locator('td').allInnerTexts();
+  assert.equal(row[0], 'floor-b.yaml');
+  assert.ok(Math.abs(Number(row[1]) - tx) < 0.1 && Math.abs(Number(row[2]) - ty) < 0.1, `row ${row}`);
+  assert.ok(Math.abs(Number(row[3]) - (tt * 180) / Math.PI) < 0.5, `row ${row}`);
+  assert.match(row[4], /^-?\d+\.\d{4} -?\d+\.\d{4} 0 0\.9\d{5} 0 0 floor_a floor_b$/);
+  assert.match(await page.locator('#real-pairs').innerText(), /floor-a\.yaml \+ floor-b\.yaml\s+merged/);
+  await page.screenshot({ path: path.join(ARTIFACTS, 'page-real-merged.png') });
+  await page.locator('#real-overlay').scrollIntoViewIfNeeded();
+  await page.screenshot({ path: path.join(ARTIFACTS, 'page-real-overlay.png') });
+
+  // The merged map: a binary PGM as large as the two maps placed by the truth.
+  const pgm = await downloaded(page, 'pgm');
+  assert.equal(pgm.name, 'merged.pgm');
+  const m = /^P5\n(?:#[^\n]*\n)*(\d+) (\d+)\n255\n/.exec(pgm.bytes.subarray(0, 200).toString('latin1'));
+  assert.ok(m, 'a binary PGM header');
+  const [w, h] = [Number(m[1]), Number(m[2])];
+  const [ew, eh] = mergedSize(maps, maps.truth);
+  assert.ok(Math.abs(w - ew) <= 2 && Math.abs(h - eh) <= 2, `merged ${w} x ${h}, the truth gives ${ew} x ${eh}`);
+  assert.equal(pgm.bytes.length, m[0].length + w * h);
+  const cells = pgm.bytes.subarray(m[0].length);
+  const walls = cells.filter((v) => v === 0).length;
+  assert.ok(walls > 1000, `${walls} wall cells`);
+  const yaml = await downloaded(page, 'yaml');
+  assert.match(yaml.bytes.toString('utf8'), /image: "?merged\.pgm"?/);
+  assert.match(yaml.bytes.toString('utf8'), /resolution: 0\.05/);
+  const png = await downloaded(page, 'png');
+  assert.deepEqual([...png.bytes.subarray(1, 4)], [0x50, 0x4e, 0x47]);
+  const json = JSON.parse((await downloaded(page, 'json')).bytes.toString('utf8'));
+  assert.equal(json.status, 'merged');
+  assert.equal(json.transforms[1].static_transform_publisher, row[4]);
+
+  // Closing the view brings the lab back as it was.
+  await page.getByRole('button', { name: /Close your maps/ }).click();
+  assert.equal(await page.locator('#real').isHidden(), true);
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});
+
+test('your maps: bad files are refused by name and field, and nothing already open or run is lost', { timeout: 120000 }, async () => {
+  const { context, page, problems } = await newPage(env.browser);
+  await page.goto(env.baseUrl);
+  await waitReady(page);
+  // The lab has a run under way: three steps of the thesis scenario.
+  for (let i = 0; i < 3; i++) await page.getByRole('button', { name: 'Step', exact: true }).click();
+  const before = await page.evaluate(() => ({ scenario: window.slamlab.scenario(), time: window.slamlab.state().time_s }));
+  await page.getByRole('button', { name: 'Your maps…' }).click();
+
+  const maps = twoMaps('good', 30, 20, 320, 240, 320, 3);
+  await page.setInputFiles('#real-files', maps.files.slice(0, 2));
+  await page.waitForFunction(() => document.querySelectorAll('.real-card').length === 1);
+  assert.equal(await page.locator('#real-merge').isDisabled(), true, 'one map is nothing to merge');
+
+  const file = (name, data) => {
+    const p = path.join(tmp, name);
+    writeFileSync(p, data);
+    return p;
+  };
+  const lonely = file('lonely.yaml', mapYaml('elsewhere.pgm'));
+  const nores = file('nores.yaml', 'image: nores.pgm\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n');
+  const noresImage = file('nores.pgm', readFileSync(maps.files[1]));
+  const huge = file('huge.yaml', mapYaml('huge.pgm'));
+  const hugeImage = file('huge.pgm', Buffer.from('P5\n5000 5000\n255\n'));
+  await page.setInputFiles('#real-files', [lonely, nores, noresImage, huge, hugeImage]);
+  await page.waitForFunction(() => document.querySelector('#real-message').classList.contains('error'));
+  const text = await page.locator('#real-message').innerText();
+  assert.match(text, /lonely\.yaml: image: 'elsewhere\.pgm' is not among the picked files/);
+  assert.match(text, /nores\.yaml: resolution: missing/);
+  assert.match(text, /huge\.yaml: image: 5000 x 5000 pixels is 25000000 cells \(the limit is 16777216 cells/);
+  assert.equal(await page.locator('#real-message').getAttribute('class'), 'real-message error');
+  await page.screenshot({ path: path.join(ARTIFACTS, 'page-real-errors.png') });
+
+  // The map opened before is still there, and a good second map merges with it.
+  assert.equal(await page.locator('.real-card').count(), 1);
+  await page.setInputFiles('#real-files', maps.files.slice(2));
+  await page.waitForFunction(() => window.slamlab.realMaps.snapshot().report, null, { timeout: 120000 });
+  assert.equal((await snapshot(page)).maps.length, 2);
+
+  // The lab behind the view kept its scenario and its run.
+  await page.getByRole('button', { name: /Close your maps/ }).click();
+  const after = await page.evaluate(() => ({ scenario: window.slamlab.scenario(), time: window.slamlab.state().time_s }));
+  assert.deepEqual(after, before);
+  await page.getByRole('button', { name: 'Step', exact: true }).click();
+  assert.ok(Math.abs((await page.evaluate(() => window.slamlab.state().time_s)) - before.time - 0.1) < 1e-9);
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});
+
+test('your maps: opening and merging two 2000 x 2000 maps shows no long task over 100 ms', { timeout: 600000 }, async () => {
+  const maps = twoMaps('large', 90, 90, 2000, 2000, 2000, 11);
+  const { context, page, problems } = await newPage(env.browser);
+  await openView(page);
+  // Watch from the pick on (opening the view is not the merge): two frames
+  // and a moment for the view's first layout and paint.
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  await page.waitForTimeout(300);
+  await watchLongTasks(page);
+  const t0 = Date.now();
+  await page.setInputFiles('#real-files', maps.files);
+  await page.waitForFunction(() => window.slamlab.realMaps.snapshot().report, null, { timeout: 540000, polling: 200 });
+  const wall = Date.now() - t0;
+  // Long tasks are reported after they end: give the observer a moment.
+  await page.waitForTimeout(500);
+  const tasks = await page.evaluate(() => window.longTasks);
+  const snap = await snapshot(page);
+  const longest = Math.max(0, ...tasks);
+  console.log(
+    `2000 x 2000 maps: ${snap.report.merge.status}; merge ${(snap.report.timings_ms.merge / 1000).toFixed(2)} s in the worker, ` +
+      `${(snap.mergeMs / 1000).toFixed(2)} s on the page, ${(wall / 1000).toFixed(2)} s from the pick; ` +
+      `${tasks.length} long tasks, the longest ${longest.toFixed(0)} ms`,
+  );
+  await observerWorks(page);
+  assert.deepEqual(snap.maps.map((m) => [m.width, m.height]), [[2000, 2000], [2000, 2000]]);
+  assert.ok(longest <= 100, `long tasks while opening and merging: ${tasks.map((d) => d.toFixed(0)).join(', ')} ms`);
+  assert.equal(snap.report.merge.status, 'merged', snap.report.merge.reason);
+  const [x, y] = snap.report.merge.transforms[1].pose;
+  assert.ok(Math.hypot(x - maps.truth[0], y - maps.truth[1]) < 0.1);
+  await page.locator('#real-overlay').scrollIntoViewIfNeeded();
+  await page.screenshot({ path: path.join(ARTIFACTS, 'page-real-large.png') });
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});
+
+test('your log: open a CARMEN log, step, play and pause it, see a loop closed, download the map', { timeout: 400000 }, async () => {
+  const file = path.join(tmp, 'ring.log');
+  writeFileSync(file, ringLog({ laps: 2, perLap: 140 }).text);
+  const { context, page, problems } = await newPage(env.browser);
+  await page.goto(env.baseUrl);
+  await waitReady(page);
+  const before = await page.evaluate(() => window.slamlab.scenario());
+  await page.getByRole('button', { name: 'Your log…' }).click();
+  await page.waitForSelector('#logview:not([hidden])');
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  await watchLongTasks(page);
+  const log = () => page.evaluate(() => window.slamlab.logView.snapshot());
+  await page.setInputFiles('#log-file', file);
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().records === 281, null, { timeout: 60000 });
+  assert.match(await page.locator('#log-name').innerText(), /ring\.log: 281 laser records/);
+
+  // Step: one step of as many scans as the speed says (5).
+  await page.getByRole('button', { name: 'Step', exact: true }).click();
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().done === 5, null, { timeout: 60000 });
+  assert.match(await page.locator('#log-progress').innerText(), /^scan 5 of 281 · 0 loop closures$/);
+
+  // Play fast until a loop is closed (the second lap meets the first).
+  await page.locator('#log-speed').fill('20');
+  await page.getByRole('button', { name: 'Play' }).click();
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().closures > 0, null, { timeout: 300000, polling: 100 });
+  const first = await log();
+  assert.ok(first.done > 100 && first.done <= 281, `the first loop closed at scan ${first.done}`);
+  await page.getByRole('button', { name: 'Pause' }).click();
+  // The step under way when Pause was pressed ends; no other starts.
+  await page.waitForFunction(() => !window.slamlab.logView.snapshot().busy);
+  const paused = (await log()).done;
+  await page.waitForTimeout(400);
+  assert.equal((await log()).done, paused, 'no scan is replayed while paused');
+  await page.screenshot({ path: path.join(ARTIFACTS, 'page-log-loop.png') });
+
+  await page.getByRole('button', { name: 'Play' }).click();
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().finished, null, { timeout: 300000, polling: 100 });
+  const done = await log();
+  assert.equal(done.done, 281);
+  assert.ok(done.closures >= first.closures, `${done.closures} loop closures`);
+  assert.match(await page.locator('#log-progress').innerText(), /^done: 281 scans, \d+ loop closures?; map \d+ × \d+ cells$/);
+  await page.screenshot({ path: path.join(ARTIFACTS, 'page-log-done.png') });
+
+  // The map: a binary PGM of the size the replay reports.
+  const [d] = await Promise.all([page.waitForEvent('download'), page.getByRole('button', { name: 'Map PGM' }).click()]);
+  assert.equal(d.suggestedFilename(), 'ring.pgm');
+  const bytes = readFileSync(await d.path());
+  const m = /^P5\n(?:#[^\n]*\n)*(\d+) (\d+)\n255\n/.exec(bytes.subarray(0, 200).toString('latin1'));
+  assert.ok(m, 'a binary PGM header');
+  assert.deepEqual([Number(m[1]), Number(m[2])], [done.summary.map.width, done.summary.map.height]);
+  assert.equal(bytes.length, m[0].length + done.summary.map.width * done.summary.map.height);
+  assert.ok(bytes.subarray(m[0].length).filter((v) => v === 0).length > 500, 'walls in the map');
+
+  const tasks = await page.evaluate(() => window.longTasks);
+  await observerWorks(page);
+  console.log(`log replay: ${done.closures} loop closures, the first at scan ${first.done}; long tasks ${tasks.map(Math.round)}`);
+  assert.ok(Math.max(0, ...tasks) <= 100, `long tasks while replaying: ${tasks.map(Math.round).join(', ')} ms`);
+  await page.getByRole('button', { name: /Close your log/ }).click();
+  assert.deepEqual(await page.evaluate(() => window.slamlab.scenario()), before, 'the lab keeps its scenario');
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});

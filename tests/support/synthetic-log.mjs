@@ -1,0 +1,76 @@
+// A synthetic CARMEN laser log for the page tests: a robot drives `laps`
+// times round a ring corridor (an outer 16 x 10 m wall, an inner block
+// with notches, so places along the loop look different), its 181 beams
+// cast exactly against the walls, its odometry turned by a small heading
+// bias per step so that it drifts and the second lap meets the first one
+// displaced — the case a loop closure mends.
+
+/** Wall segments [[x, y], [x, y]] of the ring. */
+export const RING = (() => {
+  const poly = (pts) => pts.map((p, i) => [p, pts[(i + 1) % pts.length]]);
+  return [
+    ...poly([[-8, -5], [8, -5], [8, 5], [-8, 5]]),
+    ...poly([[-5, -2], [-1, -2], [-1, -2.6], [1, -2.6], [1, -2], [5, -2], [5, 2], [2, 2], [2, 2.5], [-3, 2.5], [-3, 2], [-5, 2]]),
+    [[6.6, -5], [6.6, -4.2]], [[-8, 0.3], [-7.3, 0.3]], [[0, 5], [0, 4.3]],
+  ];
+})();
+
+/** Distance along the ray from `o` in direction `a` to the nearest wall, or `max`. */
+export function rayHit(o, a, walls, max) {
+  const d = [Math.cos(a), Math.sin(a)];
+  let best = max;
+  for (const [p, q] of walls) {
+    const e = [q[0] - p[0], q[1] - p[1]];
+    const w = [p[0] - o[0], p[1] - o[1]];
+    const cross = d[0] * e[1] - d[1] * e[0];
+    if (Math.abs(cross) < 1e-12) continue;
+    const along = (w[0] * e[1] - w[1] * e[0]) / cross;
+    const on = (w[0] * d[1] - w[1] * d[0]) / cross;
+    if (along > 0 && on >= 0 && on <= 1) best = Math.min(best, along);
+  }
+  return best;
+}
+
+/** The true pose at arc parameter s (one lap = 1): a rounded rectangle path in the corridor. */
+function pathPose(s) {
+  const u = 2 * Math.PI * (s % 1);
+  const x = 6.5 * Math.cos(u), y = 3.5 * Math.sin(u);
+  return [x, y, Math.atan2(3.5 * Math.cos(u), -6.5 * Math.sin(u))];
+}
+
+/**
+ * The log's text: `laps` laps of `perLap` scans, FLASER records (181
+ * beams, 80 m "no return") with ODOM records before them, odometry with a
+ * heading bias of `bias` rad per step. Returns `{text, truth}`.
+ */
+export function ringLog({ laps = 2, perLap = 140, bias = 0.004 } = {}) {
+  const out = ['# a ring corridor driven round, made by tests/support/synthetic-log.mjs'];
+  const truth = [];
+  let odo = null;
+  let last = null;
+  const n = laps * perLap;
+  for (let i = 0; i <= n; i++) {
+    const p = pathPose(i / perLap);
+    if (!last) odo = [...p];
+    else {
+      const c = Math.cos(last[2]), s = Math.sin(last[2]);
+      const dx = p[0] - last[0], dy = p[1] - last[1];
+      const fwd = c * dx + s * dy, side = -s * dx + c * dy;
+      const turn = Math.atan2(Math.sin(p[2] - last[2]), Math.cos(p[2] - last[2])) + bias;
+      const oc = Math.cos(odo[2]), os = Math.sin(odo[2]);
+      odo = [odo[0] + oc * fwd - os * side, odo[1] + os * fwd + oc * side, odo[2] + turn];
+    }
+    last = p;
+    truth.push(p);
+    const ranges = [];
+    for (let b = 0; b <= 180; b++) {
+      const r = rayHit(p, p[2] + ((b - 90) * Math.PI) / 180, RING, 80);
+      ranges.push(r >= 80 ? '80.00' : r.toFixed(3));
+    }
+    const pose = odo.map((v) => v.toFixed(5)).join(' ');
+    const t = (1000 + 0.25 * i).toFixed(3);
+    out.push(`ODOM ${pose} 0.4 0 0 ${t} sim ${t}`);
+    out.push(`FLASER 181 ${ranges.join(' ')} ${pose} ${pose} ${t} sim ${t}`);
+  }
+  return { text: out.join('\n') + '\n', truth };
+}

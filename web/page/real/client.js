@@ -1,0 +1,70 @@
+// The page's side of its workers (merge-worker.js, log-worker.js):
+// requests as promises, progress lines to a callback. A worker is started
+// on first use, so a page that never opens its own maps or logs never
+// loads a second wasm.
+
+export class WorkerClient {
+  /** `url`: the module worker; `onProgress(text)`: its progress lines. */
+  constructor(url, onProgress = () => {}) {
+    this.url = url;
+    this.onProgress = onProgress;
+    this.worker = null;
+    this.next = 1;
+    this.waiting = new Map();
+  }
+
+  start() {
+    if (this.worker) return;
+    this.worker = new Worker(this.url, { type: 'module' });
+    this.worker.onmessage = ({ data }) => {
+      if (data.type === 'progress') {
+        this.onProgress(data.text);
+        return;
+      }
+      const w = this.waiting.get(data.id);
+      if (!w) return;
+      this.waiting.delete(data.id);
+      if (data.ok) w.resolve(data);
+      else w.reject(new Error(data.error));
+    };
+    this.worker.onerror = (e) => {
+      const error = new Error(`the page's worker failed: ${e.message || 'could not load it (is web/pkg built?)'}`);
+      for (const w of this.waiting.values()) w.reject(error);
+      this.waiting.clear();
+      this.worker?.terminate();
+      this.worker = null;
+    };
+  }
+
+  request(message, transfer = []) {
+    this.start();
+    const id = this.next++;
+    return new Promise((resolve, reject) => {
+      this.waiting.set(id, { resolve, reject });
+      this.worker.postMessage({ ...message, id }, transfer);
+    });
+  }
+
+}
+
+/** The merge worker's requests. */
+export class MergeClient extends WorkerClient {
+  constructor(onProgress) {
+    super(new URL('./merge-worker.js', import.meta.url), onProgress);
+  }
+
+  /** Reads `files` ([{name, bytes: ArrayBuffer}]) into maps: `{added, errors}`. */
+  add(files, resolution, colours) {
+    return this.request({ type: 'add', files, resolution, colours }, files.map((f) => f.bytes));
+  }
+
+  /** Merges the maps read so far: `{report, files}` (files null on no_merge). */
+  merge() {
+    return this.request({ type: 'merge' });
+  }
+
+  /** Forgets every map. */
+  clear() {
+    return this.worker ? this.request({ type: 'clear' }) : Promise.resolve();
+  }
+}

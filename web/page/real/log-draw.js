@@ -1,0 +1,107 @@
+// Drawing a log replay in the log worker (log-worker.js): the map of the
+// scans so far (walls dark, free space white, unknown left grey), the
+// path the odometry believes (dashed grey) beside the path SLAM gives
+// (blue, moved by every loop closure), each loop closure as an orange line
+// between the two scans it joined, and the robot's current pose. Poses and
+// the map share one frame (the log's odometry frame, the first scan at its
+// odometry pose); the view fits the map's known cells and both paths.
+
+/** The live map as a picture: `grey` PGM shades top row first, `info` its MapInfo. */
+export async function mapPicture(grey, info) {
+  const { width: w, height: h } = info;
+  const rgba = new Uint8ClampedArray(w * h * 4);
+  let [c0, r0, c1, r1] = [w, h, -1, -1];
+  for (let i = 0; i < w * h; i++) {
+    const g = grey[i];
+    if (g === 205) continue;
+    const v = g < 128 ? 34 : 255;
+    rgba[i * 4] = v;
+    rgba[i * 4 + 1] = v;
+    rgba[i * 4 + 2] = v;
+    rgba[i * 4 + 3] = 255;
+    const col = i % w, row = (i / w) | 0;
+    [c0, r0, c1, r1] = [Math.min(c0, col), Math.min(r0, row), Math.max(c1, col), Math.max(r1, row)];
+  }
+  const bitmap = await createImageBitmap(new ImageData(rgba, w, h));
+  const r = info.resolution_m, [ox, oy] = info.origin_m;
+  const box = c1 < 0 ? null : [ox + c0 * r, oy + (h - 1 - r1) * r, ox + (c1 + 1) * r, oy + (h - r0) * r];
+  return { bitmap, info, box };
+}
+
+function path(ctx, flat) {
+  ctx.beginPath();
+  for (let i = 0; i < flat.length; i += 3) ctx[i ? 'lineTo' : 'moveTo'](flat[i], flat[i + 1]);
+  ctx.stroke();
+}
+
+/** The world box [x0, y0, x1, y1] to fit: the map's known cells and both paths. */
+function bounds(picture, view) {
+  const b = picture?.box ? [...picture.box] : [Infinity, Infinity, -Infinity, -Infinity];
+  for (const flat of [view.odometry, view.poses]) {
+    for (let i = 0; i < flat.length; i += 3) {
+      b[0] = Math.min(b[0], flat[i] - 1);
+      b[1] = Math.min(b[1], flat[i + 1] - 1);
+      b[2] = Math.max(b[2], flat[i] + 1);
+      b[3] = Math.max(b[3], flat[i + 1] + 1);
+    }
+  }
+  return b;
+}
+
+/** Draws the replay into `canvas` (`size`: {width, height, dpr} in device pixels). */
+export function drawReplay(canvas, { width, height, dpr }, picture, view) {
+  if (canvas.width !== width || canvas.height !== height) {
+    canvas.width = width;
+    canvas.height = height;
+  }
+  const ctx = canvas.getContext('2d');
+  ctx.setTransform(1, 0, 0, 1, 0, 0);
+  ctx.fillStyle = '#e6e6e1';
+  ctx.fillRect(0, 0, width, height);
+  const [x0, y0, x1, y1] = bounds(picture, view);
+  if (!(x1 > x0)) return;
+  const pad = 10 * dpr;
+  const k = Math.min((width - 2 * pad) / (x1 - x0), (height - 2 * pad) / (y1 - y0));
+  const ox = (width - k * (x1 - x0)) / 2, oy = (height - k * (y1 - y0)) / 2;
+  ctx.setTransform(k, 0, 0, -k, ox - k * x0, oy + k * y1);
+  if (picture) {
+    const { info, bitmap } = picture;
+    const r = info.resolution_m;
+    ctx.save();
+    ctx.transform(r, 0, 0, -r, info.origin_m[0], info.origin_m[1] + info.height * r);
+    ctx.imageSmoothingEnabled = k * r < 1;
+    ctx.drawImage(bitmap, 0, 0);
+    ctx.restore();
+  }
+  ctx.lineJoin = 'round';
+  ctx.lineWidth = (1.5 * dpr) / k;
+  ctx.setLineDash([(6 * dpr) / k, (4 * dpr) / k]);
+  ctx.strokeStyle = '#7a7a7a';
+  path(ctx, view.odometry);
+  ctx.setLineDash([]);
+  ctx.lineWidth = (2 * dpr) / k;
+  ctx.strokeStyle = '#1f5fbf';
+  path(ctx, view.poses);
+  ctx.strokeStyle = '#e07b00';
+  ctx.lineWidth = (2.5 * dpr) / k;
+  for (const c of view.closures) {
+    const [ax, ay, bx, by] = c.segment;
+    ctx.beginPath();
+    ctx.moveTo(ax, ay);
+    ctx.lineTo(bx, by);
+    ctx.stroke();
+    for (const [x, y] of [[ax, ay], [bx, by]]) {
+      ctx.beginPath();
+      ctx.arc(x, y, (3 * dpr) / k, 0, 2 * Math.PI);
+      ctx.fillStyle = '#e07b00';
+      ctx.fill();
+    }
+  }
+  const n = view.poses.length;
+  if (n) {
+    ctx.beginPath();
+    ctx.arc(view.poses[n - 3], view.poses[n - 2], (5 * dpr) / k, 0, 2 * Math.PI);
+    ctx.fillStyle = '#c81414';
+    ctx.fill();
+  }
+}

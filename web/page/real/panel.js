@@ -1,0 +1,387 @@
+// "Your maps": merge saved ROS map_server maps in the page (issue 20).
+//
+// A view over the lab (like the summary) where a user opens two to sixteen
+// maps of their own — each YAML with its PGM or PNG image, picked together
+// or dropped, or an image alone at a typed resolution — sees each one,
+// merges them automatically and reads the verdict with its reason and
+// confidence, each map's transform (metres, degrees, and the arguments of
+// ROS's static_transform_publisher) and each pair's verdict, sees the
+// joined maps overlaid in their colours, and downloads the merged map (PGM
+// + YAML + PNG) and the transforms (JSON). The reading, drawing and merging
+// run in a Web Worker (merge-worker.js), so the page stays responsive; the
+// lab's own scenario and runs behind this view are never touched.
+
+import { MergeClient } from './client.js';
+import { transformRows, transformsJson, verdictText } from './report.js';
+
+/** One colour per map (up to 16), told apart on white. */
+export const MAP_COLOURS = [
+  '#1f77b4', '#d62728', '#2ca02c', '#9467bd', '#ff7f0e', '#17becf', '#8c564b', '#e377c2',
+  '#7f7f7f', '#bcbd22', '#393b79', '#ad494a', '#637939', '#7b4173', '#843c39', '#3182bd',
+];
+
+const HTML = `
+  <div class="real-head">
+    <h1 id="real-title">Your maps: merge saved ROS maps</h1>
+    <button type="button" class="real-close" aria-label="Close your maps and go back to the lab">Close</button>
+  </div>
+  <p class="real-note">Open two to sixteen ROS <code>map_server</code> maps, each a YAML with the PGM or PNG image it
+    names (pick or drop them together). The lab merges them with the same automatic merge as
+    <code>node web/cli.mjs merge-maps</code>, off the page's main thread. Your scenario and runs stay as they are.</p>
+  <div class="real-drop" tabindex="0" aria-label="Drop map files here">
+    <span>Drop map files here, or</span>
+    <label class="button primary" for="real-files">Open maps…</label>
+    <input id="real-files" type="file" multiple accept=".yaml,.yml,.pgm,.png" hidden>
+    <label for="real-resolution" title="For an image picked without a YAML">Resolution of an image without YAML</label>
+    <input id="real-resolution" type="number" min="0.001" step="0.01" value="0.05" class="num"><span class="unit">m</span>
+    <button type="button" id="real-clear">Clear maps</button>
+  </div>
+  <div id="real-message" class="real-message" role="alert" hidden></div>
+  <div id="real-maps" class="real-maps" aria-label="The maps you opened"></div>
+  <div class="real-merge-row">
+    <button type="button" id="real-merge" class="primary">Merge maps</button>
+    <span class="real-busy" aria-hidden="true"></span>
+    <span id="real-stage" class="real-stage" aria-live="polite"></span>
+  </div>
+  <div id="real-result" class="real-result" hidden>
+    <p id="real-verdict" class="real-verdict"></p>
+    <table id="real-transforms" class="summary-table"><caption>Each map's frame in the first map's frame</caption></table>
+    <table id="real-pairs" class="summary-table"><caption>Each pair's own verdict</caption></table>
+    <div class="real-overlay-head">
+      <h2>Merged overlay</h2>
+      <label for="real-alpha">Opacity</label>
+      <input id="real-alpha" type="range" min="15" max="100" value="85" aria-label="Opacity of the maps in the overlay">
+    </div>
+    <canvas id="real-overlay" class="real-overlay" aria-label="The joined maps overlaid in their colours"></canvas>
+    <p id="real-legend" class="real-legend"></p>
+    <div class="real-downloads">
+      <button type="button" data-file="pgm">Merged map PGM</button>
+      <button type="button" data-file="yaml">Merged map YAML</button>
+      <button type="button" data-file="png">Merged map PNG</button>
+      <button type="button" data-file="json">Transforms JSON</button>
+    </div>
+  </div>`;
+
+export class RealMaps {
+  /**
+   * `root`: the view's element; `opener`: the toolbar button;
+   * `download(name, data, type)`; `covers`: the views over the lab (cover.js).
+   */
+  constructor(root, opener, { download, covers }) {
+    this.root = root;
+    this.covers = covers;
+    this.opener = opener;
+    this.download = download;
+    this.maps = [];
+    this.report = null;
+    this.files = null;
+    this.busy = false;
+    this.queue = Promise.resolve();
+    this.client = new MergeClient((text) => this.progress(text));
+  }
+
+  /** Builds the view and connects its controls. */
+  wire() {
+    const root = this.root;
+    root.innerHTML = HTML;
+    const q = (s) => root.querySelector(s);
+    this.opener.addEventListener('click', () => this.toggle(true));
+    q('.real-close').addEventListener('click', () => this.toggle(false));
+    root.addEventListener('keydown', (e) => {
+      if (e.key === 'Escape') this.toggle(false);
+      e.stopPropagation(); // the lab's shortcuts stay with the lab
+    });
+    q('#real-files').addEventListener('change', (e) => {
+      this.open([...e.target.files]);
+      e.target.value = '';
+    });
+    root.addEventListener('dragover', (e) => {
+      e.preventDefault();
+      q('.real-drop').classList.add('over');
+    });
+    root.addEventListener('dragleave', () => q('.real-drop').classList.remove('over'));
+    root.addEventListener('drop', (e) => {
+      e.preventDefault();
+      q('.real-drop').classList.remove('over');
+      this.open([...(e.dataTransfer?.files ?? [])]);
+    });
+    q('#real-clear').addEventListener('click', () => this.enqueue(() => this.clear()));
+    q('#real-merge').addEventListener('click', () => this.enqueue(() => this.merge()));
+    q('#real-alpha').addEventListener('input', () => this.drawOverlay());
+    for (const b of root.querySelectorAll('.real-downloads button')) {
+      b.addEventListener('click', () => this.save(b.dataset.file));
+    }
+    this.resizes = new ResizeObserver(() => this.drawOverlay());
+    this.resizes.observe(q('#real-overlay'));
+    this.refresh();
+  }
+
+  toggle(open) {
+    this.root.hidden = !open;
+    // The lab behind is kept as it is, but not painted nor animated while covered.
+    this.covers.set(this, open);
+    this.opener.setAttribute('aria-expanded', String(open));
+    if (open) this.root.querySelector('.real-close').focus();
+    else this.opener.focus();
+    if (open) this.drawOverlay();
+  }
+
+  /** Runs `job` after whatever is under way (picks, merges) has finished. */
+  enqueue(job) {
+    this.queue = this.queue.then(job).catch((e) => this.say(e.message, 'error'));
+    return this.queue;
+  }
+
+  /** Opens picked or dropped files: adds their maps, then merges if two or more. */
+  open(files) {
+    if (!files.length) return this.queue;
+    return this.enqueue(async () => {
+      performance.mark('real-open');
+      this.attachCanvas();
+      const read = await Promise.all(files.map(async (f) => ({ name: f.name, bytes: await f.arrayBuffer() })));
+      const resolution = this.root.querySelector('#real-resolution').value;
+      this.setBusy(true, `reading ${files.length} file${files.length > 1 ? 's' : ''}…`);
+      let out;
+      try {
+        out = await this.client.add(read, resolution, MAP_COLOURS);
+      } finally {
+        this.setBusy(false, '');
+      }
+      performance.mark('real-added');
+      this.maps.push(...out.added);
+      if (out.added.length) this.dropResult();
+      if (out.errors.length) this.say(`Not opened: ${out.errors.join(' · ')}`, 'error');
+      else this.say(`Opened ${out.added.map((m) => m.name).join(', ')}.`, 'ok');
+      this.refresh();
+      performance.mark('real-listed');
+      if (out.added.length && this.maps.length >= 2) {
+        await nextFrame();
+        await this.merge();
+      }
+    });
+  }
+
+  async clear() {
+    await this.client.clear();
+    this.maps = [];
+    this.dropResult();
+    this.say('', 'info');
+    this.refresh();
+  }
+
+  async merge() {
+    if (this.maps.length < 2) {
+      this.say('Open two or more maps to merge them.', 'warn');
+      return;
+    }
+    const n = this.maps.length;
+    const t0 = performance.now();
+    // Nothing ticks or animates while it runs: the page's main thread stays
+    // idle until the worker answers (a progress line comes after each pair).
+    this.setBusy(true, `merging ${n} maps (${(n * (n - 1)) / 2} pair${n > 2 ? 's' : ''})…`);
+    let out;
+    try {
+      out = await this.client.merge();
+    } finally {
+      this.setBusy(false, '');
+    }
+    performance.mark('real-merged');
+    this.report = out.report;
+    this.files = out.files;
+    this.mergeMs = performance.now() - t0;
+    this.stage(`merged in ${(this.mergeMs / 1000).toFixed(2)} s (the merge itself ${(out.report.timings_ms.merge / 1000).toFixed(2)} s)`);
+    await nextFrame();
+    this.showResult();
+    performance.mark('real-shown');
+  }
+
+  progress(text) {
+    this.stage(text);
+  }
+
+  stage(text) {
+    this.root.querySelector('#real-stage').textContent = text;
+  }
+
+  say(text, kind) {
+    const m = this.root.querySelector('#real-message');
+    m.textContent = text;
+    m.className = `real-message ${kind}`;
+    m.hidden = !text;
+  }
+
+  setBusy(busy, text) {
+    this.busy = busy;
+    this.root.classList.toggle('busy', busy);
+    this.stage(text);
+    this.refresh();
+  }
+
+  dropResult() {
+    this.report = null;
+    this.files = null;
+    this.root.querySelector('#real-result').hidden = true;
+    this.stage('');
+  }
+
+  /** The map cards and the state of the buttons. */
+  refresh() {
+    const q = (s) => this.root.querySelector(s);
+    q('#real-merge').disabled = this.busy || this.maps.length < 2;
+    q('#real-clear').disabled = this.busy || this.maps.length === 0;
+    const list = q('#real-maps');
+    if (list.childElementCount === this.maps.length) return;
+    list.replaceChildren(...this.maps.map((m) => (m.card ??= card(m))));
+  }
+
+  showResult() {
+    const q = (s) => this.root.querySelector(s);
+    const merge = this.report.merge;
+    q('#real-result').hidden = false;
+    const v = q('#real-verdict');
+    v.textContent = verdictText(merge);
+    v.className = `real-verdict ${merge.status === 'merged' ? 'ok' : 'no'}`;
+    const rows = transformRows(merge).map((r) => [r.map, r.x, r.y, r.deg, r.args]);
+    for (const name of merge.unjoined) rows.push([name, '–', '–', '–', 'not joined']);
+    fillTable(q('#real-transforms'), ['map', 'x (m)', 'y (m)', 'θ (°)', 'static_transform_publisher'], rows);
+    fillTable(
+      q('#real-pairs'),
+      ['pair', 'verdict', 'confidence', 'reason'],
+      merge.pairs.map((p) => [`${p.a} + ${p.b}`, p.status, p.confidence.toFixed(2), p.reason]),
+    );
+    for (const b of this.root.querySelectorAll('.real-downloads button')) {
+      b.disabled = b.dataset.file !== 'json' && !this.files;
+    }
+    // The overlay in a task of its own, after the tables are laid out.
+    nextFrame().then(() => this.drawOverlay());
+  }
+
+  /**
+   * The joined maps in the first map's frame, each in its colour: drawn by
+   * the worker into the overlay canvas (handed over once per worker), one
+   * drawing at a time (a slider's many events make one more at most).
+   */
+  drawOverlay() {
+    if (!this.report || this.root.hidden) return;
+    if (this.drawing) {
+      this.redraw = true;
+      return;
+    }
+    const canvas = this.attachCanvas();
+    const dpr = window.devicePixelRatio || 1;
+    const size = {
+      width: Math.max(1, Math.round(canvas.clientWidth * dpr)),
+      height: Math.max(1, Math.round(canvas.clientHeight * dpr)),
+      dpr,
+      alpha: this.root.querySelector('#real-alpha').value / 100,
+    };
+    this.drawing = true;
+    this.client
+      .request({ type: 'draw', ...size })
+      .catch((e) => this.say(e.message, 'error'))
+      .finally(() => {
+        this.drawing = false;
+        if (this.redraw) {
+          this.redraw = false;
+          this.drawOverlay();
+        }
+      });
+    this.legend();
+  }
+
+  /** Hands the overlay canvas to the worker (once per worker); returns the canvas. */
+  attachCanvas() {
+    let canvas = this.root.querySelector('#real-overlay');
+    if (this.canvasWorker === this.client.worker && this.client.worker) return canvas;
+    this.client.start();
+    if (this.canvasWorker) {
+      // A restarted worker needs a canvas of its own: control moves once.
+      const fresh = canvas.cloneNode();
+      canvas.replaceWith(fresh);
+      this.resizes.observe(fresh);
+      canvas = fresh;
+    }
+    const offscreen = canvas.transferControlToOffscreen();
+    this.client.request({ type: 'canvas', canvas: offscreen }, [offscreen]);
+    this.canvasWorker = this.client.worker;
+    return canvas;
+  }
+
+  legend() {
+    const byName = new Map(this.maps.map((m) => [m.name, m]));
+    const placed = this.report.merge.transforms.filter((t) => byName.has(t.map)).map((t) => ({ map: byName.get(t.map) }));
+    const legend = this.root.querySelector('#real-legend');
+    legend.replaceChildren(
+      ...placed.map(({ map }) => swatch(map.colour, map.name)),
+      placed.length > 1 ? 'Walls of two maps that fall on each other show dark.' : '',
+    );
+  }
+
+  save(kind) {
+    if (kind === 'json' && this.report) {
+      this.download('transforms.json', transformsJson(this.report), 'application/json');
+      return;
+    }
+    if (!this.files) return;
+    if (kind === 'pgm') this.download('merged.pgm', this.files.pgm, 'image/x-portable-graymap');
+    if (kind === 'png') this.download('merged.png', this.files.png, 'image/png');
+    if (kind === 'yaml') this.download('merged.yaml', this.files.yaml, 'application/yaml');
+  }
+
+  /** For tests and the console: what the view holds. */
+  snapshot() {
+    return {
+      maps: this.maps.map(({ name, width, height, resolution, origin }) => ({ name, width, height, resolution, origin })),
+      report: this.report,
+      mergeMs: this.mergeMs,
+      busy: this.busy,
+    };
+  }
+}
+
+/** Resolves after the next frame has been drawn (work split into short tasks). */
+function nextFrame() {
+  return new Promise((resolve) => requestAnimationFrame(() => setTimeout(resolve, 0)));
+}
+
+/** One opened map: its picture, name, size and resolution. */
+function card(m) {
+  const div = document.createElement('figure');
+  div.className = 'real-card';
+  div.style.borderColor = m.colour;
+  // The worker made the thumbnail at its shown size (a large canvas shrunk
+  // by CSS would be shrunk again at every repaint of the page).
+  const c = document.createElement('canvas');
+  c.width = m.thumb.width;
+  c.height = m.thumb.height;
+  c.getContext('bitmaprenderer').transferFromImageBitmap(m.thumb);
+  c.setAttribute('aria-label', `${m.name}, drawn in its colour`);
+  const cap = document.createElement('figcaption');
+  const o = m.origin.map((v) => Number(v.toFixed(3)));
+  cap.innerHTML = `<b style="color:${m.colour}"></b><br>${m.width} × ${m.height} cells · ${m.resolution} m · origin [${o.join(', ')}]`;
+  cap.querySelector('b').textContent = m.imageName === m.name ? m.name : `${m.name} + ${m.imageName}`;
+  div.append(c, cap);
+  return div;
+}
+
+function swatch(colour, name) {
+  const s = document.createElement('span');
+  s.className = 'real-swatch';
+  s.style.setProperty('--c', colour);
+  s.textContent = name;
+  return s;
+}
+
+function fillTable(table, head, rows) {
+  const caption = table.querySelector('caption');
+  const tr = (cells, tag) => {
+    const r = document.createElement('tr');
+    for (const c of cells) {
+      const td = document.createElement(tag);
+      td.textContent = c;
+      r.append(td);
+    }
+    return r;
+  };
+  table.replaceChildren(caption, tr(head, 'th'), ...rows.map((r) => tr(r, 'td')));
+}
