@@ -206,8 +206,7 @@ function onChange(kind) {
 
 const WORLD_FRAME_MS = 33; // the world view's redraw interval while running (about 30 per second)
 const WORLD_SHARE = 3; // ... and at most every 3 times its drawing time (a third of the time)
-let lastWorldMs = 0;
-let worldDrawMs = 0;
+let [lastWorldMs, worldDrawMs] = [0, 0];
 
 /** One animation frame: advance the run, redraw what changed, let the panels follow. */
 function frame(now) {
