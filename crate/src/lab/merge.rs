@@ -151,6 +151,17 @@ fn round6(x: f64) -> f64 {
     (x * 1e6).round() / 1e6
 }
 
+/// Transforms with their poses rounded for the report.
+fn rounded(transforms: &[RobotTransform]) -> Vec<RobotTransform> {
+    transforms
+        .iter()
+        .map(|t| RobotTransform {
+            robot: t.robot.clone(),
+            pose: t.pose.map(round6),
+        })
+        .collect()
+}
+
 /// Position (m) and heading (deg) error of `estimate` against `truth`.
 pub fn pose_error(estimate: &Pose2, truth: &Pose2) -> (f64, f64) {
     (
@@ -379,27 +390,13 @@ impl Lab {
             status: outcome.status,
             reason: outcome.reason.clone(),
             confidence: round6(outcome.confidence),
-            transforms: outcome
-                .transforms
-                .iter()
-                .map(|t| RobotTransform {
-                    robot: t.robot.clone(),
-                    pose: t.pose.map(round6),
-                })
-                .collect(),
+            transforms: rounded(&outcome.transforms),
             unjoined: outcome.unjoined.clone(),
             groups: outcome
                 .groups
                 .iter()
                 .map(|g| RobotGroup {
-                    transforms: g
-                        .transforms
-                        .iter()
-                        .map(|t| RobotTransform {
-                            robot: t.robot.clone(),
-                            pose: t.pose.map(round6),
-                        })
-                        .collect(),
+                    transforms: rounded(&g.transforms),
                     ..g.clone()
                 })
                 .collect(),
