@@ -196,13 +196,14 @@ fn frames_thinned_while_out_are_dropped_and_the_merge_reports_the_same() {
     let mut helped = Lab::new(&json).expect("lab");
     helped.set_frame_budget(budget);
     let mut helper = Lab::new(&json).expect("helper");
-    // Features described one round, handed back the next, as a worker
-    // does: meanwhile the store may thin the frame.
+    // Features described as frames are listed and handed back only at the
+    // end, as a slow worker might: meanwhile the store thins most of them.
     let mut out = Vec::new();
     let (mut kept, mut refused) = (0, 0);
     loop {
         let finished = helped.state().finished;
-        for (robot, index, f) in out.drain(..) {
+        let back = if finished { out.len() } else { 0 };
+        for (robot, index, f) in out.drain(..back) {
             let stored = helped
                 .store_described(robot, index, MergeMethod::Auto, f)
                 .expect("a frame that was captured");
