@@ -173,3 +173,82 @@ fn a_merge_that_takes_described_frames_reports_the_same() {
     helped.step(300).expect("steps");
     assert!(!helped.frames_to_describe(MergeMethod::Auto).is_empty());
 }
+
+/// Issue 22: the frame store thins its frames when its budget is full, also
+/// frames listed, handed out and being described elsewhere. What comes back
+/// for a thinned frame is dropped cleanly (and said so), and the merge,
+/// which asks only for frames the store holds, reports what a merge
+/// describing everything itself reports.
+#[wasm_bindgen_test(unsupported = test)]
+fn frames_thinned_while_out_are_dropped_and_the_merge_reports_the_same() {
+    let json = scenario(120.0);
+    // Room for 20 frames a robot (two robots): a frame a second thins
+    // several times in 120 s.
+    let budget = 40 * slamlab::camera::capture::FRAME_BYTES;
+    let mut alone = Lab::new(&json).expect("lab");
+    alone.set_frame_budget(budget);
+    alone.run_to_end().expect("runs");
+    alone.merge_start(MergeMethod::Auto).expect("starts");
+    alone.merge_finish().expect("merges");
+    let held = alone.frames(0).expect("frames").len();
+    assert!(held <= 20, "{held} frames kept within the budget");
+
+    let mut helped = Lab::new(&json).expect("lab");
+    helped.set_frame_budget(budget);
+    let mut helper = Lab::new(&json).expect("helper");
+    // Features described as frames are listed and handed back only at the
+    // end, as a slow worker might: meanwhile the store thins most of them.
+    let mut out = Vec::new();
+    let (mut kept, mut refused) = (0, 0);
+    loop {
+        let finished = helped.state().finished;
+        let back = if finished { out.len() } else { 0 };
+        for (robot, index, f) in out.drain(..back) {
+            let stored = helped
+                .store_described(robot, index, MergeMethod::Auto, f)
+                .expect("a frame that was captured");
+            assert_eq!(stored, helped.has_frame(robot, index));
+            if stored {
+                kept += 1;
+            } else {
+                refused += 1;
+            }
+        }
+        if finished {
+            break;
+        }
+        helped.step(150).expect("steps");
+        for (robot, index) in helped.frames_to_describe(MergeMethod::Auto) {
+            assert!(
+                helped.has_frame(robot, index),
+                "only held frames are listed"
+            );
+            let spec = helped.frame_spec(robot, index).expect("spec");
+            let f = helper
+                .describe_frame_spec(&spec, MergeMethod::Auto)
+                .expect("describes");
+            out.push((robot, index, f));
+        }
+    }
+    assert!(
+        refused > 0,
+        "some frames were thinned while out ({kept} kept)"
+    );
+    assert!(kept > 0, "{refused} refused, none kept");
+    // A thinned frame is gone for the pixels path too, and for its spec.
+    let r = helped.state().robots.len();
+    let gone = (0..r)
+        .flat_map(|robot| (0..50).map(move |i| (robot, i)))
+        .find(|&(robot, i)| !helped.has_frame(robot, i))
+        .expect("a thinned frame");
+    assert_eq!(
+        helped.describe_rendered(gone.0, gone.1, MergeMethod::Auto, vec![0; 320 * 240]),
+        Ok(false)
+    );
+    assert!(helped.frame_spec(gone.0, gone.1).is_err());
+    helped.merge_start(MergeMethod::Auto).expect("starts");
+    helped.merge_finish().expect("merges");
+    let (x, y) = (view_without_timings(&alone), view_without_timings(&helped));
+    assert!(x["report"].is_object(), "a verdict");
+    assert_eq!(x, y);
+}

@@ -15,7 +15,7 @@ use slamlab::merge::consistency::{
 };
 use slamlab::merge::frames::MergeInput;
 use slamlab::merge::fuse::fuse;
-use slamlab::merge::graph::{spanning_tree, PairEdge};
+use slamlab::merge::graph::{groups, spanning_tree, PairEdge};
 use slamlab::merge::job::{MergeConfig, MergeJob, Stage};
 use slamlab::merge::lift::{column_bearing_rad, laser_range_at, lift_keypoint_3d};
 use slamlab::merge::mapsearch::{dominant_rotation, search_maps, MapSearchConfig};
@@ -895,6 +895,49 @@ fn spanning_tree_joins_three_robots_by_the_surest_edges_and_lists_the_fourth() {
     // No edges: only robot 0; no robots: nothing.
     assert_eq!(spanning_tree(2, &[]).unjoined(), vec![1]);
     assert!(spanning_tree(0, &edges).poses.is_empty());
+}
+
+/// Issue 22: with robots 0–1 joined, 2–3–4 joined among themselves and 5
+/// joined to no one, every group comes out, each in its first robot's frame.
+#[wasm_bindgen_test(unsupported = test)]
+fn groups_are_every_connected_group_each_in_its_first_robots_frame() {
+    let edge = |a, b, pose, confidence| PairEdge {
+        a,
+        b,
+        pose,
+        confidence,
+    };
+    let e01 = Pose2::new(2.0, 0.0, PI / 2.0);
+    let e34 = Pose2::new(0.0, 3.0, -PI / 2.0);
+    let e23 = Pose2::new(1.0, 0.0, PI);
+    let edges = [
+        edge(0, 1, e01, 0.9),
+        // Stored from 4 to 3: robot 3's frame in robot 4's.
+        edge(4, 3, e34.inverse(), 0.7),
+        edge(2, 3, e23, 0.6),
+        edge(5, 0, Pose2::IDENTITY, 0.0),
+    ];
+    let g = groups(6, &edges);
+    let members =
+        |k: usize| -> Vec<usize> { (0..6).filter(|&i| g[k].poses[i].is_some()).collect() };
+    assert_eq!(g.len(), 3);
+    assert_eq!(members(0), vec![0, 1]);
+    assert_eq!(members(1), vec![2, 3, 4]);
+    assert_eq!(members(2), vec![5]);
+    // Robot 0's group is the spanning tree from robot 0.
+    assert_eq!(g[0], spanning_tree(6, &edges));
+    assert_eq!(g[1].poses[2], Some(Pose2::IDENTITY));
+    assert_eq!(g[1].poses[3], Some(e23));
+    // Robot 4 in robot 2's frame: e23 ⊕ e34 = (1, 0) + R(180°)·(0, 3) =
+    // (1, -3), heading 180° - 90° = 90°.
+    let p4 = g[1].poses[4].expect("joined");
+    assert!(
+        (p4.x - 1.0).abs() < 1e-12 && (p4.y + 3.0).abs() < 1e-12,
+        "{p4:?}"
+    );
+    assert!((p4.theta - PI / 2.0).abs() < 1e-12, "{p4:?}");
+    assert_eq!(g[2].poses[5], Some(Pose2::IDENTITY));
+    assert!(groups(0, &edges).is_empty());
 }
 
 // ----- timing ---------------------------------------------------------------

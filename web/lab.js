@@ -63,6 +63,11 @@ export class Lab {
     this.raw.setDuration(seconds);
   }
 
+  /** Bytes of camera frames all robots may keep together (default 16 MiB); stops the run. */
+  setFrameBudget(bytes) {
+    this.raw.setFrameBudget(bytes);
+  }
+
   // --- The run --------------------------------------------------------------
 
   /** Back to t = 0 (the scenario is kept). */
@@ -268,6 +273,11 @@ export class Lab {
     return out;
   }
 
+  /** Whether the run still holds a frame (the store thins its frames when full). */
+  hasFrame(robot, index) {
+    return this.raw.hasFrame(robot, index);
+  }
+
   /** What a worker needs to render a frame (JSON text, handed on unparsed). */
   frameSpec(robot, index) {
     return this.raw.frameSpecJson(robot, index);
@@ -277,12 +287,14 @@ export class Lab {
     return this.raw.describeFrameSpec(spec, method);
   }
 
+  /** False (nothing kept) when the frame has been thinned since it was handed out. */
   describeRendered(robot, index, method, gray) {
-    this.raw.describeRendered(robot, index, method, gray);
+    return this.raw.describeRendered(robot, index, method, gray);
   }
 
+  /** False (nothing kept) when the frame has been thinned since it was handed out. */
   storeDescribed(robot, index, method, packed) {
-    this.raw.storeDescribed(robot, index, method, packed);
+    return this.raw.storeDescribed(robot, index, method, packed);
   }
 }
 

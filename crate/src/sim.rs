@@ -333,6 +333,18 @@ impl Simulation {
         Ok(sim)
     }
 
+    /// Shares a frame budget of `bytes` among the robots' frame stores
+    /// instead of [`crate::camera::capture::FRAME_BUDGET_BYTES`] (for tests
+    /// and measurements of thinning; a store over its new share thins at
+    /// its next frame).
+    pub fn set_frame_budget(&mut self, bytes: usize) {
+        let n = self.robots.len();
+        for r in &mut self.robots {
+            r.frames
+                .set_budget(bytes, crate::camera::capture::FRAME_BYTES, n);
+        }
+    }
+
     /// Control steps taken so far.
     pub fn steps(&self) -> usize {
         self.steps

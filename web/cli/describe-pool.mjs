@@ -11,6 +11,13 @@
 // main thread, whose textures are not, runs SURF on the pixels. The merge
 // then finds every frame described; any a worker could not do, it
 // describes itself (and stderr says so).
+//
+// The frame store thins its frames when its memory budget is full
+// (crate/src/camera/capture.rs), also frames listed, queued or out with a
+// worker. A queued frame that is gone is not handed out; features that
+// come back for a gone frame are dropped (the lab says so by returning
+// false, and forgets what it kept of frames thinned later); the merge only
+// asks for frames the store holds.
 import { Worker } from 'node:worker_threads';
 import os from 'node:os';
 import path from 'node:path';
@@ -127,6 +134,7 @@ export class DescribePool {
     for (const w of this.workers) {
       while (w.alive && w.pending < this.ahead && this.queue.length > 0) {
         const { robot, index } = this.queue.shift();
+        if (!lab.hasFrame(robot, index)) continue; // thinned while queued
         w.thread.postMessage({ robot, index, spec: lab.frameSpec(robot, index), render: this.render });
         w.pending += 1;
       }
@@ -172,6 +180,7 @@ export class DescribePool {
         }
       } else if (this.queue.length > 0 && live.length === 0) {
         const { robot, index } = this.queue.pop();
+        if (!lab.hasFrame(robot, index)) continue;
         const packed = lab.describeFrameSpec(lab.frameSpec(robot, index), this.method);
         lab.storeDescribed(robot, index, this.method, packed);
       } else if (live.some((w) => w.pending > 0)) {

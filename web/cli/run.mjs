@@ -9,21 +9,25 @@ import { simulate, mergeMaps } from './run-loop.mjs';
 
 export const usage = `usage:
   node web/cli.mjs run SCENARIO.json [--seed N] [--duration S] [--method auto|thesis|map-only] [--json]
-      [--workers N]
+      [--workers N] [--frame-budget-mb MB]
       run the scenario headless, merge the robots' maps (default method: auto)
       and print a report (JSON with --json); N worker threads (default: one
       per core but the main thread's, at most 4) describe camera frames while
-      the robots run`;
+      the robots run; MB: memory all robots' stored frames may take (default
+      16; the store thins its frames beyond it)`;
 
 async function run(argv, wasm) {
   const { positional, options } = parseArgs(argv, {
     seed: 'value', duration: 'value', json: 'flag', method: 'value', workers: 'value',
+    'frame-budget-mb': 'value',
   });
   if (positional.length !== 1) throw new UsageError('run: expected exactly one SCENARIO.json');
   const method = methodOf(options);
   const workers = method === 'map-only' ? 0 : workersOf(options);
   const t0 = performance.now();
   const lab = await openScenario(positional[0], options, wasm);
+  const budget = frameBudgetOf(options);
+  if (budget !== undefined) wasmCall(() => lab.setFrameBudget(budget));
   const { simulateMs, waitMs } = await simulate(lab, { method, workers, progress: true });
   mergeMaps(lab, method);
   const totalMs = performance.now() - t0;
@@ -34,6 +38,17 @@ async function run(argv, wasm) {
     printSummary(wasmCall(() => lab.report(timings)), simulateMs);
   }
   return 0;
+}
+
+/** --frame-budget-mb as bytes (undefined when not given). */
+function frameBudgetOf(options) {
+  const v = options['frame-budget-mb'];
+  if (v === undefined) return undefined;
+  const mb = Number(v);
+  if (v.trim() === '' || !Number.isFinite(mb) || mb <= 0 || mb > 4000) {
+    throw new UsageError(`--frame-budget-mb: '${v}' is not a number of megabytes above 0 and at most 4000`);
+  }
+  return Math.round(mb * 1024 * 1024);
 }
 
 /** The report for people. */

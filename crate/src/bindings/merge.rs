@@ -36,6 +36,14 @@ impl Lab {
             .collect())
     }
 
+    /// Whether robot `robot` of this run holds frame `index` now (the frame
+    /// store thins its frames when full: a frame listed by
+    /// `framesToDescribe` may be gone a few steps later).
+    #[wasm_bindgen(js_name = hasFrame)]
+    pub fn has_frame(&self, robot: u32, index: u32) -> bool {
+        self.inner.has_frame(robot as usize, index as usize)
+    }
+
     /// Frame `index` of robot `robot` of this run as JSON, for a lab of the
     /// same scenario in another thread to describe (`describeFrameSpec`).
     #[wasm_bindgen(js_name = frameSpecJson)]
@@ -76,7 +84,8 @@ impl Lab {
 
     /// Describes frame `index` of robot `robot` of this run from its grey
     /// pixels (from `renderFrameSpec` in another lab of the same scenario)
-    /// and keeps the features for the next merge with `method`.
+    /// and keeps the features for the next merge with `method`. Returns
+    /// false, keeping nothing, if the frame store thinned the frame since.
     #[wasm_bindgen(js_name = describeRendered)]
     pub fn describe_rendered(
         &mut self,
@@ -84,7 +93,7 @@ impl Lab {
         index: u32,
         method: &str,
         gray: Vec<u8>,
-    ) -> Result<(), JsError> {
+    ) -> Result<bool, JsError> {
         let method = MergeMethod::parse(method).map_err(err)?;
         self.inner
             .describe_rendered(robot as usize, index as usize, method, gray)
@@ -93,7 +102,8 @@ impl Lab {
 
     /// Keeps the packed features (from `describeFrameSpec`) of frame `index`
     /// of robot `robot` of this run for the next merge with `method`, which
-    /// takes them instead of describing the frame itself.
+    /// takes them instead of describing the frame itself. Returns false,
+    /// keeping nothing, if the frame store thinned the frame since.
     #[wasm_bindgen(js_name = storeDescribed)]
     pub fn store_described(
         &mut self,
@@ -101,7 +111,7 @@ impl Lab {
         index: u32,
         method: &str,
         packed: &[f32],
-    ) -> Result<(), JsError> {
+    ) -> Result<bool, JsError> {
         let method = MergeMethod::parse(method).map_err(err)?;
         let f = crate::merge::described::decode(packed).map_err(err)?;
         self.inner

@@ -143,6 +143,19 @@ impl Lab {
         self.inner.set_duration(duration_s).map_err(js_err)
     }
 
+    /// Sets the bytes of camera frames all robots may keep together (the
+    /// frame store thins beyond it; default 16 MiB) and stops the run.
+    #[wasm_bindgen(js_name = setFrameBudget)]
+    pub fn set_frame_budget(&mut self, bytes: f64) -> Result<(), JsError> {
+        if !(bytes.is_finite() && bytes >= 0.0 && bytes.fract() == 0.0 && bytes <= 4.0e9) {
+            return Err(JsError::new(&format!(
+                "frame budget: {bytes} is not a whole number of bytes from 0 to 4e9"
+            )));
+        }
+        self.inner.set_frame_budget(bytes as usize);
+        Ok(())
+    }
+
     /// Back to time 0.
     pub fn reset(&mut self) {
         self.inner.reset();

@@ -75,14 +75,35 @@ impl FrameStore {
     /// `robots` robots sharing the budget, capturing every `period_steps`
     /// steps.
     pub fn new(frame_bytes: usize, robots: usize, period_steps: usize) -> Self {
-        let share = FRAME_BUDGET_BYTES / robots.max(1);
-        FrameStore {
+        let mut store = FrameStore {
             frames: Vec::new(),
             period_steps: period_steps.max(1),
-            max_frames: (share / frame_bytes.max(1)).max(2),
+            max_frames: 2,
             dropped: 0,
             next_index: 0,
-        }
+        };
+        store.set_budget(FRAME_BUDGET_BYTES, frame_bytes, robots);
+        store
+    }
+
+    /// Gives the store its share of a budget of `budget_bytes` for all
+    /// `robots` robots' frames of `frame_bytes` each (at least two frames).
+    /// A store already fuller than its new share thins at its next frame.
+    pub fn set_budget(&mut self, budget_bytes: usize, frame_bytes: usize, robots: usize) {
+        let share = budget_bytes / robots.max(1);
+        self.max_frames = (share / frame_bytes.max(1)).max(2);
+    }
+
+    /// Whether frame `index` is stored (captured and not thinned since).
+    pub fn holds(&self, index: usize) -> bool {
+        self.frames
+            .binary_search_by_key(&index, |f| f.index)
+            .is_ok()
+    }
+
+    /// Whether frame `index` was captured and then dropped by thinning.
+    pub fn thinned(&self, index: usize) -> bool {
+        index < self.next_index && !self.holds(index)
     }
 
     /// Whether a frame is due at `step`.

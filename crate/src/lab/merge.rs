@@ -17,7 +17,7 @@ use crate::camera::CameraImage;
 use crate::geom::{wrap_angle, Pose2};
 use crate::merge::described::{describe_image, frames_to_describe};
 use crate::merge::job::{
-    MergeConfig, MergeJob, MergeOutcome, MergeTimes, PairOutcome, RobotTransform, Stage,
+    MergeConfig, MergeJob, MergeOutcome, MergeTimes, PairOutcome, RobotGroup, RobotTransform, Stage,
 };
 use crate::merge::{MergeMethod, MergeStatus};
 use crate::slam::export::{to_pgm, to_png, to_yaml, GridPicture};
@@ -74,6 +74,9 @@ pub struct MergeReport {
     pub confidence: f64,
     pub transforms: Vec<RobotTransform>,
     pub unjoined: Vec<String>,
+    /// Every connected group of robots, each in its first robot's frame
+    /// (`interfaces.md`); robot 1's group first.
+    pub groups: Vec<RobotGroup>,
     pub pairs: Vec<PairOutcome>,
     /// Scored against the ground truth (never used by the merge).
     pub errors: Vec<TransformError>,
@@ -148,6 +151,17 @@ fn round6(x: f64) -> f64 {
     (x * 1e6).round() / 1e6
 }
 
+/// Transforms with their poses rounded for the report.
+fn rounded(transforms: &[RobotTransform]) -> Vec<RobotTransform> {
+    transforms
+        .iter()
+        .map(|t| RobotTransform {
+            robot: t.robot.clone(),
+            pose: t.pose.map(round6),
+        })
+        .collect()
+}
+
 /// Position (m) and heading (deg) error of `estimate` against `truth`.
 pub fn pose_error(estimate: &Pose2, truth: &Pose2) -> (f64, f64) {
     (
@@ -187,6 +201,14 @@ impl Lab {
             .collect()
     }
 
+    /// Whether robot `robot` of this run holds frame `index` now (frames
+    /// the store thinned are gone: see [`crate::camera::capture`]).
+    pub fn has_frame(&self, robot: usize, index: usize) -> bool {
+        self.simulation()
+            .and_then(|sim| sim.robots.get(robot))
+            .is_some_and(|r| r.frames.holds(index))
+    }
+
     /// Frame `index` of robot `robot` of this run, for another lab of the
     /// same scenario to describe.
     pub fn frame_spec(&self, robot: usize, index: usize) -> Result<FrameSpec, String> {
@@ -218,17 +240,20 @@ impl Lab {
     /// Describes frame `index` of robot `robot` of this run from its grey
     /// pixels, rendered by another lab of the same scenario
     /// ([`Lab::render_frame_spec`]), and keeps the features for the next
-    /// merge with `method`. Fails if the frame does not exist or `gray` is
-    /// not the camera's size.
+    /// merge with `method`. Returns false, keeping nothing, when the store
+    /// has thinned the frame since it was handed out; fails if the frame
+    /// was never captured or `gray` is not the camera's size.
     pub fn describe_rendered(
         &mut self,
         robot: usize,
         index: usize,
         method: MergeMethod,
         gray: Vec<u8>,
-    ) -> Result<(), String> {
+    ) -> Result<bool, String> {
         let sim = self.simulation().ok_or("nothing has run yet")?;
-        frame_exists(sim, robot, index)?;
+        if !frame_held(sim, robot, index)? {
+            return Ok(false);
+        }
         let cam = &sim.scenario.camera;
         let (width, height) = (cam.width, cam.height);
         if gray.len() != (width * height) as usize {
@@ -250,18 +275,23 @@ impl Lab {
 
     /// Keeps features another lab described for frame `index` of robot
     /// `robot` of this run, for the next merge with `method` to take.
+    /// Returns false, keeping nothing, when the store has thinned the frame
+    /// since it was handed out (no merge will ask for it); fails if the
+    /// frame was never captured.
     pub fn store_described(
         &mut self,
         robot: usize,
         index: usize,
         method: MergeMethod,
         features: crate::surf::Features,
-    ) -> Result<(), String> {
+    ) -> Result<bool, String> {
         let sim = self.simulation().ok_or("nothing has run yet")?;
-        frame_exists(sim, robot, index)?;
+        if !frame_held(sim, robot, index)? {
+            return Ok(false);
+        }
         let config = MergeConfig::new(method, sim.scenario.seed);
         self.described.insert(&config, robot, index, features);
-        Ok(())
+        Ok(true)
     }
 
     /// Where the merge stands.
@@ -360,15 +390,16 @@ impl Lab {
             status: outcome.status,
             reason: outcome.reason.clone(),
             confidence: round6(outcome.confidence),
-            transforms: outcome
-                .transforms
+            transforms: rounded(&outcome.transforms),
+            unjoined: outcome.unjoined.clone(),
+            groups: outcome
+                .groups
                 .iter()
-                .map(|t| RobotTransform {
-                    robot: t.robot.clone(),
-                    pose: t.pose.map(round6),
+                .map(|g| RobotGroup {
+                    transforms: rounded(&g.transforms),
+                    ..g.clone()
                 })
                 .collect(),
-            unjoined: outcome.unjoined.clone(),
             pairs: outcome.pairs.clone(),
             errors,
             pair_errors,
@@ -553,16 +584,19 @@ fn map_info(g: &OccupancyGrid) -> MergedMapInfo {
     }
 }
 
-/// Fails unless robot `robot` of `sim` has a stored frame `index`.
-fn frame_exists(sim: &crate::sim::Simulation, robot: usize, index: usize) -> Result<(), String> {
-    let frames = &sim
+/// Whether robot `robot` of `sim` holds frame `index`: true if stored,
+/// false if captured and thinned since; an error if there is no such robot
+/// or the frame was never captured.
+fn frame_held(sim: &crate::sim::Simulation, robot: usize, index: usize) -> Result<bool, String> {
+    let store = &sim
         .robots
         .get(robot)
         .ok_or_else(|| format!("no robot {robot}"))?
-        .frames
         .frames;
-    if frames.iter().any(|f| f.index == index) {
-        Ok(())
+    if store.holds(index) {
+        Ok(true)
+    } else if store.thinned(index) {
+        Ok(false)
     } else {
         Err(format!("robot {robot} has no frame {index}"))
     }

@@ -62,6 +62,9 @@ pub struct Lab {
     described: crate::merge::described::DescribedFrames,
     /// The host's millisecond clock, for stage timings.
     clock: Option<fn() -> f64>,
+    /// Bytes of frames all robots may keep, when not the default
+    /// ([`crate::camera::capture::FRAME_BUDGET_BYTES`]).
+    frame_budget: Option<usize>,
 }
 
 /// Live figures for the page's readouts.
@@ -114,6 +117,7 @@ impl Lab {
             merge: None,
             described: Default::default(),
             clock: None,
+            frame_budget: None,
         })
     }
 
@@ -148,6 +152,13 @@ impl Lab {
 
     pub fn set_seed(&mut self, seed: u64) {
         self.scenario.seed = seed;
+        self.stop();
+    }
+
+    /// Sets the bytes of frames all robots may keep (the store thins beyond
+    /// it, [`crate::camera::capture`]) and stops the run.
+    pub fn set_frame_budget(&mut self, bytes: usize) {
+        self.frame_budget = Some(bytes);
         self.stop();
     }
 
@@ -201,6 +212,9 @@ impl Lab {
                         if let Some(clock) = self.clock {
                             s.set_clock(clock);
                         }
+                        if let Some(bytes) = self.frame_budget {
+                            s.set_frame_budget(bytes);
+                        }
                         s
                     }
                     Err(e) => {
@@ -232,7 +246,9 @@ impl Lab {
             }
             sim.step();
         }
-        Ok(sim.steps() - before)
+        let taken = sim.steps() - before;
+        self.forget_thinned();
+        Ok(taken)
     }
 
     /// Runs to the end of the scenario's duration.
@@ -241,7 +257,18 @@ impl Lab {
             self.merge = None;
         }
         self.start()?.run_to_end();
+        self.forget_thinned();
         Ok(())
+    }
+
+    /// Drops what other threads described of frames the store has thinned
+    /// since: no merge will ask for them.
+    fn forget_thinned(&mut self) {
+        if let Some(sim) = &self.sim {
+            self.described.retain(|robot, index| {
+                sim.robots.get(robot).is_some_and(|r| r.frames.holds(index))
+            });
+        }
     }
 
     pub fn state(&self) -> LabState {

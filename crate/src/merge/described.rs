@@ -161,6 +161,12 @@ impl DescribedFrames {
         self.features.remove(&(robot, index))
     }
 
+    /// Keeps only the frames `(robot, index)` for which `keep` says so.
+    pub fn retain(&mut self, mut keep: impl FnMut(usize, usize) -> bool) {
+        self.features
+            .retain(|&(robot, index), _| keep(robot, index));
+    }
+
     pub fn len(&self) -> usize {
         self.features.len()
     }

@@ -16,6 +16,11 @@
 //! frame in a's, so with a's frame at `P_a` in robot 0's, b's is
 //! `P_a ⊕ T`; walked the other way, `P_a = P_b ⊕ T⁻¹`. Robots that no edge
 //! reaches stay unjoined, and are listed.
+//!
+//! With many robots, several groups may each share a map among themselves
+//! and none with robot 0's group ([`groups`]): each is grown the same way,
+//! from its lowest-numbered robot, whose frame is that group's frame. The
+//! first group is always robot 0's, exactly as [`spanning_tree`] joins it.
 
 use crate::geom::Pose2;
 
@@ -54,12 +59,38 @@ impl Joined {
 /// Ties go to the lower edge index. Edges naming robots out of range, loops
 /// (`a == b`) and non-finite poses are ignored.
 pub fn spanning_tree(robots: usize, edges: &[PairEdge]) -> Joined {
+    spanning_tree_from(robots, edges, 0)
+}
+
+/// Every connected group of robots, each joined along its own
+/// maximum-confidence spanning tree from its lowest-numbered robot (poses
+/// in that robot's frame; robots of other groups `None`), in the order of
+/// their first robots: robot 0's group first. A robot no edge reaches is a
+/// group of its own.
+pub fn groups(robots: usize, edges: &[PairEdge]) -> Vec<Joined> {
+    let mut placed = vec![false; robots];
+    let mut out = Vec::new();
+    for root in 0..robots {
+        if placed[root] {
+            continue;
+        }
+        let joined = spanning_tree_from(robots, edges, root);
+        for (i, p) in joined.poses.iter().enumerate() {
+            placed[i] |= p.is_some();
+        }
+        out.push(joined);
+    }
+    out
+}
+
+/// [`spanning_tree`] grown from robot `root` (whose frame is the group's).
+pub fn spanning_tree_from(robots: usize, edges: &[PairEdge], root: usize) -> Joined {
     let mut poses: Vec<Option<Pose2>> = vec![None; robots];
     let mut edges_used = Vec::new();
-    if robots == 0 {
+    if root >= robots {
         return Joined { poses, edges_used };
     }
-    poses[0] = Some(Pose2::IDENTITY);
+    poses[root] = Some(Pose2::IDENTITY);
     let usable = |e: &PairEdge| {
         e.a < robots
             && e.b < robots

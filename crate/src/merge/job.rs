@@ -40,7 +40,7 @@
 use super::described::{describe_image, DescribedFrames};
 use super::frames::MergeInput;
 use super::fuse::fuse;
-use super::graph::{spanning_tree, PairEdge};
+use super::graph::{groups, spanning_tree, Joined, PairEdge};
 use super::method::{pose3, stages_of, MethodStages, PairInput};
 use super::verify::{verify_pair, PairCheck, VerifyConfig};
 use super::MergeStatus;
@@ -97,6 +97,18 @@ pub struct RobotTransform {
     pub pose: [f64; 3],
 }
 
+/// One connected group of robots the merge joined: the robots, in order,
+/// and each one's map frame in the frame of the group's first robot. A
+/// robot no merged pair reaches is a group of its own, with the reason.
+#[derive(Clone, Debug, Serialize)]
+pub struct RobotGroup {
+    pub robots: Vec<String>,
+    pub transforms: Vec<RobotTransform>,
+    /// Why a robot stands alone (only on groups of one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+}
+
 /// The overall result.
 #[derive(Clone, Debug, Serialize)]
 pub struct MergeOutcome {
@@ -107,6 +119,9 @@ pub struct MergeOutcome {
     pub transforms: Vec<RobotTransform>,
     /// Robots that could not be joined to the first.
     pub unjoined: Vec<String>,
+    /// Every connected group of robots, robot 0's first (its transforms
+    /// are [`MergeOutcome::transforms`]).
+    pub groups: Vec<RobotGroup>,
     pub pairs: Vec<PairOutcome>,
 }
 
@@ -436,6 +451,7 @@ impl MergeJob {
             })
             .collect();
         let joined = spanning_tree(n, &edges);
+        let groups = self.groups(&edges, &pairs);
         let transforms: Vec<RobotTransform> = joined
             .poses
             .iter()
@@ -513,7 +529,73 @@ impl MergeJob {
             },
             transforms,
             unjoined,
+            groups,
             pairs,
+        }
+    }
+
+    /// Every connected group the merged pairs `edges` make
+    /// ([`super::graph::groups`]); a robot alone gets the reason, from the
+    /// decisions `pairs` on its pairs.
+    fn groups(&self, edges: &[PairEdge], pairs: &[PairOutcome]) -> Vec<RobotGroup> {
+        let n = self.robots.len();
+        groups(n, edges)
+            .iter()
+            .map(|g: &Joined| {
+                let members: Vec<(usize, Pose2)> = g
+                    .poses
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(i, p)| p.map(|p| (i, p)))
+                    .collect();
+                let reason = match members.as_slice() {
+                    [(i, _)] => Some(self.alone_reason(*i, pairs)),
+                    _ => None,
+                };
+                RobotGroup {
+                    robots: members
+                        .iter()
+                        .map(|(i, _)| self.robots[*i].name.clone())
+                        .collect(),
+                    transforms: members
+                        .iter()
+                        .map(|(i, p)| RobotTransform {
+                            robot: self.robots[*i].name.clone(),
+                            pose: pose3(p),
+                        })
+                        .collect(),
+                    reason,
+                }
+            })
+            .collect()
+    }
+
+    /// Why robot `i` joined no one: the decision on its closest pair (the
+    /// most confident, then the one with the most candidates).
+    fn alone_reason(&self, i: usize, pairs: &[PairOutcome]) -> String {
+        let name = &self.robots[i].name;
+        let mine: Vec<&PairOutcome> = pairs
+            .iter()
+            .filter(|o| &o.a == name || &o.b == name)
+            .collect();
+        let closest = mine.iter().copied().reduce(|best, o| {
+            let better = o.confidence.total_cmp(&best.confidence).is_gt()
+                || (o.confidence == best.confidence && o.candidates > best.candidates);
+            if better {
+                o
+            } else {
+                best
+            }
+        });
+        match closest {
+            None => format!("{name} is the only robot: there is nothing to merge"),
+            Some(o) => format!(
+                "{name} joined no other robot: none of its {} pairs merged; closest, {} + {}: {}",
+                mine.len(),
+                o.a,
+                o.b,
+                o.reason
+            ),
         }
     }
 
