@@ -5,7 +5,8 @@
 //! `cargo run --release -p slamlab --example run -- scenarios/thesis.json [auto|thesis|map-only]`
 //!
 //! `perf record -g target/release/examples/run scenarios/thesis.json` shows
-//! where the time goes.
+//! where the time goes; `… run SCENARIO.json simulate` stops after the
+//! simulation (the robots' runs, their SLAM and frames) and prints its time.
 
 use slamlab::lab::Lab;
 use slamlab::merge::MergeMethod;
@@ -15,8 +16,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
     let path = args
         .get(1)
-        .ok_or("usage: run SCENARIO.json [auto|thesis|map-only]")?;
-    let method = MergeMethod::parse(args.get(2).map_or("auto", |s| s.as_str()))?;
+        .ok_or("usage: run SCENARIO.json [auto|thesis|map-only|simulate]")?;
+    let method_arg = args.get(2).map_or("auto", |s| s.as_str());
+    let simulate_only = method_arg == "simulate";
+    let method = MergeMethod::parse(if simulate_only { "auto" } else { method_arg })?;
     let mut lab = Lab::new(&std::fs::read_to_string(path)?)?;
     let start = Instant::now();
     lab.set_clock(|| {
@@ -25,6 +28,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     });
     lab.run_to_end()?;
     let simulate = start.elapsed().as_secs_f64() * 1e3;
+    if simulate_only {
+        for (i, spec) in lab.scenario().robots.iter().enumerate() {
+            let f = lab.slam_figures(i)?;
+            println!(
+                "  {}: SLAM ATE {:.4} m (odometry {:.4} m)",
+                spec.name, f.ate_m, f.odometry_ate_m
+            );
+        }
+        println!("simulate (ms): {simulate:.0}");
+        return Ok(());
+    }
     lab.merge_start(method)?;
     lab.merge_finish()?;
     let total = start.elapsed().as_secs_f64() * 1e3;

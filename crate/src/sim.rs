@@ -43,6 +43,7 @@ use crate::kinematics::{integrate_wheels, wheel_speeds, P2dx, WheelState, CONTRO
 use crate::odometry::Odometry;
 use crate::rng::{Rng, Stream};
 use crate::scenario::{RobotSpec, Scenario, ScenarioError};
+use crate::sensors::sonar::SONAR_POSITIONS_M;
 use crate::sensors::{Laser, LaserScan, RangeScene, Sonar, SonarReading, LASER_BEAMS, SONAR_COUNT};
 use crate::world::World;
 use std::collections::VecDeque;
@@ -364,19 +365,34 @@ impl Simulation {
         self.steps >= self.total_steps()
     }
 
-    /// Body edges of every robot except `skip`.
-    fn obstacles_except(&self, skip: usize) -> Vec<Segment> {
+    /// Body edges of every robot except `skip` that robot `skip`'s laser or
+    /// sonars could reach: a robot whose centre is farther than the longer
+    /// sensor range plus both reaches (the body's circumradius, and the
+    /// farthest sensor from the centre) cannot be hit, so its edges are left
+    /// out. The kept edges keep their order, so every ray's answer, ties
+    /// included, is the one casting against all robots gives; with 16
+    /// robots in a big maze most are out of reach, and testing their edges
+    /// was a fifth of the simulation's time.
+    fn obstacles_near(&self, skip: usize) -> Vec<Segment> {
+        let me = &self.robots[skip];
+        let body_radius = 0.5 * P2dx::BODY_LENGTH_M.hypot(P2dx::BODY_WIDTH_M);
+        let sensor_reach = SONAR_POSITIONS_M
+            .iter()
+            .map(|p| p[0].hypot(p[1]))
+            .fold(body_radius, f64::max);
+        let reach = me.laser.range_m.max(me.sonar.range_m) + sensor_reach + body_radius;
+        let centre = me.truth.position();
         self.robots
             .iter()
             .enumerate()
-            .filter(|(j, _)| *j != skip)
+            .filter(|(j, r)| *j != skip && r.truth.position().distance(centre) <= reach)
             .flat_map(|(_, r)| r.body().edges().collect::<Vec<_>>())
             .collect()
     }
 
     fn sense(&mut self) {
         for i in 0..self.robots.len() {
-            let obstacles = self.obstacles_except(i);
+            let obstacles = self.obstacles_near(i);
             let scene = RangeScene {
                 world: &self.world,
                 obstacles: &obstacles,
@@ -409,12 +425,18 @@ impl Simulation {
             r.last_command = overrides.get(i).copied().flatten().unwrap_or(auto);
         }
         // 2-3. move and read encoders
+        // Two bodies can touch only when their centres are within both
+        // circumradii plus this step's travel (at most a few centimetres);
+        // bodies farther than that (with a generous margin) are left out,
+        // which changes no answer.
+        let touch_reach = P2dx::BODY_LENGTH_M.hypot(P2dx::BODY_WIDTH_M) + 0.5;
         for i in 0..self.robots.len() {
+            let centre = self.robots[i].truth.position();
             let others: Vec<ConvexPolygon> = self
                 .robots
                 .iter()
                 .enumerate()
-                .filter(|(j, _)| *j != i)
+                .filter(|(j, r)| *j != i && r.truth.position().distance(centre) <= touch_reach)
                 .map(|(_, r)| r.body())
                 .collect();
             let world = &self.world;
