@@ -340,7 +340,7 @@ export class RealMaps {
 }
 
 /** Resolves after the next frame has been drawn (work split into short tasks). */
-function nextFrame() {
+export function nextFrame() {
   return new Promise((resolve) => requestAnimationFrame(() => setTimeout(resolve, 0)));
 }
 
@@ -364,7 +364,7 @@ function card(m) {
   return div;
 }
 
-function swatch(colour, name) {
+export function swatch(colour, name) {
   const s = document.createElement('span');
   s.className = 'real-swatch';
   s.style.setProperty('--c', colour);
@@ -372,7 +372,7 @@ function swatch(colour, name) {
   return s;
 }
 
-function fillTable(table, head, rows) {
+export function fillTable(table, head, rows) {
   const caption = table.querySelector('caption');
   const tr = (cells, tag) => {
     const r = document.createElement('tr');
