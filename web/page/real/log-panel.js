@@ -25,7 +25,9 @@ const HTML = `
   </div>
   <p class="real-note">Open a CARMEN log (<code>.log</code>, <code>.clf</code>, gzip-compressed or not: FLASER,
     ROBOTLASER1, ODOM records) and replay it through the lab's SLAM, as <code>node web/cli.mjs run-log</code> does.
-    Dashed grey: the path the odometry believes; blue: SLAM's; orange: loop closures as they are found.</p>
+    Dashed grey: the path the odometry believes; in the robot's colour: SLAM's; orange: loop closures as they are found.
+    Two or more logs, or one log cut into stretches, are as many robots: each replays on its own, then
+    <b>Merge maps</b> joins their maps by the maps' own evidence, as <code>merge-maps</code> does.</p>
   <div class="real-drop" tabindex="0" aria-label="Drop a log file here">
     <span>Drop a log here, or</span>
     <label class="button" for="log-file">Open log…</label>
@@ -48,7 +50,7 @@ const HTML = `
   </div>
   <canvas id="log-canvas" class="real-overlay" aria-label="The map as it grows, the odometry and SLAM paths, and the loop closures"></canvas>
   <p class="real-legend"><span class="real-swatch" style="--c:#7a7a7a">odometry</span>
-    <span class="real-swatch" style="--c:#1f5fbf">SLAM</span>
+    <span class="real-swatch" style="--c:#1f77b4">SLAM (in the robot's colour)</span>
     <span class="real-swatch" style="--c:#e07b00">loop closure</span></p>
   <div class="real-downloads">
     <label for="log-map-of" hidden>Map of</label>
@@ -325,7 +327,7 @@ export class LogView {
     q('#log-progress').textContent = !s.records
       ? ''
       : s.finished
-        ? `done: ${s.done} scans${many}, ${closures}; map ${this.summary.map.width} × ${this.summary.map.height} cells`
+        ? `done: ${s.done} scans${many}, ${closures}; ${many ? 'a map each' : `map ${this.summary.map.width} × ${this.summary.map.height} cells`}`
         : `scan ${s.done} of ${s.total}${many} · ${closures}`;
     this.listRobots(robots);
     for (const b of this.root.querySelectorAll('.real-downloads button[data-file]')) b.disabled = !this.files;
