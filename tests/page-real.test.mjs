@@ -396,7 +396,7 @@ test('your log: one log cut into two stretches is two robots, and their maps mer
   assert.ok(Math.abs(Number(row[1]) - x) < 1e-3 && Math.abs(Number(row[2]) - y) < 1e-3, `row ${row}`);
   assert.match(row[4], /^-?\d+\.\d{4} -?\d+\.\d{4} 0 -?\d\.\d{6} 0 0 hall_1 hall_2$/);
   assert.match(await page.locator('#log-pairs').innerText(), /hall-1 \+ hall-2\s+merged/);
-  assert.match(await page.locator('#log-merge-legend').innerText(), /hall-1\s+hall-2/);
+  assert.match(await page.locator('#log-legend').innerText(), /hall-1\s+hall-2/);
   await page.locator('#log-overlay').scrollIntoViewIfNeeded();
   await page.waitForTimeout(300);
   await page.screenshot({ path: path.join(ARTIFACTS, 'page-log-merged.png') });
@@ -412,17 +412,17 @@ test('your log: one log cut into two stretches is two robots, and their maps mer
     const [d] = await Promise.all([page.waitForEvent('download'), page.click(selector)]);
     return { name: d.suggestedFilename(), bytes: readFileSync(await d.path()) };
   };
-  const pgm = await click('#logview [data-merged="pgm"]');
+  const pgm = await click('#log-downloads [data-file="pgm"]');
   assert.equal(pgm.name, 'merged.pgm');
   const m = /^P5\n(?:#[^\n]*\n)*(\d+) (\d+)\n255\n/.exec(pgm.bytes.subarray(0, 200).toString('latin1'));
   assert.ok(m, 'a binary PGM header');
   assert.equal(pgm.bytes.length, m[0].length + Number(m[1]) * Number(m[2]));
   assert.ok(pgm.bytes.subarray(m[0].length).filter((v) => v === 0).length > 500, 'walls in the merged map');
-  const json = JSON.parse((await click('#logview [data-merged="json"]')).bytes.toString('utf8'));
+  const json = JSON.parse((await click('#log-downloads [data-file="json"]')).bytes.toString('utf8'));
   assert.equal(json.status, 'merged');
   assert.equal(json.transforms[1].static_transform_publisher, row[4]);
   await page.selectOption('#log-map-of', 'hall-2');
-  assert.equal((await click('#logview [data-file="pgm"]')).name, 'hall-2.pgm');
+  assert.equal((await click('#log-map-downloads [data-file="pgm"]')).name, 'hall-2.pgm');
 
   assert.deepEqual(problems, [], 'no console errors or page errors');
   await context.close();
@@ -454,13 +454,13 @@ test('your log: two logs of different worlds are two robots whose maps do not me
   assert.match(await page.locator('#log-verdict').innerText(), /^No merge, because too little common wall/);
   assert.deepEqual(merge.transforms.map((t) => t.map), ['ring2.yaml']);
   assert.match(await page.locator('#log-transforms').innerText(), /hall1\s+–\s+–\s+–\s+not joined/);
-  assert.equal(await page.locator('#logview [data-merged="pgm"]').isDisabled(), true, 'no merged map to download');
-  assert.equal(await page.locator('#logview [data-merged="json"]').isDisabled(), false);
+  assert.equal(await page.locator('#log-downloads [data-file="pgm"]').isDisabled(), true, 'no merged map to download');
+  assert.equal(await page.locator('#log-downloads [data-file="json"]').isDisabled(), false);
   await page.screenshot({ path: path.join(ARTIFACTS, 'page-log-no-merge.png') });
 
   // Each robot's map still downloads, named after its log.
   await page.selectOption('#log-map-of', 'hall1');
-  const [d] = await Promise.all([page.waitForEvent('download'), page.click('#logview [data-file="yaml"]')]);
+  const [d] = await Promise.all([page.waitForEvent('download'), page.click('#log-map-downloads [data-file="yaml"]')]);
   assert.equal(d.suggestedFilename(), 'hall1.yaml');
   assert.match(readFileSync(await d.path(), 'utf8'), /image: "?hall1\.pgm"?/);
   assert.deepEqual(problems, [], 'no console errors or page errors');

@@ -52,7 +52,7 @@ const HTML = `
   <p class="real-legend"><span class="real-swatch" style="--c:#7a7a7a">odometry</span>
     <span class="real-swatch" style="--c:#1f77b4">SLAM (in the robot's colour)</span>
     <span class="real-swatch" style="--c:#e07b00">loop closure</span></p>
-  <div class="real-downloads">
+  <div id="log-map-downloads" class="real-downloads">
     <label for="log-map-of" hidden>Map of</label>
     <select id="log-map-of" hidden></select>
     <button type="button" data-file="pgm">Map PGM</button>
@@ -102,7 +102,7 @@ export class LogView {
     q('#log-step').addEventListener('click', () => this.stepOnce());
     q('#log-speed').addEventListener('input', () => this.showSpeed());
     q('#log-merge').addEventListener('click', () => this.enqueue(() => this.merge()));
-    for (const b of this.root.querySelectorAll('.real-downloads button[data-file]')) {
+    for (const b of this.root.querySelectorAll('#log-map-downloads button')) {
       b.addEventListener('click', () => this.save(b.dataset.file));
     }
     new ResizeObserver(() => this.redraw()).observe(q('#log-canvas'));
@@ -330,7 +330,7 @@ export class LogView {
         ? `done: ${s.done} scans${many}, ${closures}; ${many ? 'a map each' : `map ${this.summary.map.width} × ${this.summary.map.height} cells`}`
         : `scan ${s.done} of ${s.total}${many} · ${closures}`;
     this.listRobots(robots);
-    for (const b of this.root.querySelectorAll('.real-downloads button[data-file]')) b.disabled = !this.files;
+    for (const b of this.root.querySelectorAll('#log-map-downloads button')) b.disabled = !this.files;
   }
 
   /** With several robots: each one's swatch, stretch and progress, and the pick of whose map to download. */

@@ -364,7 +364,7 @@ function card(m) {
   return div;
 }
 
-export function swatch(colour, name) {
+function swatch(colour, name) {
   const s = document.createElement('span');
   s.className = 'real-swatch';
   s.style.setProperty('--c', colour);
@@ -372,7 +372,7 @@ export function swatch(colour, name) {
   return s;
 }
 
-export function fillTable(table, head, rows) {
+function fillTable(table, head, rows) {
   const caption = table.querySelector('caption');
   const tr = (cells, tag) => {
     const r = document.createElement('tr');
