@@ -8,19 +8,15 @@
 // as JSON. The merge itself runs in the log worker (log-merge.js).
 
 import { nextFrame } from './panel.js';
-import { OverlayCanvas, resultHtml, saveMerge, showMerge, swatch } from './merge-result.js';
+import { OverlayCanvas, mergeHtml, saveMerge, showMerge, swatch } from './merge-result.js';
 
-export const MERGE_HTML = `
-  <div class="real-merge-row">
-    <button type="button" id="log-merge" class="primary"
-      title="Replay what is left of every robot, then merge the robots' maps">Merge maps</button>
-    <span class="real-busy" aria-hidden="true"></span>
-    <span id="log-merge-stage" class="real-stage" aria-live="polite"></span>
-  </div>${resultHtml('log', {
-    frames: "Each robot's frame (its first scan) in the first robot's frame",
-    title: 'Merged maps',
-    overlay: "The robots' joined maps in their colours",
-  })}`;
+export const MERGE_HTML = mergeHtml('log', {
+  stage: 'log-merge-stage',
+  tip: "Replay what is left of every robot, then merge the robots' maps",
+  frames: "Each robot's frame (its first scan) in the first robot's frame",
+  title: 'Merged maps',
+  overlay: "The robots' joined maps in their colours",
+});
 
 /** A robot's name from its map's name in the merge report. */
 const robotName = (map) => map.replace(/\.yaml$/, '');

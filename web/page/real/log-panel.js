@@ -63,10 +63,7 @@ const HTML = `
 export class LogView {
   /** `root`, `opener`: the view and its toolbar button; `download`; `covers` (cover.js). */
   constructor(root, opener, { download, covers }) {
-    this.root = root;
-    this.opener = opener;
-    this.download = download;
-    this.covers = covers;
+    Object.assign(this, { root, opener, download, covers });
     this.client = new WorkerClient(new URL('./log-worker.js', import.meta.url), (text) => this.merged.stage(text));
     this.merged = new LogMergeView(root, this.client, download);
     this.state = emptyState();

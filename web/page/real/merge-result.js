@@ -13,6 +13,19 @@
 import { transformRows, transformsJson, verdictText } from './report.js';
 
 /**
+ * The Merge maps row (`#${p}-merge`, a busy dot, the stage line `#stage`,
+ * the button's `tip`) and the result under it (`resultHtml`).
+ */
+export function mergeHtml(p, { stage, tip = '', ...words }) {
+  return `
+  <div class="real-merge-row">
+    <button type="button" id="${p}-merge" class="primary"${tip ? ` title="${tip}"` : ''}>Merge maps</button>
+    <span class="real-busy" aria-hidden="true"></span>
+    <span id="${stage}" class="real-stage" aria-live="polite"></span>
+  </div>${resultHtml(p, words)}`;
+}
+
+/**
  * The result's HTML: `p` the id prefix; `words`: `{frames}` (the
  * transforms table's caption), `{title}` (the overlay's heading),
  * `{overlay}` (the canvas's label).
