@@ -428,7 +428,7 @@ test('your log: one log cut into two stretches is two robots, and their maps mer
   await context.close();
 });
 
-test('your log: two logs of different worlds are two robots whose maps do not merge, and a bad log is named with its line', { timeout: 400000 }, async () => {
+test('your log: two logs of different worlds are two robots whose maps do not merge; a bad log is named with its line and nothing is lost', { timeout: 400000 }, async () => {
   const ring = path.join(tmp, 'ring2.log');
   writeFileSync(ring, ringLog({ laps: 2, perLap: 140 }).text);
   const hall = path.join(tmp, 'hall1.log');
@@ -437,8 +437,16 @@ test('your log: two logs of different worlds are two robots whose maps do not me
   writeFileSync(broken, '# a log cut short\nFLASER 181 1.0 2.0 3.0\n');
   const { context, page, problems } = await newPage(env.browser);
   await openLogView(page);
-  await page.setInputFiles('#log-file', [ring, broken, hall]);
+  // One log opened and stepped; then a bad log and a good one: the bad is
+  // named with its line, the good is a second robot, the first goes on.
+  await page.setInputFiles('#log-file', ring);
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().records === 281, null, { timeout: 60000 });
+  await page.getByRole('button', { name: 'Step', exact: true }).click();
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().done === 5, null, { timeout: 60000 });
+  await page.setInputFiles('#log-file', [broken, hall]);
   await page.waitForFunction(() => window.slamlab.logView.snapshot().robots.length === 2, null, { timeout: 60000 });
+  assert.deepEqual((await logSnapshot(page)).robots.map((r) => r.done), [5, 0], 'the first robot keeps its replay');
+  assert.match(await page.locator('#log-progress').innerText(), /^scan 5 of 422 · 2 robots · 0 loop closures$/);
   const message = await page.locator('#log-message').innerText();
   assert.match(message, /broken\.log: line 2: FLASER record is truncated: 181 ranges announced, 3 fields follow/);
   assert.equal(await page.locator('#log-message').getAttribute('class'), 'real-message error');

@@ -180,11 +180,12 @@ export class LogView {
     });
   }
 
-  /** New robots (`out`: the worker's answer to open or cut): every replay from its start. */
+  /** New robots (`out`: the worker's answer to open or cut); a replay under way goes on. */
   restart(out, opened = []) {
     this.names = [...(this.names ?? []), ...opened.map((f) => f.name)];
-    const total = out.robots.reduce((s, r) => s + r.total, 0);
-    this.state = { ...emptyState(), name: this.names.join(', '), records: out.records, total, left: total, robots: out.robots };
+    const sum = (k) => out.robots.reduce((s, r) => s + r[k], 0);
+    const [done, total] = [sum('done'), sum('total')];
+    this.state = { ...emptyState(), name: this.names.join(', '), records: out.records, done, total, left: total - done, closures: sum('closures'), robots: out.robots };
     this.files = null;
     this.summary = null;
     this.merged.drop();

@@ -49,9 +49,15 @@ function stem(name) {
 function layout(cut, colours) {
   for (const r of robots) r.replay.free();
   robots = [];
+  addRobots(logs, cut, colours);
+  return describe();
+}
+
+/** Adds the robots of `some` logs (each cut into `cut` stretches); the robots there are keep their replays. */
+function addRobots(some, cut, colours) {
   merged = null;
-  const names = new Set();
-  for (const log of logs) {
+  const names = new Set(robots.map((r) => r.name));
+  for (const log of some) {
     const parts = stretches(log.records, cut);
     for (const [k, [from, to]] of parts.entries()) {
       if (robots.length >= MAX_ROBOTS) throw new Error(`at most ${MAX_ROBOTS} robots: open fewer logs or cut them into fewer stretches`);
@@ -64,7 +70,6 @@ function layout(cut, colours) {
       robots.push({ name, log: log.name, from, to, colour, replay, picture: null, view: null, mapAt: -Infinity, finished: false });
     }
   }
-  return describe();
 }
 
 /** What the page shows of each robot. */
@@ -78,9 +83,13 @@ function describe() {
   };
 }
 
-/** Opens logs (each read here, so a bad one is named with its line); the good ones are kept. */
+/**
+ * Opens logs (each read here, so a bad one is named with its line): the
+ * good ones are robots added to those there are, whose replays go on.
+ */
 function open({ files, cut, colours }) {
   const errors = [];
+  const before = logs.length;
   let added = 0;
   for (const f of files) {
     const bytes = new Uint8Array(f.bytes);
@@ -94,8 +103,8 @@ function open({ files, cut, colours }) {
       errors.push(`${f.name}: ${message(e)}`);
     }
   }
-  const out = added ? layout(cut, colours) : describe();
-  return { ...out, added, errors };
+  if (added) addRobots(logs.slice(before), cut, colours);
+  return { ...describe(), added, errors };
 }
 
 /** Redraws a robot's map from the scans so far, if it is time (or `force`). */
