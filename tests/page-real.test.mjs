@@ -453,6 +453,13 @@ test('your log: two logs of different worlds are two robots whose maps do not me
   const snap = await logSnapshot(page);
   assert.deepEqual(snap.robots.map((r) => [r.name, r.total]), [['ring2', 281], ['hall1', 141]]);
   assert.match(await page.locator('#log-name').innerText(), /^ring2\.log, hall1\.log: 422 laser records$/);
+  // Cut into 9 stretches each, the two logs would be 18 robots: refused, and nothing changes.
+  await page.locator('#log-cut').fill('9');
+  await page.locator('#log-cut').dispatchEvent('change');
+  await page.waitForFunction(() => /18 robots/.test(document.querySelector('#log-message').textContent));
+  assert.match(await page.locator('#log-message').innerText(), /^18 robots: at most 16; open fewer logs or cut them into fewer stretches$/);
+  assert.deepEqual((await logSnapshot(page)).robots.map((r) => [r.name, r.done]), [['ring2', 5], ['hall1', 0]]);
+  await page.locator('#log-cut').fill('1');
 
   await page.locator('#log-merge').click();
   await page.waitForFunction(() => window.slamlab.logView.snapshot().merge, null, { timeout: 300000, polling: 200 });

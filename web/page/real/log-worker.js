@@ -47,20 +47,27 @@ function stem(name) {
 
 /** Makes the robots anew from the logs: each log cut into `cut` stretches. */
 function layout(cut, colours) {
+  tooMany(0, logs, cut);
   for (const r of robots) r.replay.free();
   robots = [];
   addRobots(logs, cut, colours);
   return describe();
 }
 
+/** Throws, before anything changes, if `some` logs cut into `cut` stretches would make more than MAX_ROBOTS with `have`. */
+function tooMany(have, some, cut) {
+  const n = some.reduce((s, log) => s + stretches(log.records, cut).length, have);
+  if (n > MAX_ROBOTS) throw new Error(`${n} robots: at most ${MAX_ROBOTS}; open fewer logs or cut them into fewer stretches`);
+}
+
 /** Adds the robots of `some` logs (each cut into `cut` stretches); the robots there are keep their replays. */
 function addRobots(some, cut, colours) {
+  tooMany(robots.length, some, cut);
   merged = null;
   const names = new Set(robots.map((r) => r.name));
   for (const log of some) {
     const parts = stretches(log.records, cut);
     for (const [k, [from, to]] of parts.entries()) {
-      if (robots.length >= MAX_ROBOTS) throw new Error(`at most ${MAX_ROBOTS} robots: open fewer logs or cut them into fewer stretches`);
       let name = parts.length > 1 ? `${stem(log.name)}-${k + 1}` : stem(log.name);
       while (names.has(name)) name += '_';
       names.add(name);
@@ -103,7 +110,14 @@ function open({ files, cut, colours }) {
       errors.push(`${f.name}: ${message(e)}`);
     }
   }
-  if (added) addRobots(logs.slice(before), cut, colours);
+  if (added) {
+    try {
+      addRobots(logs.slice(before), cut, colours);
+    } catch (e) {
+      logs.length = before;
+      throw e;
+    }
+  }
   return { ...describe(), added, errors };
 }
 
