@@ -11,7 +11,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { loadWasm } from '../web/cli/wasm.mjs';
-import { inverse, mergeRobots, robotMap, stretches } from '../web/page/real/log-merge.js';
+import { inverse, mergedPaths, mergeRobots, robotMap, stretches } from '../web/page/real/log-merge.js';
 import { compose } from '../web/page/real/overlay.js';
 import { ringLog } from './support/synthetic-log.mjs';
 
@@ -75,6 +75,18 @@ test('two stretches of one log that overlap in space merge within 0.15 m and 1°
   assert.ok(dist < 0.15 && turn < 1, `hall-2 is ${dist} m and ${turn} deg off the truth ${truth}`);
   assert.match(new TextDecoder().decode(files.pgm.subarray(0, 2)), /P5/);
   assert.match(files.yaml, /image: "?merged\.pgm"?/);
+  // Both paths in the merged frame (the first robot's) lie on the truth seen from there.
+  const paths = mergedPaths(report, robots.map((r, k) => ({ ...r, colour: ['#111111', '#222222'][k] })));
+  assert.deepEqual(paths.map((p) => [p.colour, p.flat.length / 3]), [['#111111', 105], ['#222222', 106]]);
+  assert.ok(Math.hypot(paths[1].flat[0] - x, paths[1].flat[1] - y) < 1e-9, 'the second path starts at its frame');
+  let worst = 0;
+  for (const [k, p] of paths.entries()) {
+    for (let i = 0; i < p.flat.length / 3; i++) {
+      const t = compose(inverse(hall.truth[0]), hall.truth[k * 105 + i]);
+      worst = Math.max(worst, Math.hypot(p.flat[3 * i] - t[0], p.flat[3 * i + 1] - t[1]));
+    }
+  }
+  assert.ok(worst < 0.2, `a merged path is ${worst} m off the truth`);
   merger.free();
 });
 

@@ -8,6 +8,7 @@
 // map's known cells and both paths.
 
 import { clearCanvas, fitBox } from './fit.js';
+import { outline } from './overlay.js';
 
 /** The live map as a picture: `grey` PGM shades top row first, `info` its MapInfo. */
 export async function mapPicture(grey, info) {
@@ -139,4 +140,34 @@ export function drawReplays(canvas, { width, height, dpr }, robots) {
     if (n > 1) ctx.strokeRect(...rect);
     drawRobot(ctx, rect, dpr, robot, n > 1);
   }
+}
+
+/**
+ * Draws `paths` ([{colour, flat}], log-merge.js's `mergedPaths`) over the
+ * merged maps that overlay.js's `drawPlaced` drew into `canvas`: the same
+ * box (the joined maps' known cells) fitted the same way, so the paths
+ * fall on their maps; each path in its robot's colour, its start a dot.
+ */
+export function drawMergedPaths(canvas, { width, height, dpr }, placed, paths) {
+  if (!placed.length) return;
+  const b = [Infinity, Infinity, -Infinity, -Infinity];
+  for (const { map, pose } of placed) {
+    for (const [x, y] of outline(map, pose)) {
+      [b[0], b[1], b[2], b[3]] = [Math.min(b[0], x), Math.min(b[1], y), Math.max(b[2], x), Math.max(b[3], y)];
+    }
+  }
+  const ctx = canvas.getContext('2d');
+  ctx.save();
+  const k = fitBox(ctx, b, [0, 0, width, height], 8 * dpr);
+  ctx.lineJoin = 'round';
+  ctx.lineWidth = (2 * dpr) / k;
+  for (const { colour, flat } of paths) {
+    ctx.strokeStyle = colour;
+    path(ctx, flat);
+    ctx.beginPath();
+    ctx.arc(flat[0], flat[1], (4 * dpr) / k, 0, 2 * Math.PI);
+    ctx.fillStyle = colour;
+    ctx.fill();
+  }
+  ctx.restore();
 }

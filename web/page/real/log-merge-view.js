@@ -3,9 +3,9 @@
 // (merge-result.js): the verdict with its reason and confidence, each
 // robot's frame in the first robot's frame (metres, degrees, and the
 // arguments of ROS's static_transform_publisher), each pair's verdict, the
-// joined maps overlaid in the robots' colours (drawn by the log worker)
-// and the downloads: the merged map as PGM + YAML + PNG and the transforms
-// as JSON. The merge itself runs in the log worker (log-merge.js).
+// joined maps and the robots' paths overlaid in their colours (drawn by
+// the log worker) and the downloads: the merged map as PGM + YAML + PNG
+// and the transforms as JSON. The merge itself runs in the log worker (log-merge.js).
 
 import { nextFrame } from './panel.js';
 import { OverlayCanvas, mergeHtml, saveMerge, showMerge, swatch } from './merge-result.js';
@@ -70,7 +70,7 @@ export class LogMergeView {
     const placed = this.robots.filter((r) => joined.has(r.name));
     this.root.querySelector('#log-legend').replaceChildren(
       ...placed.map((r) => swatch(r.colour, r.name)),
-      placed.length > 1 ? 'Walls of two robots that fall on each other show dark.' : '',
+      placed.length > 1 ? 'Walls of two robots that fall on each other show dark; each robot\'s SLAM path in its colour, a dot where it starts.' : '',
     );
   }
 }

@@ -92,3 +92,19 @@ export async function placedMaps({ merger, report }, robots) {
   }
   return placed;
 }
+
+/**
+ * Each joined robot's SLAM path in the merged frame (the first robot's):
+ * `[{colour, flat: [x, y, theta, ...]}]`, every pose p of the replay's
+ * final poses (the log's frame) as merge ∘ s⁻¹ ∘ p, s the robot's first.
+ */
+export function mergedPaths(report, robots) {
+  const out = [];
+  for (const t of report.merge.transforms) {
+    const r = robots.find((x) => `${x.name}.yaml` === t.map);
+    if (!r?.report) continue;
+    const to = compose(t.pose, inverse(r.report.scans[0].pose));
+    out.push({ colour: r.colour, flat: r.report.scans.flatMap((s) => compose(to, s.pose)) });
+  }
+  return out;
+}

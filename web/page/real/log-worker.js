@@ -20,8 +20,8 @@
 // `{type: 'progress', text}` while merging.
 
 import init, * as wasm from '../../pkg/slamlab.js';
-import { drawReplays, mapPicture } from './log-draw.js';
-import { mergeRobots, placedMaps, stretches } from './log-merge.js';
+import { drawMergedPaths, drawReplays, mapPicture } from './log-draw.js';
+import { mergedPaths, mergeRobots, placedMaps, stretches } from './log-merge.js';
 import { drawPlaced } from './overlay.js';
 
 const ready = init();
@@ -180,6 +180,7 @@ async function merge(id) {
   merged?.merger.free();
   merged = mergeRobots(wasm, robots, (text) => postMessage({ type: 'progress', id, text }));
   merged.placed = await placedMaps(merged, robots);
+  merged.paths = mergedPaths(merged.report, robots);
   const { report, files } = merged;
   return { result: { report, files }, transfer: files ? [files.pgm.buffer, files.png.buffer] : [] };
 }
@@ -201,7 +202,10 @@ const handlers = {
     return {};
   },
   drawMerge: (data) => {
-    if (mergeCanvas && merged?.placed) drawPlaced(mergeCanvas, data, merged.placed);
+    if (mergeCanvas && merged?.placed) {
+      drawPlaced(mergeCanvas, data, merged.placed);
+      drawMergedPaths(mergeCanvas, data, merged.placed, merged.paths);
+    }
     return {};
   },
   clear: () => {
