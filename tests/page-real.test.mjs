@@ -379,6 +379,8 @@ test('your log: one log cut into two stretches is two robots, and their maps mer
   const snap = await logSnapshot(page);
   assert.equal(snap.finished, true);
   assert.equal(snap.done, 211);
+  assert.equal(await page.locator('#log-merge').isDisabled(), false, 'a merge can be run again');
+  assert.equal(await page.locator('#log-play').isDisabled(), true, 'nothing is left to play');
   assert.match(await page.locator('#log-progress').innerText(), /^done: 211 scans · 2 robots, \d+ loop closures?; a map each$/);
   const merge = snap.merge.merge;
   assert.equal(merge.status, 'merged', merge.reason);
