@@ -121,6 +121,16 @@ export class LogView {
     }
   }
 
+  /**
+   * Pauses and waits for the step under way: the worker answers one request
+   * at a time, but a step awaits its pictures, so nothing may change the
+   * robots while one runs.
+   */
+  async idle() {
+    this.pause();
+    while (this.busy) await new Promise((r) => setTimeout(r, 20));
+  }
+
   /** Runs `job` after whatever is under way (opening, merging) has finished. */
   enqueue(job) {
     this.queue = this.queue.then(job).catch((e) => {
@@ -166,6 +176,7 @@ export class LogView {
     if (!files.length) return this.queue;
     this.pause();
     return this.enqueue(async () => {
+      await this.idle();
       this.say('', 'info');
       const read = await Promise.all(files.map(async (f) => ({ name: f.name, bytes: await f.arrayBuffer() })));
       const size = this.size();
@@ -193,7 +204,7 @@ export class LogView {
 
   async recut() {
     if (!this.state.records) return;
-    this.pause();
+    await this.idle();
     const out = await this.client.request({ type: 'cut', cut: this.cut(), colours: MAP_COLOURS });
     this.restart(out);
     this.refresh();
@@ -201,7 +212,7 @@ export class LogView {
   }
 
   async clear() {
-    this.pause();
+    await this.idle();
     await this.client.request({ type: 'clear' });
     this.names = [];
     this.state = emptyState();
@@ -248,8 +259,7 @@ export class LogView {
       this.say('Open two or more logs, or cut this one into stretches, to merge maps.', 'warn');
       return;
     }
-    this.pause();
-    while (this.busy) await new Promise((r) => setTimeout(r, 20));
+    await this.idle();
     this.setBusy(true);
     try {
       if (!this.state.finished) {

@@ -216,7 +216,8 @@ const handlers = {
   },
 };
 
-self.onmessage = async ({ data }) => {
+/** Answers one request; the requests are answered one after another (below). */
+async function answer({ data }) {
   const { id, type } = data;
   try {
     await ready;
@@ -233,4 +234,11 @@ self.onmessage = async ({ data }) => {
   } catch (e) {
     postMessage({ id, ok: false, error: message(e) });
   }
+}
+
+// A step awaits its pictures: the next request waits for it to end, so
+// none changes the robots while one is under way.
+let chain = Promise.resolve();
+self.onmessage = (event) => {
+  chain = chain.then(() => answer(event));
 };
