@@ -366,7 +366,6 @@ test('your log: one log cut into two stretches is two robots, and their maps mer
   const playing = await logSnapshot(page);
   assert.ok(playing.robots.every((r) => r.done > 0), `each robot replays: ${playing.robots.map((r) => r.done)}`);
   assert.match(await page.locator('#log-progress').innerText(), /^scan \d+ of 211 · 2 robots · \d+ loop closures?$/);
-  await page.screenshot({ path: path.join(ARTIFACTS, 'page-log-two-robots.png') });
 
   // Merge maps: the rest of each stretch is replayed, then the maps merge.
   await page.locator('#log-merge').click();
