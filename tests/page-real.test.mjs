@@ -13,7 +13,9 @@
 // maps are opened and merged. Then "Your log": a CARMEN log of a robot
 // driving twice round a ring corridor with drifting odometry
 // (tests/support/synthetic-log.mjs) is opened, stepped, played, paused,
-// closes a loop while it replays, and its map is downloaded.
+// closes a loop while it replays, and its map is downloaded. Last, one log
+// cut into two stretches (two robots) whose maps merge at the true
+// transform, and two logs of different worlds that do not merge.
 //
 // Needs the wasm build in web/pkg (`./build.sh build`). Run alone with
 //   node --test tests/page-real.test.mjs
@@ -310,6 +312,173 @@ test('your log: open a CARMEN log, step, play and pause it, see a loop closed, d
   assert.ok(Math.max(0, ...tasks) <= 100, `long tasks while replaying: ${tasks.map(Math.round).join(', ')} ms`);
   await page.getByRole('button', { name: /Close your log/ }).click();
   assert.deepEqual(await page.evaluate(() => window.slamlab.scenario()), before, 'the lab keeps its scenario');
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});
+
+// "Your log" with several robots (issue 21, item 3): one log cut into
+// stretches, or several logs, replayed as robots of their own and their
+// maps merged with the offline merge. The hall of tests/support/synthetic-
+// log.mjs is driven round one and a half times; cut in two, the stretches
+// (records 0-104 and 105-210) overlap in space, and each robot's frame is
+// its first scan, so the truth of the second robot's frame in the first's
+// is T₀⁻¹ ∘ T₁₀₅ of the true poses: (-4, 4, -90°) here.
+
+/** `a⁻¹ ∘ b` for poses [x, y, theta]. */
+function relative([ax, ay, at], [bx, by, bt]) {
+  const c = Math.cos(at), s = Math.sin(at);
+  return [c * (bx - ax) + s * (by - ay), -s * (bx - ax) + c * (by - ay), bt - at];
+}
+
+const wrap = (a) => Math.atan2(Math.sin(a), Math.cos(a));
+
+async function openLogView(page) {
+  await page.goto(env.baseUrl);
+  await waitReady(page);
+  await page.getByRole('button', { name: 'Your log…' }).click();
+  await page.waitForSelector('#logview:not([hidden])');
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+}
+
+const logSnapshot = (page) => page.evaluate(() => window.slamlab.logView.snapshot());
+
+test('your log: one log cut into two stretches is two robots, and their maps merge at the true transform', { timeout: 400000 }, async () => {
+  const hall = ringLog({ laps: 1.5, perLap: 140, world: 'hall' });
+  const file = path.join(tmp, 'hall.log');
+  writeFileSync(file, hall.text);
+  const { context, page, problems } = await newPage(env.browser);
+  await openLogView(page);
+  await watchLongTasks(page);
+  await page.setInputFiles('#log-file', file);
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().records === 211, null, { timeout: 60000 });
+  await page.locator('#log-cut').fill('2');
+  await page.locator('#log-cut').dispatchEvent('change');
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().robots.length === 2, null, { timeout: 60000 });
+  const robots = (await logSnapshot(page)).robots;
+  assert.deepEqual(robots.map((r) => [r.name, r.from, r.to]), [['hall-1', 0, 104], ['hall-2', 105, 210]]);
+  assert.notEqual(robots[0].colour, robots[1].colour, 'a colour each');
+  assert.match(await page.locator('#log-robots').innerText(), /hall-1: records 0–104 of hall\.log, 0 of 105 replayed/);
+
+  // Play a while: both robots replay side by side.
+  await page.locator('#log-speed').fill('10');
+  await page.getByRole('button', { name: 'Play' }).click();
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().done >= 60, null, { timeout: 120000, polling: 100 });
+  const playing = await logSnapshot(page);
+  assert.ok(playing.robots.every((r) => r.done > 0), `each robot replays: ${playing.robots.map((r) => r.done)}`);
+  assert.match(await page.locator('#log-progress').innerText(), /^scan \d+ of 211 · 2 robots · \d+ loop closures?$/);
+
+  // Merge maps: the rest of each stretch is replayed, then the maps merge.
+  await page.locator('#log-merge').click();
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().merge, null, { timeout: 300000, polling: 200 });
+  // Long tasks are reported after they end: give the observer a moment.
+  await page.waitForTimeout(500);
+  const tasks = await page.evaluate(() => window.longTasks);
+  console.log(`cut log: long tasks while replaying and merging ${tasks.map(Math.round)}`);
+  assert.ok(Math.max(0, ...tasks) <= 100, `long tasks while replaying and merging: ${tasks.map(Math.round).join(', ')} ms`);
+  const snap = await logSnapshot(page);
+  assert.equal(snap.finished, true);
+  assert.equal(snap.done, 211);
+  assert.equal(await page.locator('#log-merge').isDisabled(), false, 'a merge can be run again');
+  assert.equal(await page.locator('#log-play').isDisabled(), true, 'nothing is left to play');
+  assert.match(await page.locator('#log-progress').innerText(), /^done: 211 scans · 2 robots, \d+ loop closures?; a map each$/);
+  const merge = snap.merge.merge;
+  assert.equal(merge.status, 'merged', merge.reason);
+  assert.match(await page.locator('#log-verdict').innerText(), /^Merged \(confidence \d\.\d\d\): the maps agree/);
+  assert.deepEqual(merge.transforms[0], { map: 'hall-1.yaml', pose: [0, 0, 0] });
+  const truth = relative(hall.truth[0], hall.truth[105]);
+  const [x, y, th] = merge.transforms[1].pose;
+  const dist = Math.hypot(x - truth[0], y - truth[1]);
+  const turn = (Math.abs(wrap(th - truth[2])) * 180) / Math.PI;
+  console.log(`cut log merged: hall-2 at [${x.toFixed(3)}, ${y.toFixed(3)}, ${th.toFixed(4)}], truth [${truth.map((v) => v.toFixed(3))}]: ${dist.toFixed(3)} m, ${turn.toFixed(2)} deg off`);
+  assert.ok(dist < 0.15, `hall-2 is ${dist} m off the truth`);
+  assert.ok(turn < 1, `hall-2 is ${turn} deg off the truth`);
+  const row = await page.locator('#log-transforms tr').nth(2).locator('td').allInnerTexts();
+  assert.equal(row[0], 'hall-2');
+  assert.ok(Math.abs(Number(row[1]) - x) < 1e-3 && Math.abs(Number(row[2]) - y) < 1e-3, `row ${row}`);
+  assert.match(row[4], /^-?\d+\.\d{4} -?\d+\.\d{4} 0 -?\d\.\d{6} 0 0 hall_1 hall_2$/);
+  assert.match(await page.locator('#log-pairs').innerText(), /hall-1 \+ hall-2\s+merged/);
+  assert.match(await page.locator('#log-legend').innerText(), /hall-1\s+hall-2/);
+  await page.locator('#log-overlay').scrollIntoViewIfNeeded();
+  await page.waitForTimeout(300);
+  await page.screenshot({ path: path.join(ARTIFACTS, 'page-log-merged.png') });
+  // The whole view at once (docs/issue21-logs-merge.png is this picture).
+  await page.setViewportSize({ width: 1280, height: 1780 });
+  await page.locator('#log-title').scrollIntoViewIfNeeded();
+  await page.waitForTimeout(500);
+  await page.screenshot({ path: path.join(ARTIFACTS, 'page-log-merged-view.png') });
+  await page.setViewportSize({ width: 1280, height: 720 });
+
+  // Downloads: the merged map and the transforms; each robot's own map.
+  const click = async (selector) => {
+    const [d] = await Promise.all([page.waitForEvent('download'), page.click(selector)]);
+    return { name: d.suggestedFilename(), bytes: readFileSync(await d.path()) };
+  };
+  const pgm = await click('#log-downloads [data-file="pgm"]');
+  assert.equal(pgm.name, 'merged.pgm');
+  const m = /^P5\n(?:#[^\n]*\n)*(\d+) (\d+)\n255\n/.exec(pgm.bytes.subarray(0, 200).toString('latin1'));
+  assert.ok(m, 'a binary PGM header');
+  assert.equal(pgm.bytes.length, m[0].length + Number(m[1]) * Number(m[2]));
+  assert.ok(pgm.bytes.subarray(m[0].length).filter((v) => v === 0).length > 500, 'walls in the merged map');
+  const json = JSON.parse((await click('#log-downloads [data-file="json"]')).bytes.toString('utf8'));
+  assert.equal(json.status, 'merged');
+  assert.equal(json.transforms[1].static_transform_publisher, row[4]);
+  await page.selectOption('#log-map-of', 'hall-2');
+  assert.equal((await click('#log-map-downloads [data-file="pgm"]')).name, 'hall-2.pgm');
+
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});
+
+test('your log: two logs of different worlds are two robots whose maps do not merge; a bad log is named with its line and nothing is lost', { timeout: 400000 }, async () => {
+  const ring = path.join(tmp, 'ring2.log');
+  writeFileSync(ring, ringLog({ laps: 2, perLap: 140 }).text);
+  const hall = path.join(tmp, 'hall1.log');
+  writeFileSync(hall, ringLog({ laps: 1, perLap: 140, world: 'hall' }).text);
+  const broken = path.join(tmp, 'broken.log');
+  writeFileSync(broken, '# a log cut short\nFLASER 181 1.0 2.0 3.0\n');
+  const { context, page, problems } = await newPage(env.browser);
+  await openLogView(page);
+  // One log opened and stepped; then a bad log and a good one: the bad is
+  // named with its line, the good is a second robot, the first goes on.
+  await page.setInputFiles('#log-file', ring);
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().records === 281, null, { timeout: 60000 });
+  await page.getByRole('button', { name: 'Step', exact: true }).click();
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().done === 5, null, { timeout: 60000 });
+  await page.setInputFiles('#log-file', [broken, hall]);
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().robots.length === 2, null, { timeout: 60000 });
+  assert.deepEqual((await logSnapshot(page)).robots.map((r) => r.done), [5, 0], 'the first robot keeps its replay');
+  assert.match(await page.locator('#log-progress').innerText(), /^scan 5 of 422 · 2 robots · 0 loop closures$/);
+  const message = await page.locator('#log-message').innerText();
+  assert.match(message, /broken\.log: line 2: FLASER record is truncated: 181 ranges announced, 3 fields follow/);
+  assert.equal(await page.locator('#log-message').getAttribute('class'), 'real-message error');
+  const snap = await logSnapshot(page);
+  assert.deepEqual(snap.robots.map((r) => [r.name, r.total]), [['ring2', 281], ['hall1', 141]]);
+  assert.match(await page.locator('#log-name').innerText(), /^ring2\.log, hall1\.log: 422 laser records$/);
+  // Cut into 9 stretches each, the two logs would be 18 robots: refused, and nothing changes.
+  await page.locator('#log-cut').fill('9');
+  await page.locator('#log-cut').dispatchEvent('change');
+  await page.waitForFunction(() => /18 robots/.test(document.querySelector('#log-message').textContent));
+  assert.match(await page.locator('#log-message').innerText(), /^18 robots: at most 16; open fewer logs or cut them into fewer stretches$/);
+  assert.deepEqual((await logSnapshot(page)).robots.map((r) => [r.name, r.done]), [['ring2', 5], ['hall1', 0]]);
+  await page.locator('#log-cut').fill('1');
+
+  await page.locator('#log-merge').click();
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().merge, null, { timeout: 300000, polling: 200 });
+  const merge = (await logSnapshot(page)).merge.merge;
+  assert.equal(merge.status, 'no_merge');
+  assert.match(merge.reason, /too little common wall: \d+\.\d m of wall agree within 0\.15 m \(20 m needed\)/);
+  assert.match(await page.locator('#log-verdict').innerText(), /^No merge, because too little common wall/);
+  assert.deepEqual(merge.transforms.map((t) => t.map), ['ring2.yaml']);
+  assert.match(await page.locator('#log-transforms').innerText(), /hall1\s+–\s+–\s+–\s+not joined/);
+  assert.equal(await page.locator('#log-downloads [data-file="pgm"]').isDisabled(), true, 'no merged map to download');
+  assert.equal(await page.locator('#log-downloads [data-file="json"]').isDisabled(), false);
+  await page.screenshot({ path: path.join(ARTIFACTS, 'page-log-no-merge.png') });
+
+  // Each robot's map still downloads, named after its log.
+  await page.selectOption('#log-map-of', 'hall1');
+  const [d] = await Promise.all([page.waitForEvent('download'), page.click('#log-map-downloads [data-file="yaml"]')]);
+  assert.equal(d.suggestedFilename(), 'hall1.yaml');
+  assert.match(readFileSync(await d.path(), 'utf8'), /image: "?hall1\.pgm"?/);
   assert.deepEqual(problems, [], 'no console errors or page errors');
   await context.close();
 });

@@ -3,7 +3,8 @@
 // with notches, so places along the loop look different), its 181 beams
 // cast exactly against the walls, its odometry turned by a small heading
 // bias per step so that it drifts and the second lap meets the first one
-// displaced — the case a loop closure mends.
+// displaced — the case a loop closure mends. A second world (a hall with
+// pillars) makes a log that shares nothing with the ring.
 
 /** Wall segments [[x, y], [x, y]] of the ring. */
 export const RING = (() => {
@@ -32,23 +33,48 @@ export function rayHit(o, a, walls, max) {
 }
 
 /** The true pose at arc parameter s (one lap = 1): a rounded rectangle path in the corridor. */
-function pathPose(s) {
+function ringPose(s) {
   const u = 2 * Math.PI * (s % 1);
   const x = 6.5 * Math.cos(u), y = 3.5 * Math.sin(u);
   return [x, y, Math.atan2(3.5 * Math.cos(u), -6.5 * Math.sin(u))];
 }
 
 /**
- * The log's text: `laps` laps of `perLap` scans, FLASER records (181
- * beams, 80 m "no return") with ODOM records before them, odometry with a
- * heading bias of `bias` rad per step. Returns `{text, truth}`.
+ * Another world, nothing like the ring and like itself under no turn: an
+ * irregular seven-sided hall (about 17 x 12 m), a square pillar in the
+ * middle, two small ones and a short slanted wall, driven round on a
+ * circle of 4 m radius.
  */
-export function ringLog({ laps = 2, perLap = 140, bias = 0.004 } = {}) {
-  const out = ['# a ring corridor driven round, made by tests/support/synthetic-log.mjs'];
+export const HALL = (() => {
+  const poly = (pts) => pts.map((p, i) => [p, pts[(i + 1) % pts.length]]);
+  return [
+    ...poly([[-6, -6], [7, -6], [9, -1], [5, 6], [-6, 6], [-8, 2], [-8, -3]]),
+    ...poly([[-1, -1], [1, -1], [1, 1], [-1, 1]]),
+    ...poly([[5.5, 2], [6, 2], [6, 2.5], [5.5, 2.5]]),
+    ...poly([[-3, -5.5], [-2.4, -5.5], [-2.4, -4.9], [-3, -4.9]]),
+    [[-7.5, 4], [-6, 5.2]],
+  ];
+})();
+
+function hallPose(s) {
+  const u = 2 * Math.PI * (s % 1);
+  return [4 * Math.cos(u), 4 * Math.sin(u), u + Math.PI / 2];
+}
+
+/**
+ * The log's text: `laps` laps of `perLap` scans round the ring (`world:
+ * 'ring'`) or the hall (`'hall'`), FLASER records (181 beams, 80 m "no
+ * return") with ODOM records before them, odometry with a heading bias of
+ * `bias` rad per step. Returns `{text, truth}` (`truth[i]`: the true pose
+ * of laser record i, in the frame of the odometry's first pose).
+ */
+export function ringLog({ laps = 2, perLap = 140, bias = 0.004, world = 'ring' } = {}) {
+  const [walls, pathPose] = world === 'hall' ? [HALL, hallPose] : [RING, ringPose];
+  const out = [`# a ${world} driven round, made by tests/support/synthetic-log.mjs`];
   const truth = [];
   let odo = null;
   let last = null;
-  const n = laps * perLap;
+  const n = Math.round(laps * perLap);
   for (let i = 0; i <= n; i++) {
     const p = pathPose(i / perLap);
     if (!last) odo = [...p];
@@ -64,7 +90,7 @@ export function ringLog({ laps = 2, perLap = 140, bias = 0.004 } = {}) {
     truth.push(p);
     const ranges = [];
     for (let b = 0; b <= 180; b++) {
-      const r = rayHit(p, p[2] + ((b - 90) * Math.PI) / 180, RING, 80);
+      const r = rayHit(p, p[2] + ((b - 90) * Math.PI) / 180, walls, 80);
       ranges.push(r >= 80 ? '80.00' : r.toFixed(3));
     }
     const pose = odo.map((v) => v.toFixed(5)).join(' ');

@@ -1,10 +1,14 @@
-// Drawing a log replay in the log worker (log-worker.js): the map of the
-// scans so far (walls dark, free space white, unknown left grey), the
-// path the odometry believes (dashed grey) beside the path SLAM gives
-// (blue, moved by every loop closure), each loop closure as an orange line
-// between the two scans it joined, and the robot's current pose. Poses and
-// the map share one frame (the log's odometry frame, the first scan at its
-// odometry pose); the view fits the map's known cells and both paths.
+// Drawing log replays in the log worker (log-worker.js), one tile a robot:
+// the map of the scans so far (walls dark, free space white, unknown left
+// grey), the path the odometry believes (dashed grey) beside the path SLAM
+// gives (in the robot's colour, moved by every loop closure), each loop
+// closure as an orange line between the two scans it joined, and the
+// robot's current pose. A robot's poses and map share one frame (the log's
+// odometry frame, the first scan at its odometry pose); its tile fits the
+// map's known cells and both paths.
+
+import { clearCanvas, fitBox } from './fit.js';
+import { outline } from './overlay.js';
 
 /** The live map as a picture: `grey` PGM shades top row first, `info` its MapInfo. */
 export async function mapPicture(grey, info) {
@@ -48,22 +52,21 @@ function bounds(picture, view) {
   return b;
 }
 
-/** Draws the replay into `canvas` (`size`: {width, height, dpr} in device pixels). */
-export function drawReplay(canvas, { width, height, dpr }, picture, view) {
-  if (canvas.width !== width || canvas.height !== height) {
-    canvas.width = width;
-    canvas.height = height;
-  }
-  const ctx = canvas.getContext('2d');
-  ctx.setTransform(1, 0, 0, 1, 0, 0);
-  ctx.fillStyle = '#e6e6e1';
-  ctx.fillRect(0, 0, width, height);
-  const [x0, y0, x1, y1] = bounds(picture, view);
-  if (!(x1 > x0)) return;
-  const pad = 10 * dpr;
-  const k = Math.min((width - 2 * pad) / (x1 - x0), (height - 2 * pad) / (y1 - y0));
-  const ox = (width - k * (x1 - x0)) / 2, oy = (height - k * (y1 - y0)) / 2;
-  ctx.setTransform(k, 0, 0, -k, ox - k * x0, oy + k * y1);
+/**
+ * Draws one robot's replay into the tile `rect` ([left, top, width,
+ * height] device pixels) of `ctx`: `robot.picture`, `robot.view`, its
+ * SLAM path in `robot.colour`, its name when `label`.
+ */
+function drawRobot(ctx, rect, dpr, robot, label) {
+  const { picture, view } = robot;
+  if (!view) return;
+  const box = bounds(picture, view);
+  if (!(box[2] > box[0])) return;
+  ctx.save();
+  ctx.beginPath();
+  ctx.rect(...rect);
+  ctx.clip();
+  const k = fitBox(ctx, box, rect, 10 * dpr);
   if (picture) {
     const { info, bitmap } = picture;
     const r = info.resolution_m;
@@ -80,11 +83,31 @@ export function drawReplay(canvas, { width, height, dpr }, picture, view) {
   path(ctx, view.odometry);
   ctx.setLineDash([]);
   ctx.lineWidth = (2 * dpr) / k;
-  ctx.strokeStyle = '#1f5fbf';
+  ctx.strokeStyle = robot.colour;
   path(ctx, view.poses);
+  drawClosures(ctx, view.closures, k, dpr);
+  const n = view.poses.length;
+  if (n) {
+    ctx.beginPath();
+    ctx.arc(view.poses[n - 3], view.poses[n - 2], (5 * dpr) / k, 0, 2 * Math.PI);
+    ctx.fillStyle = '#c81414';
+    ctx.fill();
+  }
+  if (label) {
+    ctx.setTransform(1, 0, 0, 1, 0, 0);
+    ctx.font = `bold ${13 * dpr}px sans-serif`;
+    ctx.fillStyle = robot.colour;
+    ctx.fillText(robot.name, rect[0] + 6 * dpr, rect[1] + 16 * dpr);
+  }
+  ctx.restore();
+}
+
+/** Each loop closure: an orange line between the two scans it joined. */
+function drawClosures(ctx, closures, k, dpr) {
   ctx.strokeStyle = '#e07b00';
+  ctx.fillStyle = '#e07b00';
   ctx.lineWidth = (2.5 * dpr) / k;
-  for (const c of view.closures) {
+  for (const c of closures) {
     const [ax, ay, bx, by] = c.segment;
     ctx.beginPath();
     ctx.moveTo(ax, ay);
@@ -93,15 +116,58 @@ export function drawReplay(canvas, { width, height, dpr }, picture, view) {
     for (const [x, y] of [[ax, ay], [bx, by]]) {
       ctx.beginPath();
       ctx.arc(x, y, (3 * dpr) / k, 0, 2 * Math.PI);
-      ctx.fillStyle = '#e07b00';
       ctx.fill();
     }
   }
-  const n = view.poses.length;
-  if (n) {
+}
+
+/**
+ * Draws the robots' replays into `canvas` (`size`: {width, height, dpr} in
+ * device pixels): one robot fills it; several share it in a grid of tiles,
+ * each in its own frame (they are not joined until the merge), named.
+ */
+export function drawReplays(canvas, { width, height, dpr }, robots) {
+  const ctx = clearCanvas(canvas, width, height, '#e6e6e1');
+  const n = robots.length;
+  if (!n) return;
+  const across = Math.min(n, Math.max(1, Math.round(Math.sqrt((n * width) / Math.max(1, height)))));
+  const down = Math.ceil(n / across);
+  const [w, h] = [width / across, height / down];
+  ctx.strokeStyle = '#fff';
+  ctx.lineWidth = 2 * dpr;
+  for (const [i, robot] of robots.entries()) {
+    const rect = [(i % across) * w, Math.floor(i / across) * h, w, h];
+    if (n > 1) ctx.strokeRect(...rect);
+    drawRobot(ctx, rect, dpr, robot, n > 1);
+  }
+}
+
+/**
+ * Draws `paths` ([{colour, flat}], log-merge.js's `mergedPaths`) over the
+ * merged maps that overlay.js's `drawPlaced` drew into `canvas`: the same
+ * box (the joined maps' known cells) fitted the same way, so the paths
+ * fall on their maps; each path in its robot's colour, its start a dot.
+ */
+export function drawMergedPaths(canvas, { width, height, dpr }, placed, paths) {
+  if (!placed.length) return;
+  const b = [Infinity, Infinity, -Infinity, -Infinity];
+  for (const { map, pose } of placed) {
+    for (const [x, y] of outline(map, pose)) {
+      [b[0], b[1], b[2], b[3]] = [Math.min(b[0], x), Math.min(b[1], y), Math.max(b[2], x), Math.max(b[3], y)];
+    }
+  }
+  const ctx = canvas.getContext('2d');
+  ctx.save();
+  const k = fitBox(ctx, b, [0, 0, width, height], 8 * dpr);
+  ctx.lineJoin = 'round';
+  ctx.lineWidth = (2 * dpr) / k;
+  for (const { colour, flat } of paths) {
+    ctx.strokeStyle = colour;
+    path(ctx, flat);
     ctx.beginPath();
-    ctx.arc(view.poses[n - 3], view.poses[n - 2], (5 * dpr) / k, 0, 2 * Math.PI);
-    ctx.fillStyle = '#c81414';
+    ctx.arc(flat[0], flat[1], (4 * dpr) / k, 0, 2 * Math.PI);
+    ctx.fillStyle = colour;
     ctx.fill();
   }
+  ctx.restore();
 }

@@ -8,8 +8,15 @@
 // the map is offered as ROS map_server PGM + YAML and PNG. The replay and
 // all drawing run in a Web Worker (log-worker.js, log-draw.js): the page
 // only sends requests and shows the counts, so it stays responsive.
+//
+// Several logs, or one log cut into N stretches of its laser records, are
+// several robots (issue 21, item 3): each replayed on its own, in its own
+// colour and tile, then **Merge maps** joins their finished maps with the
+// offline merge of `merge-maps` (log-merge.js, log-merge-view.js).
 
 import { WorkerClient } from './client.js';
+import { LogMergeView, MERGE_HTML } from './log-merge-view.js';
+import { MAP_COLOURS } from './panel.js';
 
 const HTML = `
   <div class="real-head">
@@ -18,13 +25,19 @@ const HTML = `
   </div>
   <p class="real-note">Open a CARMEN log (<code>.log</code>, <code>.clf</code>, gzip-compressed or not: FLASER,
     ROBOTLASER1, ODOM records) and replay it through the lab's SLAM, as <code>node web/cli.mjs run-log</code> does.
-    Dashed grey: the path the odometry believes; blue: SLAM's; orange: loop closures as they are found.</p>
+    Dashed grey: the path the odometry believes; in the robot's colour: SLAM's; orange: loop closures as they are found.
+    Two or more logs, or one log cut into stretches, are as many robots: each replays on its own, then
+    <b>Merge maps</b> joins their maps by the maps' own evidence, as <code>merge-maps</code> does.</p>
   <div class="real-drop" tabindex="0" aria-label="Drop a log file here">
     <span>Drop a log here, or</span>
     <label class="button" for="log-file">Open log…</label>
-    <input id="log-file" type="file" accept=".log,.clf,.gz,.txt" hidden>
+    <input id="log-file" type="file" multiple accept=".log,.clf,.gz,.txt" hidden>
+    <label for="log-cut" title="Each stretch of a log is replayed as a robot of its own">Cut each log into</label>
+    <input id="log-cut" type="number" min="1" max="16" step="1" value="1" class="num"><span class="unit">stretches</span>
+    <button type="button" id="log-clear">Clear logs</button>
     <span id="log-name" class="real-stage"></span>
   </div>
+  <p id="log-robots" class="real-legend" aria-label="The robots"></p>
   <div id="log-message" class="real-message" role="alert" hidden></div>
   <div class="real-merge-row log-controls" role="group" aria-label="Replay">
     <button type="button" id="log-play" class="primary">Play</button>
@@ -37,26 +50,27 @@ const HTML = `
   </div>
   <canvas id="log-canvas" class="real-overlay" aria-label="The map as it grows, the odometry and SLAM paths, and the loop closures"></canvas>
   <p class="real-legend"><span class="real-swatch" style="--c:#7a7a7a">odometry</span>
-    <span class="real-swatch" style="--c:#1f5fbf">SLAM</span>
+    <span class="real-swatch" style="--c:#1f77b4">SLAM (in the robot's colour)</span>
     <span class="real-swatch" style="--c:#e07b00">loop closure</span></p>
-  <div class="real-downloads">
+  <div id="log-map-downloads" class="real-downloads">
+    <label for="log-map-of" hidden>Map of</label>
+    <select id="log-map-of" hidden></select>
     <button type="button" data-file="pgm">Map PGM</button>
     <button type="button" data-file="yaml">Map YAML</button>
     <button type="button" data-file="png">Map PNG</button>
-  </div>`;
+  </div>${MERGE_HTML}`;
 
 export class LogView {
   /** `root`, `opener`: the view and its toolbar button; `download`; `covers` (cover.js). */
   constructor(root, opener, { download, covers }) {
-    this.root = root;
-    this.opener = opener;
-    this.download = download;
-    this.covers = covers;
-    this.client = new WorkerClient(new URL('./log-worker.js', import.meta.url));
-    this.state = { name: '', records: 0, done: 0, total: 0, closures: 0, left: 0, finished: false };
+    Object.assign(this, { root, opener, download, covers });
+    this.client = new WorkerClient(new URL('./log-worker.js', import.meta.url), (text) => this.merged.stage(text));
+    this.merged = new LogMergeView(root, this.client, download);
+    this.state = emptyState();
     this.playing = false;
     this.busy = false;
     this.files = null;
+    this.queue = Promise.resolve();
   }
 
   wire() {
@@ -69,24 +83,27 @@ export class LogView {
       e.stopPropagation(); // the lab's shortcuts stay with the lab
     });
     q('#log-file').addEventListener('change', (e) => {
-      const f = e.target.files[0];
+      const files = [...e.target.files];
       e.target.value = '';
-      if (f) this.open(f);
+      this.open(files);
     });
     this.root.addEventListener('dragover', (e) => e.preventDefault());
     this.root.addEventListener('drop', (e) => {
       e.preventDefault();
-      const f = e.dataTransfer?.files?.[0];
-      if (f) this.open(f);
+      this.open([...(e.dataTransfer?.files ?? [])]);
     });
+    q('#log-cut').addEventListener('change', () => this.enqueue(() => this.recut()));
+    q('#log-clear').addEventListener('click', () => this.enqueue(() => this.clear()));
     q('#log-play').addEventListener('click', () => this.play());
     q('#log-pause').addEventListener('click', () => this.pause());
     q('#log-step').addEventListener('click', () => this.stepOnce());
     q('#log-speed').addEventListener('input', () => this.showSpeed());
-    for (const b of this.root.querySelectorAll('.real-downloads button')) {
+    q('#log-merge').addEventListener('click', () => this.enqueue(() => this.merge()));
+    for (const b of this.root.querySelectorAll('#log-map-downloads button')) {
       b.addEventListener('click', () => this.save(b.dataset.file));
     }
     new ResizeObserver(() => this.redraw()).observe(q('#log-canvas'));
+    this.merged.wire();
     this.showSpeed();
     this.refresh();
   }
@@ -95,11 +112,32 @@ export class LogView {
     this.root.hidden = !open;
     this.opener.setAttribute('aria-expanded', String(open));
     this.covers.set(this, open);
-    if (open) this.root.querySelector('.real-close').focus();
-    else {
+    if (open) {
+      this.root.querySelector('.real-close').focus();
+      this.merged.draw();
+    } else {
       this.pause();
       this.opener.focus();
     }
+  }
+
+  /**
+   * Pauses and waits for the step under way: the worker answers one request
+   * at a time, but a step awaits its pictures, so nothing may change the
+   * robots while one runs.
+   */
+  async idle() {
+    this.pause();
+    while (this.busy) await new Promise((r) => setTimeout(r, 20));
+  }
+
+  /** Runs `job` after whatever is under way (opening, merging) has finished. */
+  enqueue(job) {
+    this.queue = this.queue.then(job).catch((e) => {
+      this.pause();
+      this.say(e.message, 'error');
+    });
+    return this.queue;
   }
 
   showSpeed() {
@@ -109,6 +147,11 @@ export class LogView {
 
   speed() {
     return Number(this.root.querySelector('#log-speed').value);
+  }
+
+  cut() {
+    const n = Math.round(Number(this.root.querySelector('#log-cut').value));
+    return Number.isFinite(n) ? Math.min(16, Math.max(1, n)) : 1;
   }
 
   /** The canvas's size in device pixels; the canvas goes to the worker once. */
@@ -128,25 +171,59 @@ export class LogView {
     };
   }
 
-  async open(file) {
+  /** Opens picked or dropped logs; each is one robot, or as many as the cut says. */
+  open(files) {
+    if (!files.length) return this.queue;
     this.pause();
-    this.say('', 'info');
-    const bytes = await file.arrayBuffer();
-    const size = this.size();
-    try {
-      const out = await this.client.request({ type: 'open', bytes }, [bytes]);
-      this.state = { name: file.name, records: out.records, done: 0, total: out.records, closures: 0, left: out.records, finished: false };
-      this.files = null;
+    return this.enqueue(async () => {
+      await this.idle();
+      this.say('', 'info');
+      const read = await Promise.all(files.map(async (f) => ({ name: f.name, bytes: await f.arrayBuffer() })));
+      const size = this.size();
+      const out = await this.client.request(
+        { type: 'open', files: read, cut: this.cut(), colours: MAP_COLOURS },
+        read.map((f) => f.bytes),
+      );
+      if (out.added) this.restart(out, read.filter((f) => !out.errors.some((e) => e.startsWith(`${f.name}: `))));
+      if (out.errors.length) this.say(`Not opened: ${out.errors.join(' · ')}`, 'error');
       this.refresh();
-      await this.client.request({ type: 'step', n: 0, size });
-    } catch (e) {
-      this.state = { ...this.state, name: '', records: 0, left: 0 };
-      this.say(`${file.name}: ${e.message}`, 'error');
-    }
-    this.refresh();
+      if (out.added) await this.client.request({ type: 'step', n: 0, size });
+    });
   }
 
-  /** One step of `speed` scans; at the end, settles the graph and offers the map. */
+  /** New robots (`out`: the worker's answer to open or cut); a replay under way goes on. */
+  restart(out, opened = []) {
+    this.names = [...(this.names ?? []), ...opened.map((f) => f.name)];
+    const sum = (k) => out.robots.reduce((s, r) => s + r[k], 0);
+    const [done, total] = [sum('done'), sum('total')];
+    this.state = { ...emptyState(), name: this.names.join(', '), records: out.records, done, total, left: total - done, closures: sum('closures'), robots: out.robots };
+    this.files = null;
+    this.summary = null;
+    this.merged.drop();
+  }
+
+  async recut() {
+    if (!this.state.records) return;
+    await this.idle();
+    const out = await this.client.request({ type: 'cut', cut: this.cut(), colours: MAP_COLOURS });
+    this.restart(out);
+    this.refresh();
+    await this.client.request({ type: 'step', n: 0, size: this.size() });
+  }
+
+  async clear() {
+    await this.idle();
+    await this.client.request({ type: 'clear' });
+    this.names = [];
+    this.state = emptyState();
+    this.files = null;
+    this.merged.drop();
+    this.say('', 'info');
+    this.refresh();
+    await this.client.request({ type: 'step', n: 0, size: this.size() }).catch(() => {});
+  }
+
+  /** One step of `speed` scans of every robot; at the end, settles the graphs and offers the maps. */
   async advance() {
     if (this.busy || !this.state.records || this.state.finished) return;
     this.busy = true;
@@ -166,15 +243,49 @@ export class LogView {
   async finish() {
     const out = await this.client.request({ type: 'finish' });
     this.files = out.files;
+    this.state.robots = out.robots;
     this.state.finished = true;
-    this.state.closures = out.summary.closures;
-    this.summary = out.summary;
+    this.state.done = this.state.total;
+    this.state.left = 0;
+    this.state.closures = out.robots.reduce((s, r) => s + r.summary.closures, 0);
+    this.summary = out.robots[0].summary;
     this.pause();
     await this.client.request({ type: 'step', n: 0, size: this.size() });
   }
 
+  /** Replays what is left of every robot, then merges their maps. */
+  async merge() {
+    if ((this.state.robots?.length ?? 0) < 2) {
+      this.say('Open two or more logs, or cut this one into stretches, to merge maps.', 'warn');
+      return;
+    }
+    await this.idle();
+    this.setBusy(true);
+    try {
+      if (!this.state.finished) {
+        this.merged.stage('replaying what is left of each robot…');
+        await this.finish();
+      }
+      const n = this.state.robots.length;
+      this.merged.stage(`merging ${n} maps (${(n * (n - 1)) / 2} pair${n > 2 ? 's' : ''})…`);
+      const t0 = performance.now();
+      const out = await this.client.request({ type: 'merge' });
+      this.mergeMs = performance.now() - t0;
+      this.merged.stage(`merged in ${(this.mergeMs / 1000).toFixed(2)} s`);
+      await this.merged.show(out.report, out.files, this.state.robots);
+    } finally {
+      this.setBusy(false);
+    }
+  }
+
+  setBusy(busy) {
+    this.merging = busy;
+    this.root.classList.toggle('busy', busy);
+    this.refresh();
+  }
+
   play() {
-    if (!this.state.records || this.state.finished) return;
+    if (!this.state.records || this.state.finished || this.merging) return;
     this.playing = true;
     const loop = async () => {
       if (!this.playing) return;
@@ -211,30 +322,75 @@ export class LogView {
   refresh() {
     const q = (s) => this.root.querySelector(s);
     const s = this.state;
-    const can = s.records > 0 && !s.finished;
+    const robots = s.robots ?? [];
+    const can = s.records > 0 && !s.finished && !this.merging;
     q('#log-play').disabled = !can || this.playing;
     q('#log-pause').disabled = !this.playing;
     q('#log-step').disabled = !can || this.playing;
+    q('#log-clear').disabled = !s.records || this.merging;
+    q('#log-merge').disabled = robots.length < 2 || this.merging;
     q('#log-name').textContent = s.name ? `${s.name}: ${s.records} laser records` : '';
     const closures = `${s.closures} loop closure${s.closures === 1 ? '' : 's'}`;
+    const many = robots.length > 1 ? ` · ${robots.length} robots` : '';
     q('#log-progress').textContent = !s.records
       ? ''
       : s.finished
-        ? `done: ${s.done} scans, ${closures}; map ${this.summary.map.width} × ${this.summary.map.height} cells`
-        : `scan ${s.done} of ${s.total} · ${closures}`;
-    for (const b of this.root.querySelectorAll('.real-downloads button')) b.disabled = !this.files;
+        ? `done: ${s.done} scans${many}, ${closures}; ${many ? 'a map each' : `map ${this.summary.map.width} × ${this.summary.map.height} cells`}`
+        : `scan ${s.done} of ${s.total}${many} · ${closures}`;
+    this.listRobots(robots);
+    for (const b of this.root.querySelectorAll('#log-map-downloads button')) b.disabled = !this.files;
+  }
+
+  /** With several robots: each one's swatch, stretch and progress, and the pick of whose map to download. */
+  listRobots(robots) {
+    const list = this.root.querySelector('#log-robots');
+    const pick = this.root.querySelector('#log-map-of');
+    const many = robots.length > 1;
+    pick.hidden = !many;
+    pick.previousElementSibling.hidden = !many;
+    if (!many) {
+      list.replaceChildren();
+      return;
+    }
+    list.replaceChildren(
+      ...robots.map((r) => {
+        const span = document.createElement('span');
+        span.className = 'real-swatch';
+        span.style.setProperty('--c', r.colour);
+        const c = r.summary?.closures ?? r.closures;
+        span.textContent = `${r.name}: records ${r.from}–${r.to} of ${r.log}, ${r.done} of ${r.total} replayed, ${c} loop closure${c === 1 ? '' : 's'}`;
+        return span;
+      }),
+    );
+    if (pick.options.length !== robots.length || [...pick.options].some((o, i) => o.value !== robots[i].name)) {
+      pick.replaceChildren(...robots.map((r, i) => new Option(r.name, r.name, i === 0, i === 0)));
+    }
   }
 
   save(kind) {
     if (!this.files) return;
-    const base = (this.state.name.replace(/(\.gz)?$/i, '').replace(/\.[^.]*$/, '') || 'log').replace(/[^\w.-]+/g, '_');
-    if (kind === 'pgm') this.download(`${base}.pgm`, this.files.pgm, 'image/x-portable-graymap');
-    if (kind === 'png') this.download(`${base}.png`, this.files.png, 'image/png');
-    if (kind === 'yaml') this.download(`${base}.yaml`, this.files.yaml.replace('log-map.pgm', `${base}.pgm`), 'application/yaml');
+    const robots = this.state.robots ?? [];
+    const at = Math.max(0, robots.findIndex((r) => r.name === this.root.querySelector('#log-map-of').value));
+    const files = this.files[at];
+    const base = robots[at]?.name ?? 'log';
+    if (kind === 'pgm') this.download(`${base}.pgm`, files.pgm, 'image/x-portable-graymap');
+    if (kind === 'png') this.download(`${base}.png`, files.png, 'image/png');
+    if (kind === 'yaml') this.download(`${base}.yaml`, files.yaml.replace('log-map.pgm', `${base}.pgm`), 'application/yaml');
   }
 
   /** For tests and the console. */
   snapshot() {
-    return { ...this.state, playing: this.playing, busy: this.busy, summary: this.summary ?? null };
+    return {
+      ...this.state,
+      playing: this.playing,
+      busy: this.busy,
+      merging: !!this.merging,
+      summary: this.summary ?? null,
+      merge: this.merged.report,
+    };
   }
+}
+
+function emptyState() {
+  return { name: '', records: 0, done: 0, total: 0, closures: 0, left: 0, finished: false, robots: [] };
 }

@@ -1,58 +1,188 @@
-// A CARMEN log replayed off the page's main thread (issue 21, the page).
+// CARMEN logs replayed off the page's main thread (issue 21, the page).
 //
 // A module Web Worker that loads the same wasm build as the page and holds
-// one `LogReplay` (crate/src/bindings/logs.rs): the page opens a log here,
-// asks for a few scans at a time (its play, step and speed), and gets back
-// how far the replay is and how many loops it has closed; the worker draws
-// the replay (log-draw.js) into the page's canvas, handed over once with
-// transferControlToOffscreen: the map as it grows (redrawn from the scans
-// so far at their current poses, at most every MAP_EVERY_MS), the
-// odometry's path beside SLAM's and each loop closure. At the end it
-// settles the pose graph and hands back the map as PGM, PNG and YAML.
-// Messages in: `{id, type: 'canvas' | 'open' | 'step' | 'finish', ...}`;
-// out: `{id, ok, ...}` or `{id, ok: false, error}`.
+// one `LogReplay` (crate/src/bindings/logs.rs) per robot: each log opened
+// is one robot, or N robots when the page cuts it into N stretches of its
+// laser records (each stretch replayed on its own, as if another robot had
+// driven it). The page asks for a few scans at a time (its play, step and
+// speed) and gets back how far the replays are and how many loops they
+// have closed; the worker draws them (log-draw.js) into the page's canvas,
+// handed over once with transferControlToOffscreen: each robot in a tile
+// of its own, its map as it grows (redrawn from the scans so far at their
+// current poses, at most every MAP_EVERY_MS), the odometry's path beside
+// SLAM's and each loop closure. At the end it settles each pose graph and
+// hands back each map as PGM, PNG and YAML; then `merge` joins the robots'
+// maps (log-merge.js: the offline merge of `merge-maps`, each map in its
+// robot's own frame) and draws the joined maps into a second canvas.
+// Messages in: `{id, type: 'canvas' | 'mergeCanvas' | 'open' | 'cut' |
+// 'step' | 'redraw' | 'finish' | 'merge' | 'drawMerge' | 'clear', ...}`;
+// out: `{id, ok, ...}` or `{id, ok: false, error}`, and
+// `{type: 'progress', text}` while merging.
 
 import init, * as wasm from '../../pkg/slamlab.js';
-import { drawReplay, mapPicture } from './log-draw.js';
+import { drawMergedPaths, drawReplays, mapPicture } from './log-draw.js';
+import { mergedPaths, mergeRobots, placedMaps, stretches } from './log-merge.js';
+import { drawPlaced } from './overlay.js';
 
 const ready = init();
 const MAP_EVERY_MS = 400;
-let replay = null;
+/** The most robots at once (the merge's limit). */
+const MAX_ROBOTS = 16;
+/** The logs opened: `{name, bytes: Uint8Array, records}`. */
+let logs = [];
+/** `{name, log, from, to, colour, replay, picture, view, mapAt, finished, summary}`. */
+let robots = [];
 let canvas = null;
-let picture = null;
-let mapAt = -Infinity;
-let view = null;
+let mergeCanvas = null;
+let merged = null;
 
 function message(e) {
   return e instanceof Error ? e.message : String(e);
 }
 
-/** Redraws the map from the scans so far, if it is time (or `force`). */
-async function refreshMap(force) {
+/** A log's name without folder, `.gz` and extension. */
+function stem(name) {
+  return (String(name).split(/[\\/]/).pop().replace(/(\.gz)?$/i, '').replace(/\.[^.]*$/, '') || 'log').replace(/[^\w.-]+/g, '_');
+}
+
+/** Makes the robots anew from the logs: each log cut into `cut` stretches. */
+function layout(cut, colours) {
+  tooMany(0, logs, cut);
+  for (const r of robots) r.replay.free();
+  robots = [];
+  addRobots(logs, cut, colours);
+  return describe();
+}
+
+/** Throws, before anything changes, if `some` logs cut into `cut` stretches would make more than MAX_ROBOTS with `have`. */
+function tooMany(have, some, cut) {
+  const n = some.reduce((s, log) => s + stretches(log.records, cut).length, have);
+  if (n > MAX_ROBOTS) throw new Error(`${n} robots: at most ${MAX_ROBOTS}; open fewer logs or cut them into fewer stretches`);
+}
+
+/** Adds the robots of `some` logs (each cut into `cut` stretches); the robots there are keep their replays. */
+function addRobots(some, cut, colours) {
+  tooMany(robots.length, some, cut);
+  merged = null;
+  const names = new Set(robots.map((r) => r.name));
+  for (const log of some) {
+    const parts = stretches(log.records, cut);
+    for (const [k, [from, to]] of parts.entries()) {
+      let name = parts.length > 1 ? `${stem(log.name)}-${k + 1}` : stem(log.name);
+      while (names.has(name)) name += '_';
+      names.add(name);
+      const replay = new wasm.LogReplay(log.bytes);
+      replay.setRange(from, to);
+      const colour = colours[robots.length % colours.length];
+      robots.push({ name, log: log.name, from, to, colour, replay, picture: null, view: null, mapAt: -Infinity, finished: false });
+    }
+  }
+}
+
+/** What the page shows of each robot. */
+function describe() {
+  return {
+    records: logs.reduce((s, l) => s + l.records, 0),
+    robots: robots.map(({ name, log, from, to, colour, finished, summary, view }) => ({
+      name, log, from, to, colour, finished, summary: summary ?? null,
+      done: view?.done ?? 0, total: to - from + 1, closures: view?.closures.length ?? 0,
+    })),
+  };
+}
+
+/**
+ * Opens logs (each read here, so a bad one is named with its line): the
+ * good ones are robots added to those there are, whose replays go on.
+ */
+function open({ files, cut, colours }) {
+  const errors = [];
+  const before = logs.length;
+  let added = 0;
+  for (const f of files) {
+    const bytes = new Uint8Array(f.bytes);
+    try {
+      const probe = new wasm.LogReplay(bytes);
+      const records = probe.laserRecords();
+      probe.free();
+      logs.push({ name: f.name, bytes, records });
+      added++;
+    } catch (e) {
+      errors.push(`${f.name}: ${message(e)}`);
+    }
+  }
+  if (added) {
+    try {
+      addRobots(logs.slice(before), cut, colours);
+    } catch (e) {
+      logs.length = before;
+      throw e;
+    }
+  }
+  return { ...describe(), added, errors };
+}
+
+/** Redraws a robot's map from the scans so far, if it is time (or `force`). */
+async function refreshMap(robot, force) {
+  const done = robot.view?.done ?? 0;
+  if (robot.drawnDone === done) return;
   const now = performance.now();
-  if (!force && now - mapAt < MAP_EVERY_MS) return;
-  if (!replay.drawLive()) return;
-  picture = await mapPicture(replay.livePixels(), JSON.parse(replay.liveInfoJson()));
-  mapAt = performance.now();
+  if (!force && now - robot.mapAt < MAP_EVERY_MS) return;
+  if (!robot.replay.drawLive()) return;
+  robot.picture = await mapPicture(robot.replay.livePixels(), JSON.parse(robot.replay.liveInfoJson()));
+  robot.mapAt = performance.now();
+  robot.drawnDone = done;
+}
+
+function draw(size) {
+  if (canvas) drawReplays(canvas, size, robots);
 }
 
 async function step({ n, size }) {
-  const left = replay.step(n);
-  view = JSON.parse(replay.viewJson());
-  await refreshMap(left === 0);
-  if (canvas) drawReplay(canvas, size, picture, view);
-  return { done: view.done, total: view.total, closures: view.closures.length, left };
+  let left = 0;
+  for (const r of robots) {
+    const rest = r.replay.step(n);
+    left += rest;
+    r.view = JSON.parse(r.replay.viewJson());
+    await refreshMap(r, rest === 0);
+  }
+  draw(size);
+  const all = describe();
+  const sum = (k) => all.robots.reduce((s, r) => s + r[k], 0);
+  return { ...all, done: sum('done'), total: sum('total'), closures: sum('closures'), left };
 }
 
+/** Settles every robot's pose graph; each robot's map files and summary. */
 function finish() {
-  const t0 = performance.now();
-  replay.finish();
-  const report = JSON.parse(replay.reportJson(JSON.stringify({ finish: performance.now() - t0 })));
-  const pgm = replay.mapPgm();
-  const png = replay.mapPng();
-  const yaml = replay.mapYaml('log-map.pgm');
-  const summary = { scans: report.scans.length, closures: report.loop_closures.length, map: report.map };
-  return { result: { summary, files: { pgm, png, yaml } }, transfer: [pgm.buffer, png.buffer] };
+  const files = [];
+  const transfer = [];
+  for (const r of robots) {
+    if (!r.finished) {
+      const t0 = performance.now();
+      r.replay.finish();
+      r.report = JSON.parse(r.replay.reportJson(JSON.stringify({ finish: performance.now() - t0 })));
+      r.summary = { scans: r.report.scans.length, closures: r.report.loop_closures.length, map: r.report.map };
+      r.view = JSON.parse(r.replay.viewJson());
+      r.drawnDone = -1; // the settled poses draw a new map
+      r.finished = true;
+    }
+    const pgm = r.replay.mapPgm();
+    const png = r.replay.mapPng();
+    files.push({ pgm, png, yaml: r.replay.mapYaml('log-map.pgm') });
+    transfer.push(pgm.buffer, png.buffer);
+  }
+  return { result: { ...describe(), files }, transfer };
+}
+
+/** Merges the finished robots' maps (log-merge.js); the merged map's files come with the report. */
+async function merge(id) {
+  if (robots.length < 2) throw new Error('two or more robots are needed to merge: open another log or cut this one');
+  if (robots.some((r) => !r.finished)) throw new Error('finish the replays first');
+  merged?.merger.free();
+  merged = mergeRobots(wasm, robots, (text) => postMessage({ type: 'progress', id, text }));
+  merged.placed = await placedMaps(merged, robots);
+  merged.paths = mergedPaths(merged.report, robots);
+  const { report, files } = merged;
+  return { result: { report, files }, transfer: files ? [files.pgm.buffer, files.png.buffer] : [] };
 }
 
 const handlers = {
@@ -60,35 +190,55 @@ const handlers = {
     canvas = data.canvas;
     return {};
   },
-  open: (data) => {
-    replay?.free();
-    replay = new wasm.LogReplay(new Uint8Array(data.bytes));
-    picture = null;
-    view = null;
-    mapAt = -Infinity;
-    return { records: replay.laserRecords() };
+  mergeCanvas: (data) => {
+    mergeCanvas = data.canvas;
+    return {};
   },
+  open: (data) => open(data),
+  cut: (data) => (logs.length ? layout(data.cut, data.colours) : describe()),
   step: async (data) => step(data),
   redraw: (data) => {
-    if (canvas && view) drawReplay(canvas, data.size, picture, view);
+    draw(data.size);
     return {};
+  },
+  drawMerge: (data) => {
+    if (mergeCanvas && merged?.placed) {
+      drawPlaced(mergeCanvas, data, merged.placed);
+      drawMergedPaths(mergeCanvas, data, merged.placed, merged.paths);
+    }
+    return {};
+  },
+  clear: () => {
+    for (const r of robots) r.replay.free();
+    merged?.merger.free();
+    [logs, robots, merged] = [[], [], null];
+    return describe();
   },
 };
 
-self.onmessage = async ({ data }) => {
+/** Answers one request; the requests are answered one after another (below). */
+async function answer({ data }) {
   const { id, type } = data;
   try {
     await ready;
-    if (type !== 'canvas' && type !== 'open' && !replay) throw new Error('open a log first');
-    if (type === 'finish') {
-      const out = finish();
-      postMessage({ id, ok: true, ...out.result }, out.transfer);
-      return;
+    if ((type === 'step' || type === 'finish') && !robots.length) throw new Error('open a log first');
+    let out;
+    if (type === 'finish') out = finish();
+    else if (type === 'merge') out = await merge(id);
+    else {
+      const handler = handlers[type];
+      if (!handler) throw new Error(`unknown request '${type}'`);
+      out = { result: await handler(data), transfer: [] };
     }
-    const handler = handlers[type];
-    if (!handler) throw new Error(`unknown request '${type}'`);
-    postMessage({ id, ok: true, ...(await handler(data)) });
+    postMessage({ id, ok: true, ...out.result }, out.transfer);
   } catch (e) {
     postMessage({ id, ok: false, error: message(e) });
   }
+}
+
+// A step awaits its pictures: the next request waits for it to end, so
+// none changes the robots while one is under way.
+let chain = Promise.resolve();
+self.onmessage = (event) => {
+  chain = chain.then(() => answer(event));
 };

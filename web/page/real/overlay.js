@@ -12,6 +12,8 @@
 // pixels, y up). The maps are multiplied onto white, so walls of two maps
 // that agree show dark and a wall only one map has keeps its colour.
 
+import { clearCanvas, fitBox } from './fit.js';
+
 /** `a ∘ b` for poses [x, y, theta]. */
 export function compose([ax, ay, at], [bx, by, bt]) {
   const c = Math.cos(at), s = Math.sin(at);
@@ -74,14 +76,7 @@ function scaleBar(ctx, k, height, dpr) {
  * `alpha` the maps' opacity.
  */
 export function drawPlaced(canvas, { width, height, dpr, alpha }, placed) {
-  if (canvas.width !== width || canvas.height !== height) {
-    canvas.width = width;
-    canvas.height = height;
-  }
-  const ctx = canvas.getContext('2d');
-  ctx.setTransform(1, 0, 0, 1, 0, 0);
-  ctx.fillStyle = '#fff';
-  ctx.fillRect(0, 0, width, height);
+  const ctx = clearCanvas(canvas, width, height, '#fff');
   if (!placed.length) return;
   let [x0, x1, y0, y1] = [Infinity, -Infinity, Infinity, -Infinity];
   for (const { map, pose } of placed) {
@@ -89,10 +84,7 @@ export function drawPlaced(canvas, { width, height, dpr, alpha }, placed) {
       [x0, x1, y0, y1] = [Math.min(x0, x), Math.max(x1, x), Math.min(y0, y), Math.max(y1, y)];
     }
   }
-  const pad = 8 * dpr;
-  const k = Math.min((width - 2 * pad) / (x1 - x0 || 1), (height - 2 * pad) / (y1 - y0 || 1));
-  const ox = (width - k * (x1 - x0)) / 2, oy = (height - k * (y1 - y0)) / 2;
-  ctx.setTransform(k, 0, 0, -k, ox - k * x0, oy + k * y1);
+  const k = fitBox(ctx, [x0, y0, x1, y1], [0, 0, width, height], 8 * dpr);
   ctx.globalAlpha = alpha;
   // Multiplied colours: where two maps' walls fall on each other they show dark.
   ctx.globalCompositeOperation = 'multiply';

@@ -12,7 +12,7 @@
 // lab's own scenario and runs behind this view are never touched.
 
 import { MergeClient } from './client.js';
-import { transformRows, transformsJson, verdictText } from './report.js';
+import { OverlayCanvas, mergeHtml, saveMerge, showMerge, swatch } from './merge-result.js';
 
 /** One colour per map (up to 16), told apart on white. */
 export const MAP_COLOURS = [
@@ -37,30 +37,12 @@ const HTML = `
     <button type="button" id="real-clear">Clear maps</button>
   </div>
   <div id="real-message" class="real-message" role="alert" hidden></div>
-  <div id="real-maps" class="real-maps" aria-label="The maps you opened"></div>
-  <div class="real-merge-row">
-    <button type="button" id="real-merge" class="primary">Merge maps</button>
-    <span class="real-busy" aria-hidden="true"></span>
-    <span id="real-stage" class="real-stage" aria-live="polite"></span>
-  </div>
-  <div id="real-result" class="real-result" hidden>
-    <p id="real-verdict" class="real-verdict"></p>
-    <table id="real-transforms" class="summary-table"><caption>Each map's frame in the first map's frame</caption></table>
-    <table id="real-pairs" class="summary-table"><caption>Each pair's own verdict</caption></table>
-    <div class="real-overlay-head">
-      <h2>Merged overlay</h2>
-      <label for="real-alpha">Opacity</label>
-      <input id="real-alpha" type="range" min="15" max="100" value="85" aria-label="Opacity of the maps in the overlay">
-    </div>
-    <canvas id="real-overlay" class="real-overlay" aria-label="The joined maps overlaid in their colours"></canvas>
-    <p id="real-legend" class="real-legend"></p>
-    <div class="real-downloads">
-      <button type="button" data-file="pgm">Merged map PGM</button>
-      <button type="button" data-file="yaml">Merged map YAML</button>
-      <button type="button" data-file="png">Merged map PNG</button>
-      <button type="button" data-file="json">Transforms JSON</button>
-    </div>
-  </div>`;
+  <div id="real-maps" class="real-maps" aria-label="The maps you opened"></div>${mergeHtml('real', {
+    stage: 'real-stage',
+    frames: "Each map's frame in the first map's frame",
+    title: 'Merged overlay',
+    overlay: 'The joined maps overlaid in their colours',
+  })}`;
 
 export class RealMaps {
   /**
@@ -78,6 +60,7 @@ export class RealMaps {
     this.busy = false;
     this.queue = Promise.resolve();
     this.client = new MergeClient((text) => this.progress(text));
+    this.overlay = new OverlayCanvas(root, 'real', this.client);
   }
 
   /** Builds the view and connects its controls. */
@@ -108,11 +91,10 @@ export class RealMaps {
     q('#real-clear').addEventListener('click', () => this.enqueue(() => this.clear()));
     q('#real-merge').addEventListener('click', () => this.enqueue(() => this.merge()));
     q('#real-alpha').addEventListener('input', () => this.drawOverlay());
-    for (const b of root.querySelectorAll('.real-downloads button')) {
+    for (const b of root.querySelectorAll('#real-downloads button')) {
       b.addEventListener('click', () => this.save(b.dataset.file));
     }
-    this.resizes = new ResizeObserver(() => this.drawOverlay());
-    this.resizes.observe(q('#real-overlay'));
+    this.overlay.watch(() => this.drawOverlay());
     this.refresh();
   }
 
@@ -235,76 +217,21 @@ export class RealMaps {
   }
 
   showResult() {
-    const q = (s) => this.root.querySelector(s);
-    const merge = this.report.merge;
-    q('#real-result').hidden = false;
-    const v = q('#real-verdict');
-    v.textContent = verdictText(merge);
-    v.className = `real-verdict ${merge.status === 'merged' ? 'ok' : 'no'}`;
-    const rows = transformRows(merge).map((r) => [r.map, r.x, r.y, r.deg, r.args]);
-    for (const name of merge.unjoined) rows.push([name, '–', '–', '–', 'not joined']);
-    fillTable(q('#real-transforms'), ['map', 'x (m)', 'y (m)', 'θ (°)', 'static_transform_publisher'], rows);
-    fillTable(
-      q('#real-pairs'),
-      ['pair', 'verdict', 'confidence', 'reason'],
-      merge.pairs.map((p) => [`${p.a} + ${p.b}`, p.status, p.confidence.toFixed(2), p.reason]),
-    );
-    for (const b of this.root.querySelectorAll('.real-downloads button')) {
-      b.disabled = b.dataset.file !== 'json' && !this.files;
-    }
+    showMerge(this.root, 'real', this.report.merge, !!this.files);
     // The overlay in a task of its own, after the tables are laid out.
     nextFrame().then(() => this.drawOverlay());
   }
 
-  /**
-   * The joined maps in the first map's frame, each in its colour: drawn by
-   * the worker into the overlay canvas (handed over once per worker), one
-   * drawing at a time (a slider's many events make one more at most).
-   */
+  /** The joined maps in the first map's frame, each in its colour: drawn by the worker (merge-result.js). */
   drawOverlay() {
     if (!this.report || this.root.hidden) return;
-    if (this.drawing) {
-      this.redraw = true;
-      return;
-    }
-    const canvas = this.attachCanvas();
-    const dpr = window.devicePixelRatio || 1;
-    const size = {
-      width: Math.max(1, Math.round(canvas.clientWidth * dpr)),
-      height: Math.max(1, Math.round(canvas.clientHeight * dpr)),
-      dpr,
-      alpha: this.root.querySelector('#real-alpha').value / 100,
-    };
-    this.drawing = true;
-    this.client
-      .request({ type: 'draw', ...size })
-      .catch((e) => this.say(e.message, 'error'))
-      .finally(() => {
-        this.drawing = false;
-        if (this.redraw) {
-          this.redraw = false;
-          this.drawOverlay();
-        }
-      });
+    this.overlay.draw((e) => this.say(e.message, 'error'));
     this.legend();
   }
 
   /** Hands the overlay canvas to the worker (once per worker); returns the canvas. */
   attachCanvas() {
-    let canvas = this.root.querySelector('#real-overlay');
-    if (this.canvasWorker === this.client.worker && this.client.worker) return canvas;
-    this.client.start();
-    if (this.canvasWorker) {
-      // A restarted worker needs a canvas of its own: control moves once.
-      const fresh = canvas.cloneNode();
-      canvas.replaceWith(fresh);
-      this.resizes.observe(fresh);
-      canvas = fresh;
-    }
-    const offscreen = canvas.transferControlToOffscreen();
-    this.client.request({ type: 'canvas', canvas: offscreen }, [offscreen]);
-    this.canvasWorker = this.client.worker;
-    return canvas;
+    return this.overlay.attach();
   }
 
   legend() {
@@ -318,14 +245,7 @@ export class RealMaps {
   }
 
   save(kind) {
-    if (kind === 'json' && this.report) {
-      this.download('transforms.json', transformsJson(this.report), 'application/json');
-      return;
-    }
-    if (!this.files) return;
-    if (kind === 'pgm') this.download('merged.pgm', this.files.pgm, 'image/x-portable-graymap');
-    if (kind === 'png') this.download('merged.png', this.files.png, 'image/png');
-    if (kind === 'yaml') this.download('merged.yaml', this.files.yaml, 'application/yaml');
+    saveMerge(this.download, this.report, this.files, kind);
   }
 
   /** For tests and the console: what the view holds. */
@@ -340,7 +260,7 @@ export class RealMaps {
 }
 
 /** Resolves after the next frame has been drawn (work split into short tasks). */
-function nextFrame() {
+export function nextFrame() {
   return new Promise((resolve) => requestAnimationFrame(() => setTimeout(resolve, 0)));
 }
 
@@ -362,26 +282,4 @@ function card(m) {
   cap.querySelector('b').textContent = m.imageName === m.name ? m.name : `${m.name} + ${m.imageName}`;
   div.append(c, cap);
   return div;
-}
-
-function swatch(colour, name) {
-  const s = document.createElement('span');
-  s.className = 'real-swatch';
-  s.style.setProperty('--c', colour);
-  s.textContent = name;
-  return s;
-}
-
-function fillTable(table, head, rows) {
-  const caption = table.querySelector('caption');
-  const tr = (cells, tag) => {
-    const r = document.createElement('tr');
-    for (const c of cells) {
-      const td = document.createElement(tag);
-      td.textContent = c;
-      r.append(td);
-    }
-    return r;
-  };
-  table.replaceChildren(caption, tr(head, 'th'), ...rows.map((r) => tr(r, 'td')));
 }

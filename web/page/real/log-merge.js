@@ -1,0 +1,110 @@
+// Several robots' log maps joined by the automatic merge (issue 21, item 3).
+//
+// Two or more logs, or one log cut into stretches of its laser records,
+// are replayed as robots of their own (log-worker.js). Logs carry no
+// camera, so what can join them is the maps' own evidence: each robot's
+// finished map goes to the offline merge of `merge-maps` (`MapMerge`,
+// crate/src/merge/offline.rs: wall-surface points, rotations from Hough
+// spectra, coarse correlation and refinement, then a verdict on the
+// agreement) exactly as a saved ROS map would, PGM and YAML.
+//
+// Frames: a replay draws its map in the log's own odometry frame, the
+// stretch's first scan at its odometry pose `s` (docs/interfaces.md,
+// run-log). A robot knows nothing of where another started, so each map
+// is handed to the merge in its robot's own frame, the first scan at the
+// origin, as the simulated robots' maps are: the YAML origin (the pose of
+// the image's lower-left corner) becomes s⁻¹ ∘ origin. The merge then
+// reports each robot's frame in the first robot's frame; for two stretches
+// of one log with true start poses T₁ and T₂ the truth is T₁⁻¹ ∘ T₂.
+// The images themselves are not turned: the search works in image frames,
+// so the frames only change how its answer is written.
+
+import { compose } from './overlay.js';
+import { previewOf } from './preview.js';
+
+/** The inverse of a pose [x, y, theta]: `inverse(p) ∘ p` is the identity. */
+export function inverse([x, y, t]) {
+  const c = Math.cos(t), s = Math.sin(t);
+  return [-c * x - s * y, s * x - c * y, -t];
+}
+
+/** Laser records `[from, to]` (inclusive) of each of `cut` near-equal stretches of a log of `records`. */
+export function stretches(records, cut) {
+  const n = Math.max(1, Math.min(Math.floor(cut) || 1, records));
+  return Array.from({ length: n }, (_, k) => [Math.floor((k * records) / n), Math.floor(((k + 1) * records) / n) - 1]);
+}
+
+/** A ROS map_server YAML for `image` whose lower-left corner is at `origin` [x, y, yaw]. */
+export function robotYaml(image, resolution, origin) {
+  const o = origin.map((v) => Number(v.toFixed(6)));
+  return `image: ${JSON.stringify(image)}\nresolution: ${resolution}\norigin: [${o.join(', ')}]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n`;
+}
+
+/**
+ * A finished robot's map for the merge: `{name, yaml, image}` with its
+ * YAML origin in the robot's own frame (its first scan at the origin).
+ * `robot`: `{name, report, replay}` (report: the run-log report).
+ */
+export function robotMap({ name, report, replay }) {
+  const start = report.scans[0].pose;
+  const m = report.map;
+  const origin = compose(inverse(start), [m.origin_m[0], m.origin_m[1], 0]);
+  return { name: `${name}.yaml`, yaml: robotYaml(`${name}.pgm`, m.resolution_m, origin), imageName: `${name}.pgm`, image: replay.mapPgm() };
+}
+
+/**
+ * Merges the finished robots' maps with `wasm.MapMerge`; `progress(text)`
+ * after each pair. Returns `{merger, report, files}`: the merge-maps
+ * report (with `timings_ms.merge`), and the merged map's PGM, PNG and YAML
+ * (null on no_merge). The caller frees `merger`.
+ */
+export function mergeRobots(wasm, robots, progress = () => {}) {
+  const merger = new wasm.MapMerge();
+  try {
+    for (const r of robots) {
+      const m = robotMap(r);
+      merger.addMap(m.name, m.yaml, m.imageName, m.image);
+    }
+    const t0 = performance.now();
+    const report = JSON.parse(merger.mergeWithProgress(progress));
+    report.timings_ms = { merge: performance.now() - t0 };
+    let files = null;
+    if (report.merge.status === 'merged') {
+      files = { pgm: merger.mergedPgm(), png: merger.mergedPng(), yaml: merger.mergedYaml('merged.pgm') };
+    }
+    return { merger, report, files };
+  } catch (e) {
+    merger.free();
+    throw e;
+  }
+}
+
+/** The joined maps for the overlay (overlay.js's `drawPlaced`): `[{map, pose}]`, each map in its robot's colour. */
+export async function placedMaps({ merger, report }, robots) {
+  const placed = [];
+  for (const t of report.merge.transforms) {
+    const i = robots.findIndex((r) => `${r.name}.yaml` === t.map);
+    if (i < 0) continue;
+    const info = JSON.parse(merger.mapInfoJson(i));
+    const { thumb, ...preview } = await previewOf(merger.mapPixels(i), info.width, info.height, robots[i].colour);
+    thumb.close();
+    placed.push({ map: { ...info, preview }, pose: t.pose });
+  }
+  return placed;
+}
+
+/**
+ * Each joined robot's SLAM path in the merged frame (the first robot's):
+ * `[{colour, flat: [x, y, theta, ...]}]`, every pose p of the replay's
+ * final poses (the log's frame) as merge ∘ s⁻¹ ∘ p, s the robot's first.
+ */
+export function mergedPaths(report, robots) {
+  const out = [];
+  for (const t of report.merge.transforms) {
+    const r = robots.find((x) => `${x.name}.yaml` === t.map);
+    if (!r?.report) continue;
+    const to = compose(t.pose, inverse(r.report.scans[0].pose));
+    out.push({ colour: r.colour, flat: r.report.scans.flatMap((s) => compose(to, s.pose)) });
+  }
+  return out;
+}
