@@ -7,10 +7,12 @@
 // confidence, each map's transform (metres, degrees, and the arguments of
 // ROS's static_transform_publisher) and each pair's verdict, sees the
 // joined maps overlaid in their colours, and downloads the merged map (PGM
-// + YAML + PNG) and the transforms (JSON). The reading, drawing and merging
+// + YAML + PNG) and the transforms (JSON); a pair the merge declined can be
+// placed by hand and refined (adjust.js). The reading, drawing and merging
 // run in a Web Worker (merge-worker.js), so the page stays responsive; the
 // lab's own scenario and runs behind this view are never touched.
 
+import { ADJUST_HTML, PlaceByHand } from './adjust.js';
 import { MergeClient } from './client.js';
 import { transformRows, transformsJson, verdictText } from './report.js';
 
@@ -47,6 +49,7 @@ const HTML = `
     <p id="real-verdict" class="real-verdict"></p>
     <table id="real-transforms" class="summary-table"><caption>Each map's frame in the first map's frame</caption></table>
     <table id="real-pairs" class="summary-table"><caption>Each pair's own verdict</caption></table>
+    ${ADJUST_HTML}
     <div class="real-overlay-head">
       <h2>Merged overlay</h2>
       <label for="real-alpha">Opacity</label>
@@ -78,12 +81,25 @@ export class RealMaps {
     this.busy = false;
     this.queue = Promise.resolve();
     this.client = new MergeClient((text) => this.progress(text));
+    this.adjust = new PlaceByHand(root, this.client, {
+      maps: () => this.maps,
+      report: () => this.report,
+      refined: (out) => {
+        this.report = out.report;
+        this.files = out.files;
+        this.showResult();
+      },
+      say: (text, kind) => this.say(text, kind),
+      busy: (on, text) => this.setBusy(on, text),
+      changed: () => this.legend(),
+    });
   }
 
   /** Builds the view and connects its controls. */
   wire() {
     const root = this.root;
     root.innerHTML = HTML;
+    this.adjust.wire();
     const q = (s) => root.querySelector(s);
     this.opener.addEventListener('click', () => this.toggle(true));
     q('.real-close').addEventListener('click', () => this.toggle(false));
@@ -218,6 +234,7 @@ export class RealMaps {
   }
 
   dropResult() {
+    this.adjust.active = null;
     this.report = null;
     this.files = null;
     this.root.querySelector('#real-result').hidden = true;
@@ -252,6 +269,7 @@ export class RealMaps {
     for (const b of this.root.querySelectorAll('.real-downloads button')) {
       b.disabled = b.dataset.file !== 'json' && !this.files;
     }
+    this.adjust.show(this.report);
     // The overlay in a task of its own, after the tables are laid out.
     nextFrame().then(() => this.drawOverlay());
   }
@@ -278,6 +296,9 @@ export class RealMaps {
     this.drawing = true;
     this.client
       .request({ type: 'draw', ...size })
+      .then((r) => {
+        if (this.adjust.active && r.view) this.adjust.view = r.view;
+      })
       .catch((e) => this.say(e.message, 'error'))
       .finally(() => {
         this.drawing = false;
@@ -308,9 +329,15 @@ export class RealMaps {
   }
 
   legend() {
+    const legend = this.root.querySelector('#real-legend');
+    const placing = this.adjust.active;
+    if (placing) {
+      legend.replaceChildren(swatch(placing.a.colour, placing.a.name), swatch(placing.b.colour, `${placing.b.name} (drag it)`));
+      return;
+    }
+    if (!this.report) return;
     const byName = new Map(this.maps.map((m) => [m.name, m]));
     const placed = this.report.merge.transforms.filter((t) => byName.has(t.map)).map((t) => ({ map: byName.get(t.map) }));
-    const legend = this.root.querySelector('#real-legend');
     legend.replaceChildren(
       ...placed.map(({ map }) => swatch(map.colour, map.name)),
       placed.length > 1 ? 'Walls of two maps that fall on each other show dark.' : '',
@@ -335,6 +362,7 @@ export class RealMaps {
       report: this.report,
       mergeMs: this.mergeMs,
       busy: this.busy,
+      adjust: this.adjust.snapshot(),
     };
   }
 }
