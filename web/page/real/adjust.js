@@ -78,9 +78,10 @@ export class PlaceByHand {
 
   wire() {
     const q = (s) => this.root.querySelector(s);
-    q('#real-adjust-start').addEventListener('click', () => this.start());
-    q('#real-adjust-cancel').addEventListener('click', () => this.stop());
-    q('#real-refine').addEventListener('click', () => this.refine());
+    const said = (job) => () => job().catch((e) => this.hooks.say(e.message, 'error'));
+    q('#real-adjust-start').addEventListener('click', said(() => this.start()));
+    q('#real-adjust-cancel').addEventListener('click', said(() => this.stop()));
+    q('#real-refine').addEventListener('click', said(() => this.refine()));
     // The overlay canvas may be replaced (a restarted worker): listen on the view.
     this.root.addEventListener('pointerdown', (e) => this.down(e));
     this.root.addEventListener('pointermove', (e) => this.move(e));
@@ -229,12 +230,14 @@ export class PlaceByHand {
     if (!this.active) return;
     const { a, b, pose } = this.active;
     this.drag = null;
+    this.root.querySelector('#real-refine').disabled = true;
     this.hooks.busy(true, `refining ${b.name} on ${a.name} from where you put it…`);
     let out;
     try {
       out = await this.client.refine(a.index, b.index, pose);
     } finally {
       this.hooks.busy(false, '');
+      this.controls();
     }
     this.active = null;
     this.controls();

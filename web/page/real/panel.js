@@ -51,7 +51,7 @@ const HTML = `
     <table id="real-pairs" class="summary-table"><caption>Each pair's own verdict</caption></table>
     ${ADJUST_HTML}
     <div class="real-overlay-head">
-      <h2>Merged overlay</h2>
+      <h2 id="real-overlay-title">Merged overlay</h2>
       <label for="real-alpha">Opacity</label>
       <input id="real-alpha" type="range" min="15" max="100" value="85" aria-label="Opacity of the maps in the overlay">
     </div>
@@ -331,6 +331,7 @@ export class RealMaps {
   legend() {
     const legend = this.root.querySelector('#real-legend');
     const placing = this.adjust.active;
+    this.root.querySelector('#real-overlay-title').textContent = placing ? `Placing ${placing.b.name} by hand` : 'Merged overlay';
     if (placing) {
       legend.replaceChildren(swatch(placing.a.colour, placing.a.name), swatch(placing.b.colour, `${placing.b.name} (drag it)`));
       return;
