@@ -106,31 +106,7 @@ fn turned_frame(x0: f64, x1: f64, h: f64, theta: f64, size: f64) -> Pose2 {
 
 #[test]
 fn a_pair_cut_from_one_building_merges_to_the_known_transform() {
-    let (w, h) = (36.0, 24.0);
-    let walls = building(11, w, h);
-    let fa = Pose2::new(-1.0, -1.0, 0.0);
-    let oa = Pose2::new(-3.0, 2.0, 0.0);
-    let a = cut(
-        "a.yaml",
-        &walls,
-        (w, h),
-        fa,
-        DVec2::new(26.0, 26.0),
-        |p| p.x <= 24.0,
-        oa,
-    );
-    let fb = turned_frame(12.0, 37.0, h, 0.7, 36.0);
-    let ob = Pose2::new(1.0, -2.0, 0.3);
-    let b = cut(
-        "b.yaml",
-        &walls,
-        (w, h),
-        fb,
-        DVec2::new(36.0, 36.0),
-        |p| p.x >= 12.0,
-        ob,
-    );
-    let truth = map_frame(&fa, &oa).between(&map_frame(&fb, &ob));
+    let (a, b, truth) = east_west_pair();
     let r = merge_all(&[a, b], &OfflineConfig::default(), &mut |_| {});
     assert_eq!(r.status, MergeStatus::Merged, "{}", r.reason);
     let est = r.poses[1].unwrap();
@@ -283,31 +259,12 @@ fn the_merged_map_is_written_as_map_server_files() {
 // Refine (crate/src/merge/refine.rs): a pair aligned again from a person's
 // rough overlay, judged by the same verdict.
 
-use slamlab::merge::offline::{join, PairResult};
+#[path = "merge_support/guess.rs"]
+mod guess;
+use guess::{middle, nudged, refined};
+use slamlab::merge::offline::join;
 use slamlab::merge::refine::refine_pair;
 use slamlab::merge::wallmap::WallMap;
-
-/// `pose` (B's map frame in A's) turned by `dtheta` about B's point
-/// `pivot` (in B's map frame) and then moved by `shift`: how a person drags
-/// and turns a map about its middle.
-fn nudged(pose: &Pose2, pivot: DVec2, dtheta: f64, shift: DVec2) -> Pose2 {
-    let q = pose.transform_point(pivot);
-    let (s, c) = dtheta.sin_cos();
-    let d = pose.position() - q;
-    let t = q + DVec2::new(c * d.x - s * d.y, s * d.x + c * d.y) + shift;
-    Pose2::new(t.x, t.y, pose.theta + dtheta)
-}
-
-/// The middle of map `m`'s image, in its map frame.
-fn middle(m: &RosMap) -> DVec2 {
-    m.origin
-        .transform_point(DVec2::new(m.width as f64, m.height as f64) * 0.5 * m.resolution)
-}
-
-fn refined(a: &RosMap, b: &RosMap, guess: Pose2) -> PairResult {
-    let (wa, wb) = (WallMap::new(a), WallMap::new(b));
-    refine_pair((0, a, &wa), (1, b, &wb), guess, &OfflineConfig::default()).unwrap()
-}
 
 /// The first test's pair (A the west part of a building, B the east part
 /// turned by 0.7 rad, both with YAML origins) and B's true pose in A.
@@ -499,4 +456,61 @@ fn refine_merges_a_symmetric_building_the_automatic_merge_declines() {
     assert_eq!(r.poses[1], pair.pose);
     assert!(r.unjoined.is_empty());
     assert_eq!(r, join(&maps, vec![pair]));
+}
+
+#[test]
+fn refine_is_refused_where_the_automatic_merge_found_a_clear_winner_elsewhere() {
+    use slamlab::merge::offline::merge_pair;
+    use slamlab::merge::refine::refuse_if_beaten;
+    let (a, b, truth) = east_west_pair();
+    let (wa, wb) = (WallMap::new(&a), WallMap::new(&b));
+    let cfg = OfflineConfig::default();
+    let automatic = merge_pair((0, &a, &wa), (1, &b, &wb), &cfg);
+    let guess = nudged(&truth, middle(&b), 0.1, DVec2::new(0.5, 0.5));
+    let mine = refined(&a, &b, guess);
+    assert_eq!(mine.status, MergeStatus::Merged, "{}", mine.reason);
+    let support = mine.evidence.unwrap().support_m;
+    // The same overlay found by both: nothing to refuse.
+    let mut same = mine.clone();
+    assert!(!refuse_if_beaten(&mut same, &automatic, (&a, &b), &cfg));
+    assert_eq!(same, mine);
+    // A different overlay (4 m away) with 1.4 times the support: a near
+    // tie, which the guess settles; with 1.6 times, a clear winner.
+    let elsewhere = |ratio: f64| {
+        let mut other = automatic.clone();
+        let p = other.pose.unwrap();
+        other.pose = Some(Pose2::new(p.x + 4.0, p.y, p.theta));
+        let mut e = other.evidence.unwrap();
+        e.support_m = ratio * support;
+        other.evidence = Some(e);
+        other
+    };
+    let mut near_tie = mine.clone();
+    assert!(!refuse_if_beaten(
+        &mut near_tie,
+        &elsewhere(1.4),
+        (&a, &b),
+        &cfg
+    ));
+    assert_eq!(near_tie.status, MergeStatus::Merged);
+    let mut beaten = mine.clone();
+    assert!(refuse_if_beaten(
+        &mut beaten,
+        &elsewhere(1.6),
+        (&a, &b),
+        &cfg
+    ));
+    assert_eq!(beaten.status, MergeStatus::NoMerge);
+    assert_eq!(beaten.confidence, 0.0);
+    println!("beaten: {}", beaten.reason);
+    assert!(
+        beaten.reason.starts_with("refined from your guess"),
+        "{}",
+        beaten.reason
+    );
+    assert!(
+        beaten.reason.contains("1.6 times as much"),
+        "{}",
+        beaten.reason
+    );
 }

@@ -7,7 +7,6 @@
 use glam::DVec2;
 use slamlab::geom::{wrap_angle, Pose2};
 use slamlab::merge::offline::{merge_pair, OfflineConfig, PairResult};
-use slamlab::merge::refine::refine_pair;
 use slamlab::merge::wallmap::WallMap;
 use slamlab::merge::MergeStatus;
 use slamlab::rosmap::{self, MapYaml, RosMap};
@@ -15,6 +14,10 @@ use std::path::{Path, PathBuf};
 
 #[path = "real_support/npy.rs"]
 mod npy;
+
+#[path = "merge_support/guess.rs"]
+mod guess;
+use guess::{middle, nudged, refined};
 
 fn data_dir() -> PathBuf {
     let dir = std::env::var_os("SLAMLAB_DATA")
@@ -65,6 +68,19 @@ fn expect() -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
 }
 
+/// A laser pair of expect.json: its two maps and B's true frame in A's.
+fn laser_case(dir: &Path, case: &serde_json::Value) -> (RosMap, RosMap, Pose2) {
+    let a = load(&dir.join(case["a"].as_str().unwrap()));
+    let b = load(&dir.join(case["b"].as_str().unwrap()));
+    let t: Vec<f64> = case["pose_b_in_a"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    (a, b, Pose2::new(t[0], t[1], t[2]))
+}
+
 #[test]
 fn laser_pairs_merge_within_tolerance() {
     let dir = data_dir().join("maps/laser-pairs");
@@ -72,15 +88,7 @@ fn laser_pairs_merge_within_tolerance() {
     let mut failures = Vec::new();
     println!("| pair | verdict | error (m) | error (deg) | agree (m) | index | support (m) | rival (m) |");
     for (name, case) in cases.as_object().unwrap() {
-        let a = load(&dir.join(case["a"].as_str().unwrap()));
-        let b = load(&dir.join(case["b"].as_str().unwrap()));
-        let t: Vec<f64> = case["pose_b_in_a"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|v| v.as_f64().unwrap())
-            .collect();
-        let truth = Pose2::new(t[0], t[1], t[2]);
+        let (a, b, truth) = laser_case(&dir, case);
         let r = pair(&a, &b);
         let e = r.evidence.unwrap_or_default();
         let (dm, dd) = r.pose.map_or((f64::NAN, f64::NAN), |p| error(&p, &truth));
@@ -345,42 +353,13 @@ fn halmstad_office_pairs() {
     }
 }
 
-/// `pose` (B's map frame in A's) turned by `dtheta` about B's point `pivot`
-/// (B's map frame), then moved by `shift`: a person's rough placing.
-fn nudged(pose: &Pose2, pivot: DVec2, dtheta: f64, shift: DVec2) -> Pose2 {
-    let q = pose.transform_point(pivot);
-    let (s, c) = dtheta.sin_cos();
-    let d = pose.position() - q;
-    let t = q + DVec2::new(c * d.x - s * d.y, s * d.x + c * d.y) + shift;
-    Pose2::new(t.x, t.y, pose.theta + dtheta)
-}
-
-/// The middle of map `m`'s image, in its map frame.
-fn middle(m: &RosMap) -> DVec2 {
-    m.origin
-        .transform_point(DVec2::new(m.width as f64, m.height as f64) * 0.5 * m.resolution)
-}
-
-fn refined(a: &RosMap, b: &RosMap, guess: Pose2) -> PairResult {
-    let (wa, wb) = (WallMap::new(a), WallMap::new(b));
-    refine_pair((0, a, &wa), (1, b, &wb), guess, &OfflineConfig::default()).unwrap()
-}
-
 #[test]
 fn refine_from_a_rough_guess_on_laser_pairs() {
     let dir = data_dir().join("maps/laser-pairs");
     let mut failures = Vec::new();
     println!("| pair | verdict | error (m) | error (deg) | agree (m) | index | support (m) | rival (m) |");
     for (name, case) in expect().as_object().unwrap() {
-        let a = load(&dir.join(case["a"].as_str().unwrap()));
-        let b = load(&dir.join(case["b"].as_str().unwrap()));
-        let t: Vec<f64> = case["pose_b_in_a"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|v| v.as_f64().unwrap())
-            .collect();
-        let truth = Pose2::new(t[0], t[1], t[2]);
+        let (a, b, truth) = laser_case(&dir, case);
         // 1 m and 8° off, about B's middle.
         let guess = nudged(&truth, middle(&b), 8f64.to_radians(), DVec2::new(0.8, -0.6));
         let r = refined(&a, &b, guess);

@@ -9,8 +9,8 @@
 
 use super::convert::js_err as err;
 use crate::geom::Pose2;
-use crate::merge::offline::{merge_all, OfflineConfig, OfflineMerge};
-use crate::merge::refine::refine_pair;
+use crate::merge::offline::{merge_all, OfflineConfig, OfflineMerge, PairResult};
+use crate::merge::refine::{refine_pair, refuse_if_beaten};
 use crate::merge::wallmap::WallMap;
 use crate::rosmap::{self, write::MergedMap, MapYaml, RosMap};
 use wasm_bindgen::prelude::*;
@@ -21,6 +21,8 @@ use wasm_bindgen::prelude::*;
 pub struct MapMerge {
     maps: Vec<RosMap>,
     result: Option<OfflineMerge>,
+    /// The automatic merge's pairs, kept for Refine's check.
+    automatic: Vec<PairResult>,
     merged: Option<MergedMap>,
 }
 
@@ -118,6 +120,7 @@ impl MapMerge {
         }
         let result = merge_all(&self.maps, &OfflineConfig::default(), progress);
         let report = result.report(&self.maps).to_string();
+        self.automatic = result.pairs.clone();
         self.result = Some(result);
         self.merged = None;
         Ok(report)
@@ -147,7 +150,10 @@ impl MapMerge {
     /// as the report's transforms. The result replaces that pair's verdict
     /// and the maps are joined again, so the report (`reportJson`) and the
     /// merged map follow it. Returns the pair's result as JSON, in the
-    /// report's `pairs[]` format (with `guess`).
+    /// report's `pairs[]` format (with `guess`). The pair is refined in the
+    /// order the merge judged it, so for `a > b` it comes back as `b`, `a`
+    /// with the guess inverted. A refined overlay is refused when the
+    /// automatic merge found a different one with 1.5 times its support.
     pub fn refine(
         &mut self,
         a: u32,
@@ -163,7 +169,7 @@ impl MapMerge {
                 "refine: maps {a} and {b} are not a pair of the {n} maps opened"
             )));
         }
-        let guess = Pose2::new(x, y, theta);
+        let mut guess = Pose2::new(x, y, theta);
         if !guess.is_finite() {
             return Err(JsError::new(&format!(
                 "refine: the guess must be finite numbers, got x = {x}, y = {y}, theta = {theta}"
@@ -173,14 +179,24 @@ impl MapMerge {
             .result
             .as_mut()
             .ok_or_else(|| JsError::new("refine: merge first"))?;
-        let (wa, wb) = (WallMap::new(&self.maps[a]), WallMap::new(&self.maps[b]));
-        let pair = refine_pair(
-            (a, &self.maps[a], &wa),
-            (b, &self.maps[b], &wb),
-            guess,
-            &OfflineConfig::default(),
-        )
-        .map_err(|e| JsError::new(&format!("refine: {e}")))?;
+        // Refined in the order the merge judged the pair.
+        let automatic = self
+            .automatic
+            .iter()
+            .find(|p| (p.a, p.b) == (a, b) || (p.a, p.b) == (b, a))
+            .ok_or_else(|| JsError::new("refine: that pair was not judged"))?;
+        let (a, b) = if automatic.a == a {
+            (a, b)
+        } else {
+            guess = guess.inverse();
+            (b, a)
+        };
+        let cfg = OfflineConfig::default();
+        let (ma, mb) = (&self.maps[a], &self.maps[b]);
+        let (wa, wb) = (WallMap::new(ma), WallMap::new(mb));
+        let mut pair = refine_pair((a, ma, &wa), (b, mb, &wb), guess, &cfg)
+            .map_err(|e| JsError::new(&format!("refine: {e}")))?;
+        refuse_if_beaten(&mut pair, automatic, (ma, mb), &cfg);
         let k = result
             .replace_pair(&self.maps, pair)
             .ok_or_else(|| JsError::new("refine: that pair was not judged"))?;

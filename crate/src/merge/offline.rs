@@ -145,7 +145,24 @@ pub fn merge_pair(
         .iter()
         .map(|p| (p.pose, evidence(wa, wb, &p.pose, &cfg.evidence)))
         .collect();
-    // The overlay with the most net support (ties: the better search score).
+    if !judge_overlays(&mut out, (a, b, wb), &judged, cfg, "") {
+        out.reason = "no overlay of the walls scores above zero".into();
+    }
+    out
+}
+
+/// Judges the overlay of `judged` (B's image frame in A's, with its
+/// evidence) with the most net support (ties: the earlier) against the best
+/// different one of them, and writes the verdict, the pose (B's map frame in
+/// A's), the evidence and the rival into `out`; `others` says where the
+/// rivals were found, for the reason. `false` when `judged` is empty.
+pub fn judge_overlays(
+    out: &mut PairResult,
+    (a, b, wb): (&RosMap, &RosMap, &WallMap),
+    judged: &[(Pose2, Evidence)],
+    cfg: &OfflineConfig,
+    others: &str,
+) -> bool {
     let Some(w) = (0..judged.len()).reduce(|best, i| {
         if judged[i].1.support_m > judged[best].1.support_m {
             i
@@ -153,8 +170,7 @@ pub fn merge_pair(
             best
         }
     }) else {
-        out.reason = "no overlay of the walls scores above zero".into();
-        return out;
+        return false;
     };
     let (wpose, e) = judged[w];
     let centre = wb.walls.iter().copied().sum::<DVec2>() / wb.walls.len() as f64;
@@ -169,11 +185,11 @@ pub fn merge_pair(
         Ok(confidence) => {
             out.status = MergeStatus::Merged;
             out.confidence = confidence;
-            out.reason = agreement_reason(&e, out.rival_support_m, cfg, "");
+            out.reason = agreement_reason(&e, out.rival_support_m, cfg, others);
         }
         Err(reason) => out.reason = reason,
     }
-    out
+    true
 }
 
 /// Merges all `maps` (see the module doc). `progress` hears a line per

@@ -38,13 +38,17 @@
 //!    end; but a guess onto the wrong place (the walls do not agree there)
 //!    or onto another building is still refused, with the numbers, and a
 //!    window holding two overlays that fit as well (a row of equal rooms
-//!    one step apart) is still ambiguous.
+//!    one step apart) is still ambiguous. And the guess settles only a near
+//!    tie: when the automatic search of the pair found a different overlay
+//!    with 1.5 times the refined one's support, the refined one is refused
+//!    ([`refuse_if_beaten`]), so a person cannot talk the lab out of a
+//!    clear winner.
 //!
 //! Every reason starts "refined from your guess", so a reader of the report
 //! knows a person chose the neighbourhood.
 
-use super::evidence::{distinct, evidence, judge, Evidence};
-use super::offline::{agreement_reason, OfflineConfig, PairResult};
+use super::evidence::{distinct, evidence, Evidence};
+use super::offline::{judge_overlays, OfflineConfig, PairResult};
 pub use super::offline_search::RefineConfig;
 use super::offline_search::{field_score, refine, thinned};
 use super::wallmap::WallMap;
@@ -101,6 +105,15 @@ fn window_peaks(a: &WallMap, b: &WallMap, start: Pose2, cfg: &OfflineConfig) -> 
     kept
 }
 
+/// How every reason of a refined pair begins.
+fn guess_prefix(a: &RosMap, b: &RosMap, cfg: &OfflineConfig) -> String {
+    let (half_m, _) = cfg.refine.window_m(a.resolution, b.resolution);
+    format!(
+        "refined from your guess (within {:.1} m and {:.0}° of it)",
+        half_m, cfg.refine.window_deg
+    )
+}
+
 /// Aligns B on A from `guess` (B's map frame in A's map frame) and judges
 /// the result (see the module doc). `Err` only for a guess that is not
 /// finite numbers; a refused overlay is an `Ok` with status `NoMerge` and
@@ -119,11 +132,7 @@ pub fn refine_pair(
     }
     let mut out = PairResult::unjudged(ia, ib);
     out.guess = Some(guess);
-    let (half_m, _) = cfg.refine.window_m(a.resolution, b.resolution);
-    let prefix = format!(
-        "refined from your guess (within {:.1} m and {:.0}° of it)",
-        half_m, cfg.refine.window_deg
-    );
+    let prefix = guess_prefix(a, b, cfg);
     if wa.walls.len() < 10 || wb.walls.len() < 10 {
         out.reason = format!("{prefix}: a map has (almost) no walls to align");
         return Ok(out);
@@ -139,34 +148,49 @@ pub fn refine_pair(
         })
         .collect();
     out.overlays = judged.len();
-    let Some(w) = (0..judged.len()).reduce(|best, i| {
-        if judged[i].1.support_m > judged[best].1.support_m {
-            i
-        } else {
-            best
-        }
-    }) else {
+    if !judge_overlays(&mut out, (a, b, wb), &judged, cfg, "near your guess") {
         out.reason = format!("{prefix}: no wall of one map comes near the other's there");
         return Ok(out);
-    };
-    let (wpose, e) = judged[w];
-    let centre = wb.walls.iter().copied().sum::<DVec2>() / wb.walls.len() as f64;
-    out.rival_support_m = judged
-        .iter()
-        .filter(|(p, _)| distinct(p, &wpose, centre, &cfg.evidence))
-        .map(|(_, r)| r.support_m)
-        .fold(0.0, f64::max);
-    out.evidence = Some(e);
-    let pose = a.origin.compose(&wpose).compose(&b.origin.inverse());
-    out.pose = Some(Pose2::new(pose.x, pose.y, wrap_angle(pose.theta)));
-    match judge(&e, out.rival_support_m, &cfg.evidence) {
-        Ok(confidence) => {
-            out.status = MergeStatus::Merged;
-            out.confidence = confidence;
-            let agree = agreement_reason(&e, out.rival_support_m, cfg, "near your guess");
-            out.reason = format!("{prefix}: {agree}");
-        }
-        Err(reason) => out.reason = format!("{prefix}: {reason}"),
     }
+    out.pose = out.pose.map(|p| Pose2::new(p.x, p.y, wrap_angle(p.theta)));
+    out.reason = format!("{prefix}: {}", out.reason);
     Ok(out)
+}
+
+/// The guess settles a near tie, never a clear winner: a refined pair
+/// (`refined`, of maps `a` and `b`) is refused when the automatic search of
+/// the same pair (`automatic`, same order) found a different overlay with
+/// at least `min_margin` times its net support. Returns whether it was.
+pub fn refuse_if_beaten(
+    refined: &mut PairResult,
+    automatic: &PairResult,
+    (a, b): (&RosMap, &RosMap),
+    cfg: &OfflineConfig,
+) -> bool {
+    let (Some(mine), Some(theirs)) = (refined.evidence, automatic.evidence) else {
+        return false;
+    };
+    let (Some(p), Some(q)) = (refined.pose, automatic.pose) else {
+        return false;
+    };
+    let at = b
+        .origin
+        .transform_point(DVec2::new(b.width as f64, b.height as f64) * 0.5 * b.resolution);
+    let beaten = (refined.a, refined.b) == (automatic.a, automatic.b)
+        && refined.status == MergeStatus::Merged
+        && distinct(&p, &q, at, &cfg.evidence)
+        && theirs.support_m >= cfg.evidence.min_margin * mine.support_m.max(0.0);
+    if beaten {
+        refined.status = MergeStatus::NoMerge;
+        refined.confidence = 0.0;
+        refined.reason = format!(
+            "{}: the walls agree there ({:.1} m of net support), but the automatic search found another overlay with {:.1} m, {:.1} times as much ({:.1} times makes it the clear winner): the maps fit best elsewhere",
+            guess_prefix(a, b, cfg),
+            mine.support_m,
+            theirs.support_m,
+            theirs.support_m / mine.support_m.max(1e-9),
+            cfg.evidence.min_margin
+        );
+    }
+    beaten
 }
