@@ -168,28 +168,37 @@ fn three_maps_join_along_the_spanning_tree() {
     assert_eq!(r.pairs.len(), 3);
 }
 
-#[test]
-fn two_different_buildings_are_not_merged() {
+/// Maps of two different buildings (seeds 3 and 8), B's image turned by
+/// 0.4 rad, and B's frame in A's where their corners sit as cut.
+fn two_buildings() -> (RosMap, RosMap, Pose2) {
     let fa = Pose2::new(-1.0, -1.0, 0.0);
+    let (sa, sb) = ((36.0, 24.0), (30.0, 20.0));
+    let all = |_: DVec2| true;
     let a = cut(
         "a.yaml",
-        &building(3, 36.0, 24.0),
-        (36.0, 24.0),
+        &building(3, sa.0, sa.1),
+        sa,
         fa,
         DVec2::new(38.0, 26.0),
-        |_| true,
+        all,
         Pose2::IDENTITY,
     );
     let fb = turned_frame(0.0, 30.0, 20.0, 0.4, 38.0);
     let b = cut(
         "b.yaml",
-        &building(8, 30.0, 20.0),
-        (30.0, 20.0),
+        &building(8, sb.0, sb.1),
+        sb,
         fb,
         DVec2::new(38.0, 38.0),
-        |_| true,
+        all,
         Pose2::IDENTITY,
     );
+    (a, b, fa.between(&fb))
+}
+
+#[test]
+fn two_different_buildings_are_not_merged() {
+    let (a, b, _) = two_buildings();
     let r = merge_all(&[a, b], &OfflineConfig::default(), &mut |_| {});
     println!("different buildings: {}", r.reason);
     assert_eq!(r.status, MergeStatus::NoMerge, "{}", r.reason);
@@ -346,31 +355,11 @@ fn refine_onto_a_wrong_place_is_refused() {
 
 #[test]
 fn refine_never_merges_two_different_buildings() {
-    let fa = Pose2::new(-1.0, -1.0, 0.0);
-    let all = |_: DVec2| true;
-    let a = cut(
-        "a.yaml",
-        &building(3, 36.0, 24.0),
-        (36.0, 24.0),
-        fa,
-        DVec2::new(38.0, 26.0),
-        all,
-        Pose2::IDENTITY,
-    );
-    let fb = turned_frame(0.0, 30.0, 20.0, 0.4, 38.0);
-    let b = cut(
-        "b.yaml",
-        &building(8, 30.0, 20.0),
-        (30.0, 20.0),
-        fb,
-        DVec2::new(38.0, 38.0),
-        all,
-        Pose2::IDENTITY,
-    );
+    let (a, b, placed) = two_buildings();
     // Outer walls laid on each other as a person would try.
     for guess in [
-        fa.between(&fb),
-        nudged(&fa.between(&fb), middle(&b), 0.1, DVec2::new(2.0, 1.0)),
+        placed,
+        nudged(&placed, middle(&b), 0.1, DVec2::new(2.0, 1.0)),
     ] {
         let r = refined(&a, &b, guess);
         println!("different buildings, refined: {}", r.reason);
