@@ -208,30 +208,9 @@ fn two_different_buildings_are_not_merged() {
 
 #[test]
 fn the_merged_map_is_written_as_map_server_files() {
-    let (w, h) = (36.0, 24.0);
-    let walls = building(11, w, h);
-    let fa = Pose2::new(-1.0, -1.0, 0.0);
-    let a = cut(
-        "a.yaml",
-        &walls,
-        (w, h),
-        fa,
-        DVec2::new(26.0, 26.0),
-        |p| p.x <= 24.0,
-        Pose2::IDENTITY,
-    );
-    let fb = turned_frame(12.0, 37.0, h, 0.7, 36.0);
-    let b = cut(
-        "b.yaml",
-        &walls,
-        (w, h),
-        fb,
-        DVec2::new(36.0, 36.0),
-        |p| p.x >= 12.0,
-        Pose2::IDENTITY,
-    );
-    let merged =
-        rosmap::write::merge_maps(&[(&a, Pose2::IDENTITY), (&b, fa.between(&fb))]).unwrap();
+    let (a, b, b_in_a) = east_west_pair_with(Pose2::IDENTITY, Pose2::IDENTITY);
+    let (fa, h) = (Pose2::new(-1.0, -1.0, 0.0), 24.0);
+    let merged = rosmap::write::merge_maps(&[(&a, Pose2::IDENTITY), (&b, b_in_a)]).unwrap();
     // It covers both maps: A's 26 m and B's turned square reach x = 37 m.
     assert!(merged.width as f64 * 0.05 > 38.0, "{}", merged.width);
     let yaml = merged.yaml("m.pgm");
@@ -278,10 +257,15 @@ use slamlab::merge::wallmap::WallMap;
 /// The first test's pair (A the west part of a building, B the east part
 /// turned by 0.7 rad, both with YAML origins) and B's true pose in A.
 fn east_west_pair() -> (RosMap, RosMap, Pose2) {
+    east_west_pair_with(Pose2::new(-3.0, 2.0, 0.0), Pose2::new(1.0, -2.0, 0.3))
+}
+
+/// The same with YAML origins `oa` and `ob`. A's image's lower-left corner
+/// is at (-1, -1) of the 36 x 24 m plan.
+fn east_west_pair_with(oa: Pose2, ob: Pose2) -> (RosMap, RosMap, Pose2) {
     let (w, h) = (36.0, 24.0);
     let walls = building(11, w, h);
     let fa = Pose2::new(-1.0, -1.0, 0.0);
-    let oa = Pose2::new(-3.0, 2.0, 0.0);
     let a = cut(
         "a.yaml",
         &walls,
@@ -292,7 +276,6 @@ fn east_west_pair() -> (RosMap, RosMap, Pose2) {
         oa,
     );
     let fb = turned_frame(12.0, 37.0, h, 0.7, 36.0);
-    let ob = Pose2::new(1.0, -2.0, 0.3);
     let b = cut(
         "b.yaml",
         &walls,

@@ -345,7 +345,7 @@ test('your maps: a merge declined as ambiguous is placed by hand, turned and dra
   assert.equal(snap.report.merge.status, 'merged', snap.report.merge.reason);
   const [x, y, th] = snap.report.merge.transforms[1].pose;
   const dm = Math.hypot(x - truth[0], y - truth[1]), dd = (Math.abs(wrap(th - truth[2])) * 180) / Math.PI;
-  console.log(`refined: ${dm.toFixed(3)} m and ${dd.toFixed(3)} deg from the truth`);
+  console.log(`refined: ${dm.toFixed(3)} m and ${dd.toFixed(3)} deg from the truth, in ${(snap.report.timings_ms.merge / 1000).toFixed(2)} s in the worker`);
   assert.ok(dm < 0.1 && dd < 0.5, `off by ${dm} m, ${dd} deg`);
   assert.match(await page.locator('#real-verdict').innerText(), /^Merged \(confidence \d\.\d\d\): refined from your guess \(within 2\.5 m and 20° of it\): the maps agree: .*near your guess$/);
   assert.match(await page.locator('#real-refined').innerText(), /^Refine of sym-b\.yaml on sym-a\.yaml: merged/);
