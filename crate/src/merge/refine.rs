@@ -12,8 +12,8 @@
 //! 1. **A local coarse search around the guess.** A drag is rough, so the
 //!    search looks in a window of ±`window_cells` cells (50 cells: 2.5 m at
 //!    the common 0.05 m, never less than 2.5 m) and ±`window_deg` (20°)
-//!    around the guess. B is turned about its walls' centre (where a person
-//!    sees the map's middle), in `step_deg` (1°) steps, and moved in steps
+//!    around the guess. B is turned about its walls' centre (so a turn
+//!    does not also swing it away), in `step_deg` (1°) steps, and moved in steps
 //!    of `step_cells` cells (4: 0.2 m at 0.05 m); each overlay is scored
 //!    by the wide likelihood field of the automatic search,
 //!    `Σ max(0, 1 − d/τ)` over a thinned set of B's wall points with
@@ -137,7 +137,8 @@ pub fn refine_pair(
         out.reason = format!("{prefix}: a map has (almost) no walls to align");
         return Ok(out);
     }
-    // The guess in image frames: map frame = origin ⊕ image frame⁻¹ …
+    // The guess between image frames, P = origin_A⁻¹ ⊕ guess ⊕ origin_B
+    // (the report's pose is origin_A ⊕ P ⊕ origin_B⁻¹).
     let start = a.origin.inverse().compose(&guess).compose(&b.origin);
     let (_, step_m) = cfg.refine.window_m(a.resolution, b.resolution);
     let judged: Vec<(Pose2, Evidence)> = window_peaks(wa, wb, start, cfg)
