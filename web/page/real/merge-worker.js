@@ -68,6 +68,8 @@ async function add({ files, resolution, colours }) {
 function merge(id) {
   const t0 = performance.now();
   const report = JSON.parse(merger.mergeWithProgress((text) => postMessage({ type: 'progress', id, text })));
+  adjusting = null; // a new merge ends any placing by hand
+  view = null;
   return withFiles(report, t0);
 }
 

@@ -190,6 +190,7 @@ export class RealMaps {
       this.say('Open two or more maps to merge them.', 'warn');
       return;
     }
+    if (this.adjust.active) await this.adjust.stop();
     const n = this.maps.length;
     const t0 = performance.now();
     // Nothing ticks or animates while it runs: the page's main thread stays
