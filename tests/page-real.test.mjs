@@ -16,7 +16,8 @@
 // closes a loop while it replays, and its map is downloaded. And Refine:
 // two full maps of a building that is the same turned by 180° (the
 // automatic merge declines them as ambiguous) are placed by hand with real
-// mouse events (a Shift-drag turns the map, a drag moves it) roughly onto
+// mouse events (a Shift-drag turns the map, a drag moves it; the arrow
+// keys and Q / E are checked too) roughly onto
 // the truth and refined to it; a map dragged onto a wrong place is refused.
 //
 // Needs the wasm build in web/pkg (`./build.sh build`). Run alone with
@@ -328,6 +329,15 @@ test('your maps: a merge declined as ambiguous is placed by hand, turned and dra
   assert.match(await page.locator('#real-adjust-help').innerText(), /Drag the map roughly onto the other, then press Refine/);
   const start = (await snapshot(page)).adjust.placing;
   assert.deepEqual(start.pose.map((v) => Number(v.toFixed(6))).slice(2), [0], 'the map starts unturned, beside the other');
+  // Keyboard users: the arrow keys move the map by 0.1 m, Q and E turn it by 1° about its middle.
+  await page.locator('#real-overlay').focus();
+  for (const key of ['ArrowRight', 'ArrowRight', 'ArrowRight', 'ArrowUp', 'q']) await page.keyboard.press(key);
+  const keyed = (await snapshot(page)).adjust.placing.pose;
+  assert.ok(Math.abs(keyed[2] - start.pose[2] - Math.PI / 180) < 1e-9, `Q turned to ${keyed[2]}`);
+  const keyedMiddle = compose(keyed, [...start.pivot, 0]), startMiddle = compose(start.pose, [...start.pivot, 0]);
+  assert.ok(Math.abs(keyedMiddle[0] - startMiddle[0] - 0.3) < 1e-9 && Math.abs(keyedMiddle[1] - startMiddle[1] - 0.1) < 1e-9, 'arrows moved the middle');
+  await page.keyboard.press('e');
+  assert.ok(Math.abs((await snapshot(page)).adjust.placing.pose[2] - start.pose[2]) < 1e-9, 'E turned it back');
   // Roughly onto the truth: turned 6° too far, its middle 0.5 m off.
   const target = compose(truth, [...start.pivot, 0]);
   const placed = await turnAndMove(page, wrap(truth[2] + (6 * Math.PI) / 180 - start.pose[2]), [target[0] + 0.4, target[1] - 0.3]);
