@@ -106,31 +106,7 @@ fn turned_frame(x0: f64, x1: f64, h: f64, theta: f64, size: f64) -> Pose2 {
 
 #[test]
 fn a_pair_cut_from_one_building_merges_to_the_known_transform() {
-    let (w, h) = (36.0, 24.0);
-    let walls = building(11, w, h);
-    let fa = Pose2::new(-1.0, -1.0, 0.0);
-    let oa = Pose2::new(-3.0, 2.0, 0.0);
-    let a = cut(
-        "a.yaml",
-        &walls,
-        (w, h),
-        fa,
-        DVec2::new(26.0, 26.0),
-        |p| p.x <= 24.0,
-        oa,
-    );
-    let fb = turned_frame(12.0, 37.0, h, 0.7, 36.0);
-    let ob = Pose2::new(1.0, -2.0, 0.3);
-    let b = cut(
-        "b.yaml",
-        &walls,
-        (w, h),
-        fb,
-        DVec2::new(36.0, 36.0),
-        |p| p.x >= 12.0,
-        ob,
-    );
-    let truth = map_frame(&fa, &oa).between(&map_frame(&fb, &ob));
+    let (a, b, truth) = east_west_pair();
     let r = merge_all(&[a, b], &OfflineConfig::default(), &mut |_| {});
     assert_eq!(r.status, MergeStatus::Merged, "{}", r.reason);
     let est = r.poses[1].unwrap();
@@ -192,28 +168,37 @@ fn three_maps_join_along_the_spanning_tree() {
     assert_eq!(r.pairs.len(), 3);
 }
 
-#[test]
-fn two_different_buildings_are_not_merged() {
+/// Maps of two different buildings (seeds 3 and 8), B's image turned by
+/// 0.4 rad, and B's frame in A's where their corners sit as cut.
+fn two_buildings() -> (RosMap, RosMap, Pose2) {
     let fa = Pose2::new(-1.0, -1.0, 0.0);
+    let (sa, sb) = ((36.0, 24.0), (30.0, 20.0));
+    let all = |_: DVec2| true;
     let a = cut(
         "a.yaml",
-        &building(3, 36.0, 24.0),
-        (36.0, 24.0),
+        &building(3, sa.0, sa.1),
+        sa,
         fa,
         DVec2::new(38.0, 26.0),
-        |_| true,
+        all,
         Pose2::IDENTITY,
     );
     let fb = turned_frame(0.0, 30.0, 20.0, 0.4, 38.0);
     let b = cut(
         "b.yaml",
-        &building(8, 30.0, 20.0),
-        (30.0, 20.0),
+        &building(8, sb.0, sb.1),
+        sb,
         fb,
         DVec2::new(38.0, 38.0),
-        |_| true,
+        all,
         Pose2::IDENTITY,
     );
+    (a, b, fa.between(&fb))
+}
+
+#[test]
+fn two_different_buildings_are_not_merged() {
+    let (a, b, _) = two_buildings();
     let r = merge_all(&[a, b], &OfflineConfig::default(), &mut |_| {});
     println!("different buildings: {}", r.reason);
     assert_eq!(r.status, MergeStatus::NoMerge, "{}", r.reason);
@@ -223,30 +208,9 @@ fn two_different_buildings_are_not_merged() {
 
 #[test]
 fn the_merged_map_is_written_as_map_server_files() {
-    let (w, h) = (36.0, 24.0);
-    let walls = building(11, w, h);
-    let fa = Pose2::new(-1.0, -1.0, 0.0);
-    let a = cut(
-        "a.yaml",
-        &walls,
-        (w, h),
-        fa,
-        DVec2::new(26.0, 26.0),
-        |p| p.x <= 24.0,
-        Pose2::IDENTITY,
-    );
-    let fb = turned_frame(12.0, 37.0, h, 0.7, 36.0);
-    let b = cut(
-        "b.yaml",
-        &walls,
-        (w, h),
-        fb,
-        DVec2::new(36.0, 36.0),
-        |p| p.x >= 12.0,
-        Pose2::IDENTITY,
-    );
-    let merged =
-        rosmap::write::merge_maps(&[(&a, Pose2::IDENTITY), (&b, fa.between(&fb))]).unwrap();
+    let (a, b, b_in_a) = east_west_pair_with(Pose2::IDENTITY, Pose2::IDENTITY);
+    let (fa, h) = (Pose2::new(-1.0, -1.0, 0.0), 24.0);
+    let merged = rosmap::write::merge_maps(&[(&a, Pose2::IDENTITY), (&b, b_in_a)]).unwrap();
     // It covers both maps: A's 26 m and B's turned square reach x = 37 m.
     assert!(merged.width as f64 * 0.05 > 38.0, "{}", merged.width);
     let yaml = merged.yaml("m.pgm");
@@ -278,4 +242,247 @@ fn the_merged_map_is_written_as_map_server_files() {
     let png = merged.png().unwrap();
     let from_png = rosmap::load("m.yaml", &yaml.replace("m.pgm", "m.png"), "m.png", &png).unwrap();
     assert_eq!(from_png.data, back.data);
+}
+
+// Refine (crate/src/merge/refine.rs): a pair aligned again from a person's
+// rough overlay, judged by the same verdict.
+
+#[path = "merge_support/guess.rs"]
+mod guess;
+use guess::{middle, nudged, refined};
+use slamlab::merge::offline::join;
+use slamlab::merge::refine::refine_pair;
+use slamlab::merge::wallmap::WallMap;
+
+/// The first test's pair (A the west part of a building, B the east part
+/// turned by 0.7 rad, both with YAML origins) and B's true pose in A.
+fn east_west_pair() -> (RosMap, RosMap, Pose2) {
+    east_west_pair_with(Pose2::new(-3.0, 2.0, 0.0), Pose2::new(1.0, -2.0, 0.3))
+}
+
+/// The same with YAML origins `oa` and `ob`. A's image's lower-left corner
+/// is at (-1, -1) of the 36 x 24 m plan.
+fn east_west_pair_with(oa: Pose2, ob: Pose2) -> (RosMap, RosMap, Pose2) {
+    let (w, h) = (36.0, 24.0);
+    let walls = building(11, w, h);
+    let fa = Pose2::new(-1.0, -1.0, 0.0);
+    let a = cut(
+        "a.yaml",
+        &walls,
+        (w, h),
+        fa,
+        DVec2::new(26.0, 26.0),
+        |p| p.x <= 24.0,
+        oa,
+    );
+    let fb = turned_frame(12.0, 37.0, h, 0.7, 36.0);
+    let b = cut(
+        "b.yaml",
+        &walls,
+        (w, h),
+        fb,
+        DVec2::new(36.0, 36.0),
+        |p| p.x >= 12.0,
+        ob,
+    );
+    let truth = map_frame(&fa, &oa).between(&map_frame(&fb, &ob));
+    (a, b, truth)
+}
+
+#[test]
+fn refine_from_a_guess_1_m_and_10_deg_off_converges_and_merges() {
+    let (a, b, truth) = east_west_pair();
+    for (dtheta, shift) in [
+        (10f64, DVec2::new(0.6, -0.8)),
+        (-10.0, DVec2::new(-0.8, 0.6)),
+    ] {
+        let guess = nudged(&truth, middle(&b), dtheta.to_radians(), shift);
+        let r = refined(&a, &b, guess);
+        let (dm, dd) = error(&r.pose.unwrap(), &truth);
+        println!(
+            "refine from {dtheta}° / {shift}: off by {dm:.4} m, {dd:.3} deg; {}",
+            r.reason
+        );
+        assert_eq!(r.status, MergeStatus::Merged, "{}", r.reason);
+        assert!(dm < 0.1 && dd < 0.5, "off by {dm} m {dd} deg");
+        assert!(
+            r.reason.starts_with("refined from your guess"),
+            "{}",
+            r.reason
+        );
+        assert!(r.reason.contains("near your guess"), "{}", r.reason);
+        assert_eq!(r.guess, Some(guess));
+        assert!(r.confidence > 0.0 && r.confidence <= 1.0);
+    }
+}
+
+#[test]
+fn refine_onto_a_wrong_place_is_refused() {
+    let (a, b, truth) = east_west_pair();
+    // B's middle dropped 6 m west and 5 m south of where it belongs, and
+    // turned by 90°: the walls do not agree there.
+    for (dtheta, shift) in [(0.0f64, DVec2::new(-6.0, -5.0)), (90.0, DVec2::ZERO)] {
+        let guess = nudged(&truth, middle(&b), dtheta.to_radians(), shift);
+        let r = refined(&a, &b, guess);
+        println!("wrong place ({dtheta}°, {shift}): {}", r.reason);
+        assert_eq!(r.status, MergeStatus::NoMerge, "{}", r.reason);
+        assert!(
+            r.reason.starts_with("refined from your guess"),
+            "{}",
+            r.reason
+        );
+        assert!(r.reason.chars().any(|c| c.is_ascii_digit()), "{}", r.reason);
+        assert_eq!(r.confidence, 0.0);
+    }
+}
+
+#[test]
+fn refine_never_merges_two_different_buildings() {
+    let (a, b, placed) = two_buildings();
+    // Outer walls laid on each other as a person would try.
+    for guess in [
+        placed,
+        nudged(&placed, middle(&b), 0.1, DVec2::new(2.0, 1.0)),
+    ] {
+        let r = refined(&a, &b, guess);
+        println!("different buildings, refined: {}", r.reason);
+        assert_eq!(r.status, MergeStatus::NoMerge, "{}", r.reason);
+    }
+}
+
+#[test]
+fn refine_refuses_a_guess_that_is_not_finite() {
+    let (a, b, _) = east_west_pair();
+    let (wa, wb) = (WallMap::new(&a), WallMap::new(&b));
+    for guess in [
+        Pose2::new(f64::NAN, 0.0, 0.0),
+        Pose2::new(0.0, f64::INFINITY, 0.0),
+        Pose2::new(0.0, 0.0, f64::NEG_INFINITY),
+    ] {
+        let e =
+            refine_pair((0, &a, &wa), (1, &b, &wb), guess, &OfflineConfig::default()).unwrap_err();
+        assert!(e.contains("finite"), "{e}");
+    }
+}
+
+/// A building that is the same turned by 180°: a `w / 2` wide plan and its
+/// copy turned about the middle of the `w` x `h` rectangle.
+fn symmetric_building(seed: u64, w: f64, h: f64) -> Vec<Segment> {
+    let half = building(seed, 0.5 * w, h);
+    let turn = |p: DVec2| DVec2::new(w - p.x, h - p.y);
+    let mut walls = half.clone();
+    walls.extend(half.iter().map(|s| Segment::new(turn(s.a), turn(s.b))));
+    walls
+}
+
+#[test]
+fn refine_merges_a_symmetric_building_the_automatic_merge_declines() {
+    let (w, h) = (40.0, 20.0);
+    let walls = symmetric_building(21, w, h);
+    let all = |_: DVec2| true;
+    let fa = Pose2::new(-1.0, -1.0, 0.0);
+    let a = cut(
+        "a.yaml",
+        &walls,
+        (w, h),
+        fa,
+        DVec2::new(42.0, 22.0),
+        all,
+        Pose2::IDENTITY,
+    );
+    let fb = turned_frame(-1.0, 41.0, h, 0.9, 44.0);
+    let b = cut(
+        "b.yaml",
+        &walls,
+        (w, h),
+        fb,
+        DVec2::new(44.0, 44.0),
+        all,
+        Pose2::IDENTITY,
+    );
+    let truth = fa.between(&fb);
+    let maps = [a, b];
+    let mut r = merge_all(&maps, &OfflineConfig::default(), &mut |_| {});
+    println!("symmetric building, automatic: {}", r.reason);
+    assert_eq!(r.status, MergeStatus::NoMerge, "{}", r.reason);
+    assert!(r.reason.contains("ambiguous"), "{}", r.reason);
+
+    let guess = nudged(
+        &truth,
+        middle(&maps[1]),
+        8f64.to_radians(),
+        DVec2::new(0.7, 0.7),
+    );
+    let pair = refined(&maps[0], &maps[1], guess);
+    let (dm, dd) = error(&pair.pose.unwrap(), &truth);
+    println!(
+        "symmetric building, refined: off by {dm:.4} m, {dd:.3} deg; {}",
+        pair.reason
+    );
+    assert_eq!(pair.status, MergeStatus::Merged, "{}", pair.reason);
+    assert!(dm < 0.1 && dd < 0.5, "off by {dm} m {dd} deg");
+
+    // The refined pair replaces the automatic one and the maps are joined.
+    assert_eq!(r.replace_pair(&maps, pair.clone()), Some(0));
+    assert_eq!(r.status, MergeStatus::Merged, "{}", r.reason);
+    assert_eq!(r.poses[1], pair.pose);
+    assert!(r.unjoined.is_empty());
+    assert_eq!(r, join(&maps, vec![pair]));
+}
+
+#[test]
+fn refine_is_refused_where_the_automatic_merge_found_a_clear_winner_elsewhere() {
+    use slamlab::merge::offline::merge_pair;
+    use slamlab::merge::refine::refuse_if_beaten;
+    let (a, b, truth) = east_west_pair();
+    let (wa, wb) = (WallMap::new(&a), WallMap::new(&b));
+    let cfg = OfflineConfig::default();
+    let automatic = merge_pair((0, &a, &wa), (1, &b, &wb), &cfg);
+    let guess = nudged(&truth, middle(&b), 0.1, DVec2::new(0.5, 0.5));
+    let mine = refined(&a, &b, guess);
+    assert_eq!(mine.status, MergeStatus::Merged, "{}", mine.reason);
+    let support = mine.evidence.unwrap().support_m;
+    // The same overlay found by both: nothing to refuse.
+    let mut same = mine.clone();
+    assert!(!refuse_if_beaten(&mut same, &automatic, (&a, &b), &cfg));
+    assert_eq!(same, mine);
+    // A different overlay (4 m away) with 1.4 times the support: a near
+    // tie, which the guess settles; with 1.6 times, a clear winner.
+    let elsewhere = |ratio: f64| {
+        let mut other = automatic.clone();
+        let p = other.pose.unwrap();
+        other.pose = Some(Pose2::new(p.x + 4.0, p.y, p.theta));
+        let mut e = other.evidence.unwrap();
+        e.support_m = ratio * support;
+        other.evidence = Some(e);
+        other
+    };
+    let mut near_tie = mine.clone();
+    assert!(!refuse_if_beaten(
+        &mut near_tie,
+        &elsewhere(1.4),
+        (&a, &b),
+        &cfg
+    ));
+    assert_eq!(near_tie.status, MergeStatus::Merged);
+    let mut beaten = mine.clone();
+    assert!(refuse_if_beaten(
+        &mut beaten,
+        &elsewhere(1.6),
+        (&a, &b),
+        &cfg
+    ));
+    assert_eq!(beaten.status, MergeStatus::NoMerge);
+    assert_eq!(beaten.confidence, 0.0);
+    println!("beaten: {}", beaten.reason);
+    assert!(
+        beaten.reason.starts_with("refined from your guess"),
+        "{}",
+        beaten.reason
+    );
+    assert!(
+        beaten.reason.contains("1.6 times as much"),
+        "{}",
+        beaten.reason
+    );
 }

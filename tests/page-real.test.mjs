@@ -16,6 +16,12 @@
 // closes a loop while it replays, and its map is downloaded. Last, one log
 // cut into two stretches (two robots) whose maps merge at the true
 // transform, and two logs of different worlds that do not merge.
+// closes a loop while it replays, and its map is downloaded. And Refine:
+// two full maps of a building that is the same turned by 180° (the
+// automatic merge declines them as ambiguous) are placed by hand with real
+// mouse events (a Shift-drag turns the map, a drag moves it; the arrow
+// keys and Q / E are checked too) roughly onto
+// the truth and refined to it; a map dragged onto a wrong place is refused.
 //
 // Needs the wasm build in web/pkg (`./build.sh build`). Run alone with
 //   node --test tests/page-real.test.mjs
@@ -25,7 +31,7 @@ import { mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { ARTIFACTS, newPage, useBrowser, waitReady } from './support/browser.mjs';
-import { centredFrame, floorPlan, mapImage, mapYaml } from './support/synthetic-maps.mjs';
+import { centredFrame, floorPlan, mapImage, mapYaml, symmetricPlan } from './support/synthetic-maps.mjs';
 import { ringLog } from './support/synthetic-log.mjs';
 
 const env = useBrowser();
@@ -249,6 +255,140 @@ test('your maps: opening and merging two 2000 x 2000 maps shows no long task ove
   assert.ok(Math.hypot(x - maps.truth[0], y - maps.truth[1]) < 0.1);
   await page.locator('#real-overlay').scrollIntoViewIfNeeded();
   await page.screenshot({ path: path.join(ARTIFACTS, 'page-real-large.png') });
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});
+
+/** `a ∘ b` for poses [x, y, theta]. */
+function compose([ax, ay, at], [bx, by, bt]) {
+  const c = Math.cos(at), s = Math.sin(at);
+  return [ax + c * bx - s * by, ay + s * bx + c * by, at + bt];
+}
+
+const wrap = (t) => Math.atan2(Math.sin(t), Math.cos(t));
+
+/** The page's point (CSS pixels) of `[x, y]` in map a's frame, while a map is placed by hand. */
+async function onScreen(page, [x, y]) {
+  const { view } = (await snapshot(page)).adjust;
+  const box = await page.locator('#real-overlay').boundingBox();
+  return [box.x + (view.k * x + view.e) / view.dpr, box.y + (view.f - view.k * y) / view.dpr];
+}
+
+/** A real mouse drag through `points` (page pixels), `steps` moves between each two. */
+async function drag(page, points, steps = 6) {
+  await page.mouse.move(...points[0]);
+  await page.mouse.down();
+  for (const p of points.slice(1)) await page.mouse.move(...p, { steps });
+  await page.mouse.up();
+}
+
+/** Turns the placed map by `d` rad with a Shift-drag round its ring mark, then moves its middle to `to`. */
+async function turnAndMove(page, d, to) {
+  const { pose, pivot } = (await snapshot(page)).adjust.placing;
+  const [cx, cy] = compose(pose, [...pivot, 0]);
+  const { view } = (await snapshot(page)).adjust;
+  const rw = (70 * view.dpr) / view.k; // 70 CSS pixels, in metres
+  const arc = [];
+  for (let i = 0; i <= 12; i++) {
+    const phi = Math.PI / 2 + (d * i) / 12;
+    arc.push(await onScreen(page, [cx + rw * Math.cos(phi), cy + rw * Math.sin(phi)]));
+  }
+  await page.keyboard.down('Shift');
+  await drag(page, arc, 3);
+  await page.keyboard.up('Shift');
+  const turned = (await snapshot(page)).adjust.placing;
+  const middle = compose(turned.pose, [...turned.pivot, 0]);
+  await drag(page, [await onScreen(page, middle), await onScreen(page, to)], 12);
+  await page.waitForFunction(() => !document.querySelector('#real-overlay').dataset.sending);
+  return (await snapshot(page)).adjust.placing.pose;
+}
+
+test('your maps: a merge declined as ambiguous is placed by hand, turned and dragged, and refined to the truth', { timeout: 300000 }, async () => {
+  const plan = symmetricPlan(40, 20, 5);
+  const frameA = [-0.5, -0.5, 0], frameB = centredFrame(20, 10, 0.9, 880, 880);
+  const file = (name, data) => {
+    const p = path.join(tmp, name);
+    writeFileSync(p, data);
+    return p;
+  };
+  const files = [
+    file('sym-a.yaml', mapYaml('sym-a.pgm')),
+    file('sym-a.pgm', mapImage(plan, frameA, 820, 420, () => true)),
+    file('sym-b.yaml', mapYaml('sym-b.pgm')),
+    file('sym-b.pgm', mapImage(plan, frameB, 880, 880, () => true)),
+  ];
+  const truth = [frameB[0] - frameA[0], frameB[1] - frameA[1], frameB[2]];
+  const { context, page, problems } = await newPage(env.browser, { width: 1280, height: 900 });
+  await openView(page);
+  await page.setInputFiles('#real-files', files);
+  await page.waitForFunction(() => window.slamlab.realMaps.snapshot().report, null, { timeout: 120000 });
+  const auto = (await snapshot(page)).report.merge;
+  assert.equal(auto.status, 'no_merge', auto.reason);
+  assert.match(auto.reason, /ambiguous/);
+  assert.match(await page.locator('#real-pair').innerText(), /sym-b\.yaml onto sym-a\.yaml \(no merge\)/);
+
+  await page.getByRole('button', { name: 'Place by hand' }).click();
+  await page.waitForFunction(() => window.slamlab.realMaps.snapshot().adjust.view);
+  assert.match(await page.locator('#real-adjust-help').innerText(), /Drag the map roughly onto the other, then press Refine/);
+  const start = (await snapshot(page)).adjust.placing;
+  assert.deepEqual(start.pose.map((v) => Number(v.toFixed(6))).slice(2), [0], 'the map starts unturned, beside the other');
+  // Keyboard users: the arrow keys move the map by 0.1 m, Q and E turn it by 1° about its middle.
+  await page.locator('#real-overlay').focus();
+  for (const key of ['ArrowRight', 'ArrowRight', 'ArrowRight', 'ArrowUp', 'q']) await page.keyboard.press(key);
+  const keyed = (await snapshot(page)).adjust.placing.pose;
+  assert.ok(Math.abs(keyed[2] - start.pose[2] - Math.PI / 180) < 1e-9, `Q turned to ${keyed[2]}`);
+  const keyedMiddle = compose(keyed, [...start.pivot, 0]), startMiddle = compose(start.pose, [...start.pivot, 0]);
+  assert.ok(Math.abs(keyedMiddle[0] - startMiddle[0] - 0.3) < 1e-9 && Math.abs(keyedMiddle[1] - startMiddle[1] - 0.1) < 1e-9, 'arrows moved the middle');
+  await page.keyboard.press('e');
+  assert.ok(Math.abs((await snapshot(page)).adjust.placing.pose[2] - start.pose[2]) < 1e-9, 'E turned it back');
+  // Roughly onto the truth: turned 6° too far, its middle 0.5 m off.
+  const target = compose(truth, [...start.pivot, 0]);
+  const placed = await turnAndMove(page, wrap(truth[2] + (6 * Math.PI) / 180 - start.pose[2]), [target[0] + 0.4, target[1] - 0.3]);
+  const offDeg = (wrap(placed[2] - truth[2]) * 180) / Math.PI;
+  const offM = Math.hypot(...compose(placed, [...start.pivot, 0]).slice(0, 2).map((v, i) => v - target[i]));
+  console.log(`placed by hand: ${offDeg.toFixed(1)} deg and ${offM.toFixed(2)} m from the truth`);
+  assert.ok(Math.abs(offDeg) > 3 && Math.abs(offDeg) < 9, `turned to ${offDeg} deg off`);
+  assert.ok(offM > 0.2 && offM < 1, `moved to ${offM} m off`);
+  await page.screenshot({ path: path.join(ARTIFACTS, 'page-real-placing.png') });
+
+  await page.getByRole('button', { name: 'Refine' }).click();
+  await page.waitForFunction(() => window.slamlab.realMaps.snapshot().adjust.pair && !window.slamlab.realMaps.snapshot().busy, null, { timeout: 120000 });
+  const snap = await snapshot(page);
+  assert.equal(snap.adjust.pair.status, 'merged', snap.adjust.pair.reason);
+  assert.equal(snap.report.merge.status, 'merged', snap.report.merge.reason);
+  const [x, y, th] = snap.report.merge.transforms[1].pose;
+  const dm = Math.hypot(x - truth[0], y - truth[1]), dd = (Math.abs(wrap(th - truth[2])) * 180) / Math.PI;
+  console.log(`refined: ${dm.toFixed(3)} m and ${dd.toFixed(3)} deg from the truth, in ${(snap.report.timings_ms.merge / 1000).toFixed(2)} s in the worker`);
+  assert.ok(dm < 0.1 && dd < 0.5, `off by ${dm} m, ${dd} deg`);
+  assert.match(await page.locator('#real-verdict').innerText(), /^Merged \(confidence \d\.\d\d\): refined from your guess \(within 2\.5 m and 20° of it\): the maps agree: .*near your guess$/);
+  assert.match(await page.locator('#real-refined').innerText(), /^Refine of sym-b\.yaml on sym-a\.yaml: merged/);
+  const row = await page.locator('#real-transforms tr').nth(2).locator('td').allInnerTexts();
+  assert.equal(row[0], 'sym-b.yaml');
+  assert.match(row[4], /^-?\d+\.\d{4} -?\d+\.\d{4} 0 0\.9\d{5} 0 0 sym_a sym_b$/);
+  assert.match(await page.locator('#real-pairs').innerText(), /sym-a\.yaml \+ sym-b\.yaml\s+merged/);
+  const pgm = await downloaded(page, 'pgm');
+  assert.match(pgm.bytes.subarray(0, 2).toString('latin1'), /^P5$/);
+  assert.equal(JSON.parse((await downloaded(page, 'json')).bytes.toString('utf8')).status, 'merged');
+  await page.locator('#real-adjust').scrollIntoViewIfNeeded();
+  await page.screenshot({ path: path.join(ARTIFACTS, 'page-real-refined.png') });
+
+  // Onto a wrong place: the map's middle dragged 6 m west and 4 m south of where it belongs.
+  await page.getByRole('button', { name: 'Place by hand' }).click();
+  await page.waitForFunction(() => window.slamlab.realMaps.snapshot().adjust.view && window.slamlab.realMaps.snapshot().adjust.placing);
+  const again = (await snapshot(page)).adjust.placing;
+  const middle = compose(again.pose, [...again.pivot, 0]);
+  await drag(page, [await onScreen(page, middle), await onScreen(page, [middle[0] - 6, middle[1] - 4])], 12);
+  await page.getByRole('button', { name: 'Refine' }).click();
+  await page.waitForFunction((n) => {
+    const s = window.slamlab.realMaps.snapshot();
+    return s.adjust.pair && s.adjust.pair.status !== 'merged' && !s.busy;
+  }, null, { timeout: 120000 });
+  const wrong = await snapshot(page);
+  assert.equal(wrong.report.merge.status, 'no_merge');
+  assert.match(wrong.adjust.pair.reason, /^refined from your guess \(within 2\.5 m and 20° of it\): .*\d/);
+  assert.match(await page.locator('#real-verdict').innerText(), /^No merge, because refined from your guess/);
+  await page.locator('#real-adjust').scrollIntoViewIfNeeded();
+  await page.screenshot({ path: path.join(ARTIFACTS, 'page-real-refused.png') });
   assert.deepEqual(problems, [], 'no console errors or page errors');
   await context.close();
 });

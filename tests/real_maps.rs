@@ -15,6 +15,10 @@ use std::path::{Path, PathBuf};
 #[path = "real_support/npy.rs"]
 mod npy;
 
+#[path = "merge_support/guess.rs"]
+mod guess;
+use guess::{middle, nudged, refined};
+
 fn data_dir() -> PathBuf {
     let dir = std::env::var_os("SLAMLAB_DATA")
         .map(PathBuf::from)
@@ -64,6 +68,19 @@ fn expect() -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
 }
 
+/// A laser pair of expect.json: its two maps and B's true frame in A's.
+fn laser_case(dir: &Path, case: &serde_json::Value) -> (RosMap, RosMap, Pose2) {
+    let a = load(&dir.join(case["a"].as_str().unwrap()));
+    let b = load(&dir.join(case["b"].as_str().unwrap()));
+    let t: Vec<f64> = case["pose_b_in_a"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    (a, b, Pose2::new(t[0], t[1], t[2]))
+}
+
 #[test]
 fn laser_pairs_merge_within_tolerance() {
     let dir = data_dir().join("maps/laser-pairs");
@@ -71,15 +88,7 @@ fn laser_pairs_merge_within_tolerance() {
     let mut failures = Vec::new();
     println!("| pair | verdict | error (m) | error (deg) | agree (m) | index | support (m) | rival (m) |");
     for (name, case) in cases.as_object().unwrap() {
-        let a = load(&dir.join(case["a"].as_str().unwrap()));
-        let b = load(&dir.join(case["b"].as_str().unwrap()));
-        let t: Vec<f64> = case["pose_b_in_a"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|v| v.as_f64().unwrap())
-            .collect();
-        let truth = Pose2::new(t[0], t[1], t[2]);
+        let (a, b, truth) = laser_case(&dir, case);
         let r = pair(&a, &b);
         let e = r.evidence.unwrap_or_default();
         let (dm, dd) = r.pose.map_or((f64::NAN, f64::NAN), |p| error(&p, &truth));
@@ -342,4 +351,62 @@ fn halmstad_office_pairs() {
             );
         }
     }
+}
+
+#[test]
+fn refine_from_a_rough_guess_on_laser_pairs() {
+    let dir = data_dir().join("maps/laser-pairs");
+    let mut failures = Vec::new();
+    println!("| pair | verdict | error (m) | error (deg) | agree (m) | index | support (m) | rival (m) |");
+    for (name, case) in expect().as_object().unwrap() {
+        let (a, b, truth) = laser_case(&dir, case);
+        // 1 m and 8° off, about B's middle.
+        let guess = nudged(&truth, middle(&b), 8f64.to_radians(), DVec2::new(0.8, -0.6));
+        let r = refined(&a, &b, guess);
+        let e = r.evidence.unwrap_or_default();
+        let (dm, dd) = r.pose.map_or((f64::NAN, f64::NAN), |p| error(&p, &truth));
+        println!(
+            "| {name} | {:?} | {dm:.3} | {dd:.2} | {:.1} | {:.2} | {:.1} | {:.1} |",
+            r.status, e.agree_m, e.index, e.support_m, r.rival_support_m
+        );
+        if r.status != MergeStatus::Merged || dm > 0.15 || dd > 1.0 {
+            failures.push(format!(
+                "{name}: {:?} off by {dm:.3} m {dd:.2} deg: {}",
+                r.status, r.reason
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+fn refine_refuses_cross_building_guesses() {
+    let dir = data_dir().join("maps/laser-pairs");
+    let buildings = ["intel", "aces", "csail", "freiburg-079"];
+    let mut wrong = Vec::new();
+    for (i, ba) in buildings.iter().enumerate() {
+        let bb = buildings[(i + 1) % buildings.len()];
+        let a = load(&dir.join(format!("{ba}-half-a.yaml")));
+        let b = load(&dir.join(format!("{bb}-half-b.yaml")));
+        // B's middle on A's middle, at four headings.
+        for k in 0..4 {
+            let theta = k as f64 * std::f64::consts::FRAC_PI_2;
+            let turned = Pose2::new(0.0, 0.0, theta).transform_point(middle(&b));
+            let at = middle(&a) - turned;
+            let r = refined(&a, &b, Pose2::new(at.x, at.y, theta));
+            println!(
+                "{ba}-half-a + {bb}-half-b at {}°: {:?}: {}",
+                90 * k,
+                r.status,
+                r.reason
+            );
+            if r.status == MergeStatus::Merged {
+                wrong.push(format!("{ba} + {bb} at {}°", 90 * k));
+            }
+        }
+    }
+    assert!(
+        wrong.is_empty(),
+        "different buildings merged by refine: {wrong:?}"
+    );
 }

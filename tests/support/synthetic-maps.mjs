@@ -109,3 +109,15 @@ export function centredFrame(cx, cy, theta, nx, ny, res = 0.05) {
   const hx = (nx * res) / 2, hy = (ny * res) / 2, c = Math.cos(theta), s = Math.sin(theta);
   return [cx - (c * hx - s * hy), cy - (s * hx + c * hy), theta];
 }
+
+/**
+ * A `w` x `h` m floor plan that is the same turned by 180°: a `w / 2` wide
+ * plan (floorPlan) and its copy turned about the middle of the rectangle.
+ * Two full maps of it fit each other as well either way round, so the
+ * automatic merge declines them as ambiguous.
+ */
+export function symmetricPlan(w, h, seed) {
+  const half = floorPlan(w / 2, h, seed);
+  const turn = ([x, y]) => [w - x, h - y];
+  return { w, h, walls: [...half.walls, ...half.walls.map(([p, q]) => [turn(p), turn(q)])] };
+}

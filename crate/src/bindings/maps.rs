@@ -8,7 +8,10 @@
 //! file and the field.
 
 use super::convert::js_err as err;
-use crate::merge::offline::{merge_all, OfflineConfig, OfflineMerge};
+use crate::geom::Pose2;
+use crate::merge::offline::{merge_all, OfflineConfig, OfflineMerge, PairResult};
+use crate::merge::refine::{refine_pair, refuse_if_beaten};
+use crate::merge::wallmap::WallMap;
 use crate::rosmap::{self, write::MergedMap, MapYaml, RosMap};
 use wasm_bindgen::prelude::*;
 
@@ -18,6 +21,8 @@ use wasm_bindgen::prelude::*;
 pub struct MapMerge {
     maps: Vec<RosMap>,
     result: Option<OfflineMerge>,
+    /// The automatic merge's pairs, kept for Refine's check.
+    automatic: Vec<PairResult>,
     merged: Option<MergedMap>,
 }
 
@@ -115,6 +120,7 @@ impl MapMerge {
         }
         let result = merge_all(&self.maps, &OfflineConfig::default(), progress);
         let report = result.report(&self.maps).to_string();
+        self.automatic = result.pairs.clone();
         self.result = Some(result);
         self.merged = None;
         Ok(report)
@@ -137,6 +143,77 @@ impl MapMerge {
         self.merged
             .as_ref()
             .ok_or_else(|| JsError::new("no merged map"))
+    }
+
+    /// Aligns maps `a` and `b` again from a person's rough overlay: map
+    /// `b`'s frame at `(x, y, theta)` (metres, radians) in map `a`'s frame,
+    /// as the report's transforms. The result replaces that pair's verdict
+    /// and the maps are joined again, so the report (`reportJson`) and the
+    /// merged map follow it. Returns the pair's result as JSON, in the
+    /// report's `pairs[]` format (with `guess`). The pair is refined in the
+    /// order the merge judged it, so for `a > b` it comes back as `b`, `a`
+    /// with the guess inverted. A refined overlay is refused when the
+    /// automatic merge found a different one with 1.5 times its support.
+    pub fn refine(
+        &mut self,
+        a: u32,
+        b: u32,
+        x: f64,
+        y: f64,
+        theta: f64,
+    ) -> Result<String, JsError> {
+        let (a, b) = (a as usize, b as usize);
+        let n = self.maps.len();
+        if a >= n || b >= n || a == b {
+            return Err(JsError::new(&format!(
+                "refine: maps {a} and {b} are not a pair of the {n} maps opened"
+            )));
+        }
+        let mut guess = Pose2::new(x, y, theta);
+        if !guess.is_finite() {
+            return Err(JsError::new(&format!(
+                "refine: the guess must be finite numbers, got x = {x}, y = {y}, theta = {theta}"
+            )));
+        }
+        let result = self
+            .result
+            .as_mut()
+            .ok_or_else(|| JsError::new("refine: merge first"))?;
+        // Refined in the order the merge judged the pair.
+        let automatic = self
+            .automatic
+            .iter()
+            .find(|p| (p.a, p.b) == (a, b) || (p.a, p.b) == (b, a))
+            .ok_or_else(|| JsError::new("refine: that pair was not judged"))?;
+        let (a, b) = if automatic.a == a {
+            (a, b)
+        } else {
+            guess = guess.inverse();
+            (b, a)
+        };
+        let cfg = OfflineConfig::default();
+        let (ma, mb) = (&self.maps[a], &self.maps[b]);
+        let (wa, wb) = (WallMap::new(ma), WallMap::new(mb));
+        let mut pair = refine_pair((a, ma, &wa), (b, mb, &wb), guess, &cfg)
+            .map_err(|e| JsError::new(&format!("refine: {e}")))?;
+        refuse_if_beaten(&mut pair, automatic, (ma, mb), &cfg);
+        let k = result
+            .replace_pair(&self.maps, pair)
+            .ok_or_else(|| JsError::new("refine: that pair was not judged"))?;
+        self.merged = None;
+        let report = result.report(&self.maps);
+        Ok(report["merge"]["pairs"][k].to_string())
+    }
+
+    /// The report's `maps` and `merge` as JSON, as `merge` returned it,
+    /// after any `refine`.
+    #[wasm_bindgen(js_name = reportJson)]
+    pub fn report_json(&self) -> Result<String, JsError> {
+        let r = self
+            .result
+            .as_ref()
+            .ok_or_else(|| JsError::new("merge first"))?;
+        Ok(r.report(&self.maps).to_string())
     }
 
     /// The merged map (the maps joined to the first) as a binary PGM.

@@ -42,7 +42,8 @@
 //!
 //! Saved maps without robots (ROS `map_server` files, [`crate::rosmap`])
 //! are merged offline by [`offline`], with its own search
-//! ([`offline_search`]) and verdict ([`evidence`]) made for real maps.
+//! ([`offline_search`]) and verdict ([`evidence`]) made for real maps;
+//! [`refine`] aligns a pair again from a person's rough overlay.
 //!
 //! Ground truth is never read here: the session layer (`crate::lab`) scores
 //! the result.
@@ -63,6 +64,7 @@ pub mod mapsearch;
 pub mod method;
 pub mod offline;
 pub mod offline_search;
+pub mod refine;
 pub mod rigid;
 pub mod selection;
 pub mod thesis;

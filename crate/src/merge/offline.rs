@@ -12,6 +12,7 @@
 //! | search | [`super::offline_search`] | rotations from Hough spectra, coarse correlation, refinement |
 //! | judge | [`super::evidence`] | agreement within a tolerance band, acceptance index, margin |
 //! | join | [`super::graph`] | with three or more maps, the most confident spanning tree |
+//! | refine | [`super::refine`] | a pair again, from a person's rough overlay (the page's Refine) |
 //! | write | [`crate::rosmap::write`] | the merged map as PGM + PNG + YAML |
 //!
 //! Each pair of maps is searched and judged on its own; a pair is an edge
@@ -28,7 +29,7 @@
 
 use super::evidence::{distinct, evidence, judge, Evidence, EvidenceConfig};
 use super::graph::{spanning_tree, PairEdge};
-use super::offline_search::{propose, SearchConfig};
+use super::offline_search::{propose, RefineConfig, SearchConfig};
 use super::wallmap::WallMap;
 use super::MergeStatus;
 use crate::geom::Pose2;
@@ -41,6 +42,8 @@ use serde_json::json;
 pub struct OfflineConfig {
     pub search: SearchConfig,
     pub evidence: EvidenceConfig,
+    /// The search around a person's guess ([`super::refine`]).
+    pub refine: RefineConfig,
 }
 
 /// The verdict on one pair of maps.
@@ -59,6 +62,58 @@ pub struct PairResult {
     pub rival_support_m: f64,
     /// Overlays refined and judged.
     pub overlays: usize,
+    /// The person's guess this pair was refined from (B's map frame in
+    /// A's), `None` for the automatic merge.
+    pub guess: Option<Pose2>,
+}
+
+impl PairResult {
+    /// A pair not judged yet: `no_merge`, no reason, nothing found.
+    pub fn unjudged(a: usize, b: usize) -> PairResult {
+        PairResult {
+            a,
+            b,
+            status: MergeStatus::NoMerge,
+            reason: String::new(),
+            confidence: 0.0,
+            pose: None,
+            evidence: None,
+            rival_support_m: 0.0,
+            overlays: 0,
+            guess: None,
+        }
+    }
+}
+
+/// The reason of an accepted overlay in words with numbers; `others` says
+/// which overlays the rival was taken among ("any other overlay …").
+pub fn agreement_reason(
+    e: &Evidence,
+    rival_support_m: f64,
+    cfg: &OfflineConfig,
+    others: &str,
+) -> String {
+    let ratio = if rival_support_m > 0.0 {
+        e.support_m / rival_support_m
+    } else {
+        f64::INFINITY
+    };
+    let others = if others.is_empty() {
+        String::new()
+    } else {
+        format!(" {others}")
+    };
+    format!(
+        "the maps agree: {:.1} m of wall of each on the other's within {:.2} m, acceptance index {:.2} ({} points agree, {} in the band, {} in free space), {:.1} m of net support, {:.1} times that of any other overlay{others}",
+        e.agree_m,
+        cfg.evidence.agree_m,
+        e.index,
+        e.agree[0] + e.agree[1],
+        e.band[0] + e.band[1],
+        e.disagree[0] + e.disagree[1],
+        e.support_m,
+        ratio
+    )
 }
 
 /// The merge of all maps.
@@ -79,17 +134,7 @@ pub fn merge_pair(
     (ib, b, wb): (usize, &RosMap, &WallMap),
     cfg: &OfflineConfig,
 ) -> PairResult {
-    let mut out = PairResult {
-        a: ia,
-        b: ib,
-        status: MergeStatus::NoMerge,
-        reason: String::new(),
-        confidence: 0.0,
-        pose: None,
-        evidence: None,
-        rival_support_m: 0.0,
-        overlays: 0,
-    };
+    let mut out = PairResult::unjudged(ia, ib);
     if wa.walls.len() < 10 || wb.walls.len() < 10 {
         out.reason = "a map has (almost) no walls to align".into();
         return out;
@@ -100,7 +145,24 @@ pub fn merge_pair(
         .iter()
         .map(|p| (p.pose, evidence(wa, wb, &p.pose, &cfg.evidence)))
         .collect();
-    // The overlay with the most net support (ties: the better search score).
+    if !judge_overlays(&mut out, (a, b, wb), &judged, cfg, "") {
+        out.reason = "no overlay of the walls scores above zero".into();
+    }
+    out
+}
+
+/// Judges the overlay of `judged` (B's image frame in A's, with its
+/// evidence) with the most net support (ties: the earlier) against the best
+/// different one of them, and writes the verdict, the pose (B's map frame in
+/// A's), the evidence and the rival into `out`; `others` says where the
+/// rivals were found, for the reason. `false` when `judged` is empty.
+pub fn judge_overlays(
+    out: &mut PairResult,
+    (a, b, wb): (&RosMap, &RosMap, &WallMap),
+    judged: &[(Pose2, Evidence)],
+    cfg: &OfflineConfig,
+    others: &str,
+) -> bool {
     let Some(w) = (0..judged.len()).reduce(|best, i| {
         if judged[i].1.support_m > judged[best].1.support_m {
             i
@@ -108,8 +170,7 @@ pub fn merge_pair(
             best
         }
     }) else {
-        out.reason = "no overlay of the walls scores above zero".into();
-        return out;
+        return false;
     };
     let (wpose, e) = judged[w];
     let centre = wb.walls.iter().copied().sum::<DVec2>() / wb.walls.len() as f64;
@@ -124,21 +185,11 @@ pub fn merge_pair(
         Ok(confidence) => {
             out.status = MergeStatus::Merged;
             out.confidence = confidence;
-            out.reason = format!(
-                "the maps agree: {:.1} m of wall of each on the other's within {:.2} m, acceptance index {:.2} ({} points agree, {} in the band, {} in free space), {:.1} m of net support, {:.1} times that of any other overlay",
-                e.agree_m,
-                cfg.evidence.agree_m,
-                e.index,
-                e.agree[0] + e.agree[1],
-                e.band[0] + e.band[1],
-                e.disagree[0] + e.disagree[1],
-                e.support_m,
-                if out.rival_support_m > 0.0 { e.support_m / out.rival_support_m } else { f64::INFINITY }
-            );
+            out.reason = agreement_reason(&e, out.rival_support_m, cfg, others);
         }
         Err(reason) => out.reason = reason,
     }
-    out
+    true
 }
 
 /// Merges all `maps` (see the module doc). `progress` hears a line per
@@ -171,6 +222,12 @@ pub fn merge_all(
             pairs.push(r);
         }
     }
+    join(maps, pairs)
+}
+
+/// Joins `maps` along the most confident spanning tree of the merged
+/// `pairs` (see the module doc) and words the verdict.
+pub fn join(maps: &[RosMap], pairs: Vec<PairResult>) -> OfflineMerge {
     let edges: Vec<PairEdge> = pairs
         .iter()
         .filter(|p| p.status == MergeStatus::Merged)
@@ -238,6 +295,21 @@ pub fn merge_all(
     }
 }
 
+impl OfflineMerge {
+    /// Puts `pair` in place of the result on the same two maps (either
+    /// order) and joins the maps again; returns its index in `pairs`,
+    /// `None` when no such pair was judged.
+    pub fn replace_pair(&mut self, maps: &[RosMap], pair: PairResult) -> Option<usize> {
+        let same =
+            |p: &PairResult| (p.a, p.b) == (pair.a, pair.b) || (p.a, p.b) == (pair.b, pair.a);
+        let k = self.pairs.iter().position(same)?;
+        let mut pairs = std::mem::take(&mut self.pairs);
+        pairs[k] = pair;
+        *self = join(maps, pairs);
+        Some(k)
+    }
+}
+
 fn pose_json(p: &Pose2) -> serde_json::Value {
     json!([p.x, p.y, p.theta])
 }
@@ -264,7 +336,7 @@ impl OfflineMerge {
             .pairs
             .iter()
             .map(|p| {
-                json!({
+                let mut pair = json!({
                     "a": name(p.a),
                     "b": name(p.b),
                     "status": status_name(p.status),
@@ -274,7 +346,11 @@ impl OfflineMerge {
                     "evidence": p.evidence,
                     "rival_support_m": p.rival_support_m,
                     "overlays": p.overlays,
-                })
+                });
+                if let Some(g) = p.guess {
+                    pair["guess"] = pose_json(&g);
+                }
+                pair
             })
             .collect();
         json!({

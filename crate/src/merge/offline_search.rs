@@ -81,6 +81,50 @@ impl Default for SearchConfig {
     }
 }
 
+/// Settings of the search around a person's guess ([`super::refine`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RefineConfig {
+    /// Half the translation window, in cells of the coarser map. Default 50.
+    pub window_cells: f64,
+    /// The translation window is never smaller than this, m. Default 2.5.
+    pub min_window_m: f64,
+    /// Half the rotation window, degrees. Default 20.
+    pub window_deg: f64,
+    /// Translation step of the coarse search, cells. Default 4.
+    pub step_cells: f64,
+    /// Rotation step of the coarse search, degrees. Default 1.
+    pub step_deg: f64,
+    /// Distinct coarse overlays refined. Default 6.
+    pub peaks: usize,
+    /// B's wall points scored in the coarse search (evenly thinned).
+    /// Default 1500.
+    pub points: usize,
+}
+
+impl Default for RefineConfig {
+    fn default() -> Self {
+        RefineConfig {
+            window_cells: 50.0,
+            min_window_m: 2.5,
+            window_deg: 20.0,
+            step_cells: 4.0,
+            step_deg: 1.0,
+            peaks: 6,
+            points: 1500,
+        }
+    }
+}
+
+impl RefineConfig {
+    /// The translation window's half width and the step (m) for maps of
+    /// resolutions `ra` and `rb`: both scale with the coarser map.
+    pub fn window_m(&self, ra: f64, rb: f64) -> (f64, f64) {
+        let res = ra.max(rb);
+        let half = (self.window_cells * res).max(self.min_window_m);
+        (half, half * self.step_cells / self.window_cells)
+    }
+}
+
 /// One proposed overlay: B's image frame in A's.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Proposal {
@@ -97,7 +141,7 @@ const ANGLES: usize = 720;
 /// At most this many points go into a spectrum (evenly thinned).
 const SPECTRUM_POINTS: usize = 20_000;
 
-fn thinned(points: &[DVec2], most: usize) -> Vec<DVec2> {
+pub fn thinned(points: &[DVec2], most: usize) -> Vec<DVec2> {
     let stride = points.len().div_ceil(most.max(1)).max(1);
     points.iter().step_by(stride).copied().collect()
 }

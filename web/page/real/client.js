@@ -63,6 +63,21 @@ export class MergeClient extends WorkerClient {
     return this.request({ type: 'merge' });
   }
 
+  /** Shows map `b` (index) with its frame at `pose` in map `a`'s; `fit` fits the view anew: `{view}`. */
+  adjust(a, b, pose, fit = false) {
+    return this.request({ type: 'adjust', a, b, pose, fit });
+  }
+
+  /** Back to the merge's overlay: `{view}`. */
+  endAdjust() {
+    return this.request({ type: 'endAdjust' });
+  }
+
+  /** Aligns map `b` on map `a` from `pose`: `{pair, report, files}`. */
+  refine(a, b, pose) {
+    return this.request({ type: 'refine', a, b, pose });
+  }
+
   /** Forgets every map. */
   clear() {
     return this.worker ? this.request({ type: 'clear' }) : Promise.resolve();

@@ -28,16 +28,17 @@ export function mergeHtml(p, { stage, tip = '', ...words }) {
 /**
  * The result's HTML: `p` the id prefix; `words`: `{frames}` (the
  * transforms table's caption), `{title}` (the overlay's heading),
- * `{overlay}` (the canvas's label).
+ * `{overlay}` (the canvas's label), `{extra}` (HTML put between the tables
+ * and the overlay, e.g. "Place a map by hand").
  */
-export function resultHtml(p, { frames, title, overlay }) {
+export function resultHtml(p, { frames, title, overlay, extra = '' }) {
   return `
   <div id="${p}-result" class="real-result" hidden>
     <p id="${p}-verdict" class="real-verdict"></p>
     <table id="${p}-transforms" class="summary-table"><caption>${frames}</caption></table>
-    <table id="${p}-pairs" class="summary-table"><caption>Each pair's own verdict</caption></table>
+    <table id="${p}-pairs" class="summary-table"><caption>Each pair's own verdict</caption></table>${extra}
     <div class="real-overlay-head">
-      <h2>${title}</h2>
+      <h2 id="${p}-overlay-title">${title}</h2>
       <label for="${p}-alpha">Opacity</label>
       <input id="${p}-alpha" type="range" min="15" max="100" value="85" aria-label="Opacity of the maps in the overlay">
     </div>
@@ -112,8 +113,8 @@ export class OverlayCanvas {
     return this.root.querySelector(`#${this.p}-overlay`);
   }
 
-  /** Asks the worker to draw; `onError(e)` if it fails. */
-  draw(onError = () => {}) {
+  /** Asks the worker to draw; `onError(e)` if it fails, `onDrawn(answer)` when drawn. */
+  draw(onError = () => {}, onDrawn = () => {}) {
     if (this.drawing) {
       this.again = true;
       return;
@@ -129,12 +130,13 @@ export class OverlayCanvas {
     this.drawing = true;
     this.client
       .request({ type: this.types.draw, ...size })
+      .then(onDrawn)
       .catch(onError)
       .finally(() => {
         this.drawing = false;
         if (this.again) {
           this.again = false;
-          this.draw(onError);
+          this.draw(onError, onDrawn);
         }
       });
   }

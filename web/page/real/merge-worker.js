@@ -10,13 +10,19 @@
 // canvas, which the page hands over once. Messages in:
 // `{id, type: 'add', files, resolution, colours}`, `{id, type: 'merge'}`,
 // `{id, type: 'canvas', canvas}`, `{id, type: 'draw', width, height, dpr,
-// alpha}`, `{id, type: 'clear'}`; out: `{id, ok, ...}` or
-// `{id, ok: false, error}`, and `{type: 'progress', text}` while merging.
+// alpha}`, `{id, type: 'clear'}`, and for placing a map by hand (the
+// page's Refine, adjust.js): `{id, type: 'adjust', a, b, pose, fit}` (map
+// b's frame at `pose` in map a's: shown, the view kept still unless
+// `fit`), `{id, type: 'refine', a, b, pose}` (aligns from there, answers
+// `{pair, report, files}` as a merge does), `{id, type: 'endAdjust'}`;
+// out: `{id, ok, ...}` or `{id, ok: false, error}`, and
+// `{type: 'progress', text}` while merging. Draws answer with the view
+// used (`{view: {k, e, f, width, height, dpr}}`).
 
 import init, * as wasm from '../../pkg/slamlab.js';
 import { groupFiles } from './files.js';
 import { previewOf } from './preview.js';
-import { drawPlaced } from './overlay.js';
+import { compose, drawPlaced, fitView } from './overlay.js';
 
 const ready = init();
 let merger = null;
@@ -25,6 +31,10 @@ let colourIndex = 0;
 let pictures = new Map();
 let placed = [];
 let overlay = null;
+/** While a map is placed by hand: `{a, b, pose}` (indices) and the still view. */
+let adjusting = null;
+let view = null;
+let lastSize = null;
 
 function message(e) {
   return e instanceof Error ? e.message : String(e);
@@ -47,7 +57,7 @@ async function add({ files, resolution, colours }) {
     const info = JSON.parse(merger.mapInfoJson(index));
     const colour = colours[colourIndex++ % colours.length];
     const { thumb, ...preview } = await previewOf(merger.mapPixels(index), info.width, info.height, colour);
-    pictures.set(info.name, { ...info, preview });
+    pictures.set(info.name, { ...info, index, preview });
     transfer.push(thumb);
     added.push({ ...info, index, imageName: m.imageName, colour, thumb });
   }
@@ -58,6 +68,24 @@ async function add({ files, resolution, colours }) {
 function merge(id) {
   const t0 = performance.now();
   const report = JSON.parse(merger.mergeWithProgress((text) => postMessage({ type: 'progress', id, text })));
+  adjusting = null; // a new merge ends any placing by hand
+  view = null;
+  return withFiles(report, t0);
+}
+
+/** Aligns map b on map a again from the page's guess; the report follows it. */
+function refine({ a, b, pose }) {
+  const t0 = performance.now();
+  const pair = JSON.parse(merger.refine(a, b, pose[0], pose[1], pose[2]));
+  const out = withFiles(JSON.parse(merger.reportJson()), t0);
+  adjusting = null;
+  view = null;
+  out.result.pair = pair;
+  return out;
+}
+
+/** The report with the merged map's files (when merged) and the overlay's placing. */
+function withFiles(report, t0) {
   const t1 = performance.now();
   let files = null;
   const transfer = [];
@@ -86,15 +114,27 @@ self.onmessage = async ({ data }) => {
     } else if (type === 'canvas') {
       overlay = data.canvas;
       out = { result: {}, transfer: [] };
+    } else if (type === 'refine') {
+      if (!merger) throw new Error('open two or more maps first');
+      out = refine(data);
     } else if (type === 'draw') {
-      if (overlay) drawPlaced(overlay, data, placed);
-      out = { result: {}, transfer: [] };
+      out = { result: { view: draw(data) }, transfer: [] };
+    } else if (type === 'adjust') {
+      if (data.fit || !adjusting) view = null;
+      adjusting = { a: data.a, b: data.b, pose: data.pose };
+      out = { result: { view: draw(lastSize) }, transfer: [] };
+    } else if (type === 'endAdjust') {
+      adjusting = null;
+      view = null;
+      out = { result: { view: draw(lastSize) }, transfer: [] };
     } else if (type === 'clear') {
       merger?.free();
       merger = null;
       colourIndex = 0;
       pictures = new Map();
       placed = [];
+      adjusting = null;
+      view = null;
       out = { result: {}, transfer: [] };
     } else throw new Error(`unknown request '${type}'`);
     postMessage({ id, ok: true, ...out.result }, out.transfer);
@@ -102,3 +142,38 @@ self.onmessage = async ({ data }) => {
     postMessage({ id, ok: false, error: message(e) });
   }
 };
+
+/** The picture of map number `i`. */
+function pictureOf(i) {
+  for (const p of pictures.values()) if (p.index === i) return p;
+  throw new Error(`no map number ${i}`);
+}
+
+/**
+ * Draws the overlay at `size` (the page's canvas size and opacity): the
+ * merge's placing, or while a map is placed by hand map a and map b at the
+ * guess, in a view kept still (fitted once, with room around), and a mark
+ * at b's middle, where it turns. Returns the view.
+ */
+function draw(size) {
+  if (!overlay || !size) return null;
+  lastSize = { width: size.width, height: size.height, dpr: size.dpr, alpha: size.alpha };
+  if (!adjusting) return drawPlaced(overlay, lastSize, placed);
+  const a = pictureOf(adjusting.a), b = pictureOf(adjusting.b);
+  const shown = [{ map: a, pose: [0, 0, 0] }, { map: b, pose: adjusting.pose }];
+  view = drawPlaced(overlay, lastSize, shown, view ?? fitView(shown, lastSize, 0.15));
+  const [x, y] = compose(compose(adjusting.pose, b.origin), [(b.width * b.resolution) / 2, (b.height * b.resolution) / 2, 0]);
+  const ctx = overlay.getContext('2d');
+  const px = view.k * x + view.e, py = view.f - view.k * y, r = 9 * size.dpr;
+  ctx.setTransform(1, 0, 0, 1, 0, 0);
+  ctx.strokeStyle = '#111';
+  ctx.lineWidth = 2 * size.dpr;
+  ctx.beginPath();
+  ctx.arc(px, py, r, 0, 2 * Math.PI);
+  ctx.moveTo(px - 1.6 * r, py);
+  ctx.lineTo(px + 1.6 * r, py);
+  ctx.moveTo(px, py - 1.6 * r);
+  ctx.lineTo(px, py + 1.6 * r);
+  ctx.stroke();
+  return view;
+}

@@ -12,7 +12,7 @@
 // pixels, y up). The maps are multiplied onto white, so walls of two maps
 // that agree show dark and a wall only one map has keeps its colour.
 
-import { clearCanvas, fitBox } from './fit.js';
+import { clearCanvas } from './fit.js';
 
 /** `a ∘ b` for poses [x, y, theta]. */
 export function compose([ax, ay, at], [bx, by, bt]) {
@@ -70,26 +70,43 @@ function scaleBar(ctx, k, height, dpr) {
 }
 
 /**
- * Draws `placed` ([{map, pose}]: maps with their map frame's pose in one
- * common frame) fitted into `canvas` (an OffscreenCanvas of the merge
- * worker, `width` x `height` device pixels, `dpr` of them a CSS pixel);
- * `alpha` the maps' opacity.
+ * The view that fits `placed` into a `width` x `height` canvas: metres to
+ * device pixels, `px = k x + e`, `py = f − k y` (y up). `spare` widens the
+ * box on every side by that share of its size (room to drag a map around).
  */
-export function drawPlaced(canvas, { width, height, dpr, alpha }, placed) {
-  const ctx = clearCanvas(canvas, width, height, '#fff');
-  if (!placed.length) return;
+export function fitView(placed, { width, height, dpr }, spare = 0) {
   let [x0, x1, y0, y1] = [Infinity, -Infinity, Infinity, -Infinity];
   for (const { map, pose } of placed) {
     for (const [x, y] of outline(map, pose)) {
       [x0, x1, y0, y1] = [Math.min(x0, x), Math.max(x1, x), Math.min(y0, y), Math.max(y1, y)];
     }
   }
-  const k = fitBox(ctx, [x0, y0, x1, y1], [0, 0, width, height], 8 * dpr);
+  const mx = spare * (x1 - x0), my = spare * (y1 - y0);
+  [x0, x1, y0, y1] = [x0 - mx, x1 + mx, y0 - my, y1 + my];
+  const pad = 8 * dpr;
+  const k = Math.min((width - 2 * pad) / (x1 - x0 || 1), (height - 2 * pad) / (y1 - y0 || 1));
+  const ox = (width - k * (x1 - x0)) / 2, oy = (height - k * (y1 - y0)) / 2;
+  return { k, e: ox - k * x0, f: oy + k * y1, width, height, dpr };
+}
+
+/**
+ * Draws `placed` ([{map, pose}]: maps with their map frame's pose in one
+ * common frame) into `canvas` (an OffscreenCanvas of the merge worker,
+ * `width` x `height` device pixels, `dpr` of them a CSS pixel); `alpha`
+ * the maps' opacity. `view` (from `fitView`) keeps the view still while a
+ * map is dragged; without it the maps are fitted in. Returns the view used.
+ */
+export function drawPlaced(canvas, { width, height, dpr, alpha }, placed, view = null) {
+  const ctx = clearCanvas(canvas, width, height, '#fff');
+  if (!placed.length) return null;
+  const v = view && view.width === width && view.height === height ? view : fitView(placed, { width, height, dpr });
+  ctx.setTransform(v.k, 0, 0, -v.k, v.e, v.f);
   ctx.globalAlpha = alpha;
   // Multiplied colours: where two maps' walls fall on each other they show dark.
   ctx.globalCompositeOperation = 'multiply';
   for (const { map, pose } of placed) drawMap(ctx, map, pose);
   ctx.globalCompositeOperation = 'source-over';
   ctx.globalAlpha = 1;
-  scaleBar(ctx, k, height, dpr);
+  scaleBar(ctx, v.k, height, dpr);
+  return v;
 }

@@ -7,10 +7,12 @@
 // confidence, each map's transform (metres, degrees, and the arguments of
 // ROS's static_transform_publisher) and each pair's verdict, sees the
 // joined maps overlaid in their colours, and downloads the merged map (PGM
-// + YAML + PNG) and the transforms (JSON). The reading, drawing and merging
+// + YAML + PNG) and the transforms (JSON); a pair the merge declined can be
+// placed by hand and refined (adjust.js). The reading, drawing and merging
 // run in a Web Worker (merge-worker.js), so the page stays responsive; the
 // lab's own scenario and runs behind this view are never touched.
 
+import { ADJUST_HTML, PlaceByHand } from './adjust.js';
 import { MergeClient } from './client.js';
 import { OverlayCanvas, mergeHtml, saveMerge, showMerge, swatch } from './merge-result.js';
 
@@ -42,6 +44,7 @@ const HTML = `
     frames: "Each map's frame in the first map's frame",
     title: 'Merged overlay',
     overlay: 'The joined maps overlaid in their colours',
+    extra: ADJUST_HTML,
   })}`;
 
 export class RealMaps {
@@ -61,12 +64,25 @@ export class RealMaps {
     this.queue = Promise.resolve();
     this.client = new MergeClient((text) => this.progress(text));
     this.overlay = new OverlayCanvas(root, 'real', this.client);
+    this.adjust = new PlaceByHand(root, this.client, {
+      maps: () => this.maps,
+      report: () => this.report,
+      refined: (out) => {
+        this.report = out.report;
+        this.files = out.files;
+        this.showResult();
+      },
+      say: (text, kind) => this.say(text, kind),
+      busy: (on, text) => this.setBusy(on, text),
+      changed: () => this.legend(),
+    });
   }
 
   /** Builds the view and connects its controls. */
   wire() {
     const root = this.root;
     root.innerHTML = HTML;
+    this.adjust.wire();
     const q = (s) => root.querySelector(s);
     this.opener.addEventListener('click', () => this.toggle(true));
     q('.real-close').addEventListener('click', () => this.toggle(false));
@@ -156,6 +172,7 @@ export class RealMaps {
       this.say('Open two or more maps to merge them.', 'warn');
       return;
     }
+    if (this.adjust.active) await this.adjust.stop();
     const n = this.maps.length;
     const t0 = performance.now();
     // Nothing ticks or animates while it runs: the page's main thread stays
@@ -200,6 +217,7 @@ export class RealMaps {
   }
 
   dropResult() {
+    this.adjust.active = null;
     this.report = null;
     this.files = null;
     this.root.querySelector('#real-result').hidden = true;
@@ -218,6 +236,7 @@ export class RealMaps {
 
   showResult() {
     showMerge(this.root, 'real', this.report.merge, !!this.files);
+    this.adjust.show(this.report);
     // The overlay in a task of its own, after the tables are laid out.
     nextFrame().then(() => this.drawOverlay());
   }
@@ -225,7 +244,12 @@ export class RealMaps {
   /** The joined maps in the first map's frame, each in its colour: drawn by the worker (merge-result.js). */
   drawOverlay() {
     if (!this.report || this.root.hidden) return;
-    this.overlay.draw((e) => this.say(e.message, 'error'));
+    this.overlay.draw(
+      (e) => this.say(e.message, 'error'),
+      (r) => {
+        if (this.adjust.active && r?.view) this.adjust.view = r.view;
+      },
+    );
     this.legend();
   }
 
@@ -235,9 +259,16 @@ export class RealMaps {
   }
 
   legend() {
+    const legend = this.root.querySelector('#real-legend');
+    const placing = this.adjust.active;
+    this.root.querySelector('#real-overlay-title').textContent = placing ? `Placing ${placing.b.name} by hand` : 'Merged overlay';
+    if (placing) {
+      legend.replaceChildren(swatch(placing.a.colour, placing.a.name), swatch(placing.b.colour, `${placing.b.name} (drag it)`));
+      return;
+    }
+    if (!this.report) return;
     const byName = new Map(this.maps.map((m) => [m.name, m]));
     const placed = this.report.merge.transforms.filter((t) => byName.has(t.map)).map((t) => ({ map: byName.get(t.map) }));
-    const legend = this.root.querySelector('#real-legend');
     legend.replaceChildren(
       ...placed.map(({ map }) => swatch(map.colour, map.name)),
       placed.length > 1 ? 'Walls of two maps that fall on each other show dark.' : '',
@@ -255,6 +286,7 @@ export class RealMaps {
       report: this.report,
       mergeMs: this.mergeMs,
       busy: this.busy,
+      adjust: this.adjust.snapshot(),
     };
   }
 }
