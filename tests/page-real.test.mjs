@@ -470,7 +470,6 @@ function relative([ax, ay, at], [bx, by, bt]) {
   return [c * (bx - ax) + s * (by - ay), -s * (bx - ax) + c * (by - ay), bt - at];
 }
 
-const wrap = (a) => Math.atan2(Math.sin(a), Math.cos(a));
 
 async function openLogView(page) {
   await page.goto(env.baseUrl);
