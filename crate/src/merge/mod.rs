@@ -63,6 +63,7 @@ pub mod mapsearch;
 pub mod method;
 pub mod offline;
 pub mod offline_search;
+pub mod pairbudget;
 pub mod rigid;
 pub mod selection;
 pub mod thesis;
