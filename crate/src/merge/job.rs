@@ -460,10 +460,7 @@ impl MergeJob {
 
     /// [`MergeJob::decide`] with a pair budget (step 4 of
     /// [`super::pairbudget`]'s doc).
-    fn decide_within_budget(
-        &self,
-        input: &impl MergeInput,
-    ) -> (Vec<PairOutcome>, BudgetSummary) {
+    fn decide_within_budget(&self, input: &impl MergeInput) -> (Vec<PairOutcome>, BudgetSummary) {
         let mut summary = BudgetSummary {
             pairs: self.pairs.len(),
             ..Default::default()
@@ -490,10 +487,23 @@ impl MergeJob {
             }
         }
         // The map searches, likeliest pairs first.
-        let mut order: Vec<usize> = (0..self.pairs.len())
-            .filter(|&k| self.pairs[k].budget.is_some_and(|b| b.plan != PairPlan::NotChecked))
-            .filter(|&k| outcomes[k].status != MergeStatus::Merged)
-            .collect();
+        let mut order: Vec<usize> = Vec::new();
+        for (k, o) in outcomes.iter_mut().enumerate() {
+            let b = self.pairs[k].budget.unwrap_or_default();
+            let ambiguous = o.verdict.as_ref().is_some_and(|d| d.ambiguous);
+            if o.status == MergeStatus::Merged || b.plan == PairPlan::NotChecked || ambiguous {
+                continue;
+            }
+            if b.search {
+                order.push(k);
+            } else {
+                o.reason = format!(
+                    "{}; maps not searched: neither robot ranks the other among its {} likeliest partners by coarse map overlap ({:.2})",
+                    o.reason, b.partners, b.overlap
+                );
+                o.check = Some("frames");
+            }
+        }
         order.sort_by_key(|&k| (self.pairs[k].budget.map_or(usize::MAX, |b| b.rank), k));
         for k in order {
             let p = &self.pairs[k];
@@ -504,7 +514,11 @@ impl MergeJob {
                     "{}; maps not searched: {} and {} are already joined through merged pairs",
                     o.reason, o.a, o.b
                 );
-                o.check = Some(if o.check == Some("full") { "frames" } else { "none" });
+                o.check = Some(if o.check == Some("full") {
+                    "frames"
+                } else {
+                    "none"
+                });
                 continue;
             }
             summary.maps_searched += 1;

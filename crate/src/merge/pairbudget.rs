@@ -34,10 +34,11 @@
 //!    figure, with `k = ⌈log₂ n + ½ log₂(1 + F / 100)⌉` growing gently with
 //!    the robots `n` and the mean number of frames `F` a robot brings (a
 //!    longer run covers more of the building and meets more robots). A pair
-//!    among either robot's `k` best by the votes is checked in full (frames
-//!    matched, then the verdict and, if needed, the map search); one among
-//!    the best by map overlap only is searched by the maps alone; any other
-//!    pair is not checked, and the report says so. Up to
+//!    among either robot's `k` best by the votes has its frames matched and
+//!    judged; a pair among either robot's `k` best by map overlap has its
+//!    maps searched where the frames did not merge it (or were not
+//!    matched); any other pair is not checked, and the report says so. So
+//!    at most `n k` pairs are matched and `n k` maps searched. Up to
 //!    `all_pairs_up_to` robots (four: six pairs) every pair is checked in
 //!    full, exactly as before.
 //! 4. **Early exit** (the spanning tree needs only enough edges,
@@ -103,6 +104,9 @@ pub struct PairBudget {
     pub rank: usize,
     /// Partners each robot keeps (`k` of the module doc).
     pub partners: usize,
+    /// Whether the maps may be searched: one robot ranks the other among
+    /// its `k` likeliest partners by coarse map overlap.
+    pub search: bool,
     /// The visual-vote figure and the coarse map overlap.
     pub votes: f64,
     pub overlap: f64,
@@ -151,7 +155,13 @@ pub fn visual_votes(bags: &[Vec<Bag>], votes_per_frame: usize) -> Vec<Vec<f64>> 
     (0..n)
         .map(|a| {
             (0..n)
-                .map(|b| if a == b { 0.0 } else { share(a, b) + share(b, a) })
+                .map(|b| {
+                    if a == b {
+                        0.0
+                    } else {
+                        share(a, b) + share(b, a)
+                    }
+                })
                 .collect()
         })
         .collect()
@@ -230,6 +240,7 @@ pub fn plan_pairs(votes: &[Vec<f64>], overlaps: &[Vec<f64>], k: usize) -> Vec<Pa
                 plan,
                 rank: rank_votes.min(rank_maps),
                 partners: k,
+                search: rank_maps < k,
                 votes: votes[a][b],
                 overlap: overlaps[a][b],
             });
@@ -284,8 +295,10 @@ pub struct BudgetSummary {
     /// Map searches run (of matched pairs vision did not merge, and of
     /// pairs searched by their maps only).
     pub maps_searched: usize,
-    /// Map searches not run because the two robots were already joined.
+    /// Map searches not run because the two robots were already joined
+    /// (of matched pairs, and of pairs left to their maps).
     pub searches_skipped: usize,
-    /// Pairs not checked within the budget.
+    /// Pairs of which nothing was checked: not within the budget, or left
+    /// to their maps and skipped as joined already (`check: "none"`).
     pub not_checked: usize,
 }

@@ -82,8 +82,8 @@ pub struct PairOutcome {
     pub distance: Option<DistanceSolution>,
     /// With many robots ([`super::pairbudget`]), how much of the pair was
     /// checked: `"full"` (frames matched; maps searched if needed),
-    /// `"frames"` (frames matched; maps not searched, the robots being
-    /// joined already), `"maps"` (maps searched alone), `"none"` (not
+    /// `"frames"` (frames matched; maps not searched: the robots were
+    /// joined already, or the maps did not rank the pair), `"maps"` (maps searched alone), `"none"` (not
     /// checked within the budget). Absent when every pair is checked in
     /// full.
     #[serde(skip_serializing_if = "Option::is_none")]

@@ -167,7 +167,10 @@ impl MethodStages for Auto {
         }
         if let Some(d) = o.verdict.as_mut() {
             d.status = o.status;
-            d.pose = m.pose.filter(|_| m.status == MergeStatus::Merged).or(d.pose);
+            d.pose = m
+                .pose
+                .filter(|_| m.status == MergeStatus::Merged)
+                .or(d.pose);
             d.confidence = o.confidence;
             if m.status == MergeStatus::Merged {
                 d.support.clear();
