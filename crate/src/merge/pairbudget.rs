@@ -53,7 +53,7 @@
 //! the lower robot index).
 
 use super::mapsearch::{coarse_overlap, WallSpectrum};
-use super::vocabulary::Bag;
+use super::vocabulary::{inverted_file, word_count, Bag};
 use crate::slam::OccupancyGrid;
 use serde::Serialize;
 
@@ -126,18 +126,8 @@ pub fn visual_votes(bags: &[Vec<Bag>], votes_per_frame: usize) -> Vec<Vec<f64>> 
     let n = bags.len();
     let owner: Vec<usize> = (0..n).flat_map(|r| vec![r; bags[r].len()]).collect();
     let all: Vec<&Bag> = bags.iter().flatten().collect();
-    let words = all
-        .iter()
-        .flat_map(|b| b.words.iter().map(|(w, _)| *w as usize + 1))
-        .max()
-        .unwrap_or(0);
     // One inverted file over every frame of every robot.
-    let mut postings: Vec<Vec<(u32, f32)>> = vec![Vec::new(); words];
-    for (j, bag) in all.iter().enumerate() {
-        for &(w, v) in &bag.words {
-            postings[w as usize].push((j as u32, v));
-        }
-    }
+    let postings = inverted_file(all.iter().copied(), word_count(all.iter().copied()));
     let mut votes = vec![vec![0usize; n]; n];
     let mut scores = vec![0f64; all.len()];
     for (i, bag) in all.iter().enumerate() {
