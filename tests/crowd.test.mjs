@@ -6,7 +6,10 @@
 // - in a crowded maze (tests/bench/crowd_maze.mjs), every pair of robots
 //   whose true paths overlap by at least 50 m^2 ends up in one of the
 //   report's merge.groups[], and every transform in every group is right,
-//   both checked against the ground truth.
+//   both checked against the ground truth;
+// - with sixteen robots the merge checks a bounded number of robot pairs
+//   (crate/src/merge/pairbudget.rs), says which it left out, and still
+//   finds every overlapping group, checked the same way.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawnSync } from 'node:child_process';
@@ -88,13 +91,22 @@ function footprint(truth, cell = 0.5, reach = 1.5) {
   return cells;
 }
 
-test('a crowded maze: every pair of robots whose paths overlap by 50 m^2 is joined, and no transform is wrong', () => {
-  const scenario = crowdMaze({ cells: 10, cellM: 3, open: 0.2, robots: 6, duration: 400, seed: 5 });
-  const file = path.join(tmp, 'crowd.json');
-  writeFileSync(file, JSON.stringify(scenario));
+/** Runs a crowded maze through the CLI; the parsed report. */
+function runCrowd(options, name) {
+  const file = path.join(tmp, `${name}.json`);
+  writeFileSync(file, JSON.stringify(crowdMaze(options)));
   const r = run('run', file, '--json');
   assert.equal(r.code, 0, r.stderr);
-  const report = JSON.parse(r.stdout);
+  return JSON.parse(r.stdout);
+}
+
+/**
+ * Checks a report's merge.groups[] against the truth: every robot in one
+ * group, every pair of robots whose paths overlap by 50 m^2 in one group
+ * (at least `minOverlapping` such pairs), and every transform of every
+ * group right. Returns the overlapping pairs.
+ */
+function assertGroupsAgainstTruth(report, minOverlapping) {
   const names = report.robots.map((x) => x.name);
   const groups = report.merge.groups;
   // Every robot in exactly one group; robot 1's group is the top-level join.
@@ -119,11 +131,10 @@ test('a crowded maze: every pair of robots whose paths overlap by 50 m^2 is join
   }
   const groupOf = Object.fromEntries(groups.flatMap((g, k) => g.robots.map((n) => [n, k])));
   const overlapping = overlaps.filter((o) => o.m2 >= 50);
-  assert.ok(overlapping.length >= 3, `an instance with overlaps: ${JSON.stringify(overlaps)}`);
+  assert.ok(overlapping.length >= minOverlapping, `an instance with overlaps: ${JSON.stringify(overlaps)}`);
   for (const o of overlapping) {
     assert.equal(groupOf[o.a], groupOf[o.b], `${o.a} and ${o.b} drove ${o.m2} m^2 together but are not joined`);
   }
-  assert.ok(groups.some((g) => g.robots.length >= 3), 'a group of three or more');
   // No transform is wrong: each robot's frame in its group's first robot's
   // frame, against the start poses.
   for (const g of groups) {
@@ -135,4 +146,40 @@ test('a crowded maze: every pair of robots whose paths overlap by 50 m^2 is join
       assert.ok(err < 0.5 && deg < 3, `${t.robot} in ${g.robots[0]}'s frame: off by ${err.toFixed(2)} m, ${deg.toFixed(1)} deg`);
     }
   }
+  return overlapping;
+}
+
+test('a crowded maze: every pair of robots whose paths overlap by 50 m^2 is joined, and no transform is wrong', () => {
+  const report = runCrowd({ cells: 10, cellM: 3, open: 0.2, robots: 6, duration: 400, seed: 5 }, 'crowd');
+  assertGroupsAgainstTruth(report, 3);
+  assert.ok(report.merge.groups.some((g) => g.robots.length >= 3), 'a group of three or more');
+});
+
+test('sixteen robots: a bounded number of pairs is checked, and every overlapping group is still found', () => {
+  const report = runCrowd({ cells: 12, cellM: 3, open: 0.2, robots: 16, duration: 240, seed: 22 }, 'crowd16');
+  const n = report.robots.length;
+  const { budget, pairs } = report.merge;
+  assert.ok(budget, 'sixteen robots: the merge reports its pair budget');
+  assert.equal(budget.pairs, n * (n - 1) / 2);
+  assert.equal(pairs.length, budget.pairs);
+  // k = ceil(log2 16 + log2(1 + F / 100) / 2) partners a robot, F its frames.
+  const k = budget.partners_per_robot;
+  assert.ok(k >= 4 && k <= 7, `partners per robot: ${k}`);
+  // Frames are matched only for a robot's k likeliest partners by visual
+  // votes, and maps searched only for its k likeliest by map overlap.
+  const matched = pairs.filter((p) => p.check === 'full' || p.check === 'frames').length;
+  assert.equal(matched, budget.matched);
+  assert.ok(matched <= n * k && matched < budget.pairs / 2, `${matched} of ${budget.pairs} pairs matched`);
+  assert.ok(budget.maps_searched <= n * k && budget.maps_searched < budget.pairs / 2, `${budget.maps_searched} map searches`);
+  const none = pairs.filter((p) => p.check === 'none');
+  assert.equal(none.length, budget.not_checked);
+  assert.ok(none.length > 0, 'some pairs are not checked');
+  for (const p of none) assert.equal(p.status, 'no_merge');
+  assert.ok(none.some((p) => /not checked within the budget/.test(p.reason)), 'the reason says so');
+  // The match tables of pairs left out are empty.
+  for (const t of report.match_tables) {
+    const p = pairs.find((q) => q.a === t.a && q.b === t.b);
+    if (p.check === 'none' || p.check === 'maps') assert.equal(t.checked, 0, `${t.a} + ${t.b}`);
+  }
+  assertGroupsAgainstTruth(report, 5);
 });

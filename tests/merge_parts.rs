@@ -1011,3 +1011,78 @@ fn bench_automatic_merge_stages() {
     println!("{report}");
     assert_eq!(outcome.status, MergeStatus::Merged, "{}", outcome.reason);
 }
+
+// ----- the pair budget with many robots -------------------------------------
+
+#[wasm_bindgen_test(unsupported = test)]
+fn a_budgeted_merge_of_five_maps_searches_in_rank_order_and_skips_joined_robots() {
+    // Four robots toured the house from frames turned every which way; a
+    // fifth mapped another building. Five robots: over the budget's
+    // all-pairs limit (four), so the pairs are ranked and bounded.
+    let house = building(16.0, 12.0, &HOUSE);
+    let other = building(14.0, 10.0, &[[3.0, 3.0, 3.0, 10.0], [6.0, 0.0, 6.0, 6.0]]);
+    let frames = [
+        Pose2::new(1.3, 0.7, 17f64.to_radians()),
+        Pose2::new(9.2, 4.1, -110f64.to_radians()),
+        Pose2::new(3.0, 8.0, 75f64.to_radians()),
+        Pose2::new(-2.0, 5.0, 200f64.to_radians()),
+    ];
+    let tours = [
+        stops(0.0, 11.0, 0.0, 12.0),
+        stops(5.0, 16.0, 0.0, 12.0),
+        stops(0.0, 16.0, 0.0, 8.0),
+        stops(2.0, 16.0, 4.0, 12.0),
+    ];
+    let mut maps: Vec<OccupancyGrid> = frames
+        .iter()
+        .zip(&tours)
+        .map(|(f, t)| scanned_map(&house, f, t))
+        .collect();
+    maps.push(scanned_map(
+        &other,
+        &Pose2::new(0.0, 0.0, 0.0),
+        &stops(0.0, 14.0, 0.0, 10.0),
+    ));
+    let input = MapsOnly(maps);
+    let mut job = MergeJob::new(&input, MergeConfig::new(MergeMethod::Auto, 1)).expect("a job");
+    job.run(&input).expect("runs");
+    let outcome = job.outcome().expect("decided");
+    let budget = outcome.budget.clone().expect("five robots: a budget");
+    // No frames, so no visual votes: nothing is matched, and each robot
+    // keeps k = ⌈log₂ 5⌉ = 3 partners by coarse map overlap.
+    assert_eq!(budget.pairs, 10);
+    assert_eq!(budget.partners_per_robot, 3);
+    assert_eq!(budget.matched, 0);
+    // Each pair was searched, or not checked at all (left out of the
+    // budget, or left out because its robots were joined already).
+    assert_eq!(budget.maps_searched + budget.not_checked, 10, "{budget:?}");
+    // Four maps of one house need three merged pairs; the other three
+    // pairs among them come after in rank order and are not searched.
+    assert!(budget.searches_skipped >= 1, "{budget:?}");
+    for p in &outcome.pairs {
+        match p.check {
+            Some("none") => {
+                assert!(p.reason.contains("budget"), "{}", p.reason);
+                assert_eq!(p.status, MergeStatus::NoMerge);
+            }
+            Some("maps") => {}
+            other => panic!("{} + {}: check {other:?}", p.a, p.b),
+        }
+    }
+    // The groups: the house's four maps, each right, and the other alone.
+    assert_eq!(outcome.groups.len(), 2, "{:?}", outcome.groups);
+    let house_group = &outcome.groups[0];
+    assert_eq!(house_group.robots, ["map0", "map1", "map2", "map3"]);
+    for (t, frame) in house_group.transforms.iter().zip(&frames) {
+        let truth = frames[0].inverse().compose(frame);
+        let (m, deg) = pose_error(&Pose2::new(t.pose[0], t.pose[1], t.pose[2]), &truth);
+        assert!(
+            m < 0.15 && deg < 1.0,
+            "{}: off by {m:.3} m, {deg:.2}°",
+            t.robot
+        );
+    }
+    assert_eq!(outcome.groups[1].robots, ["map4"]);
+    let reason = outcome.groups[1].reason.clone().unwrap_or_default();
+    assert!(reason.contains("joined no other robot"), "{reason}");
+}

@@ -19,6 +19,7 @@ use crate::merge::described::{describe_image, frames_to_describe};
 use crate::merge::job::{
     MergeConfig, MergeJob, MergeOutcome, MergeTimes, PairOutcome, RobotGroup, RobotTransform, Stage,
 };
+use crate::merge::pairbudget::BudgetSummary;
 use crate::merge::{MergeMethod, MergeStatus};
 use crate::slam::export::{to_pgm, to_png, to_yaml, GridPicture};
 use crate::slam::OccupancyGrid;
@@ -78,6 +79,10 @@ pub struct MergeReport {
     /// (`interfaces.md`); robot 1's group first.
     pub groups: Vec<RobotGroup>,
     pub pairs: Vec<PairOutcome>,
+    /// What the pair budget did, with many robots only
+    /// ([`crate::merge::pairbudget`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub budget: Option<BudgetSummary>,
     /// Scored against the ground truth (never used by the merge).
     pub errors: Vec<TransformError>,
     pub pair_errors: Vec<PairError>,
@@ -401,6 +406,7 @@ impl Lab {
                 })
                 .collect(),
             pairs: outcome.pairs.clone(),
+            budget: outcome.budget.clone(),
             errors,
             pair_errors,
             robot_poses,

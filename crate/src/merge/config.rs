@@ -7,6 +7,7 @@
 
 use super::baseline::BaselineConfig;
 use super::mapsearch::MapSearchConfig;
+use super::pairbudget::PairBudgetConfig;
 use super::selection::SelectionConfig;
 use super::verdict::VerdictConfig;
 use super::verify::VerifyConfig;
@@ -37,6 +38,9 @@ pub struct MergeConfig {
     pub proposals_per_frame: usize,
     /// Automatic method: at most this many pairs verified per robot pair.
     pub max_pairs: usize,
+    /// Automatic method with many robots: which robot pairs are checked
+    /// ([`super::pairbudget`]).
+    pub pair_budget: PairBudgetConfig,
     pub verdict: VerdictConfig,
     /// Automatic method: when vision finds no transform the maps confirm,
     /// search the maps alone ([`super::mapsearch`]); `None` turns that off.
@@ -67,6 +71,7 @@ impl MergeConfig {
             vocabulary: VocabularyConfig::default(),
             proposals_per_frame: 3,
             max_pairs: 600,
+            pair_budget: PairBudgetConfig::default(),
             verdict: VerdictConfig::default(),
             map_search: Some(MapSearchConfig::default()),
             baseline: BaselineConfig::default(),

@@ -42,6 +42,7 @@ use super::frames::MergeInput;
 use super::fuse::fuse;
 use super::graph::{groups, spanning_tree, Joined, PairEdge};
 use super::method::{pose3, stages_of, MethodStages, PairInput};
+use super::pairbudget::{BudgetSummary, Components, PairBudget, PairPlan};
 use super::verify::{verify_pair, PairCheck, VerifyConfig};
 use super::MergeStatus;
 use crate::camera::PinholeCamera;
@@ -123,6 +124,8 @@ pub struct MergeOutcome {
     /// are [`MergeOutcome::transforms`]).
     pub groups: Vec<RobotGroup>,
     pub pairs: Vec<PairOutcome>,
+    /// What the pair budget did (many robots only, [`super::pairbudget`]).
+    pub budget: Option<BudgetSummary>,
 }
 
 /// A matched-pair table in the report's layout (`interfaces.md`).
@@ -191,6 +194,7 @@ impl MergeJob {
                     todo: Vec::new(),
                     cells: Vec::new(),
                     outcome: None,
+                    budget: None,
                 });
             }
         }
@@ -271,8 +275,11 @@ impl MergeJob {
         match self.stage {
             Stage::Features => Ok(self.advance_features(input, units)),
             Stage::Proposals => {
+                let maps: Vec<&OccupancyGrid> = (0..self.robots.len())
+                    .map(|i| input.map(i, self.config.mapper))
+                    .collect();
                 self.method
-                    .propose(&self.robots, &mut self.pairs, &self.config);
+                    .propose(&self.robots, &mut self.pairs, &maps, &self.config);
                 self.stage = Stage::Matching;
                 Ok(1)
             }
@@ -407,29 +414,160 @@ impl MergeJob {
         done
     }
 
-    /// The decision on every pair of robots, by the method's own rule,
-    /// then the join.
-    fn decide(&mut self, input: &impl MergeInput) {
+    /// What the decision on pair `p` reads.
+    fn pair_input<'a>(
+        &'a self,
+        input: &'a impl MergeInput,
+        p: &'a PairWork,
+        search_maps: bool,
+    ) -> PairInput<'a> {
         let mapper = self.config.mapper;
-        let outcomes: Vec<PairOutcome> = self
-            .pairs
-            .iter()
-            .map(|p| {
-                self.method.decide(&PairInput {
-                    work: p,
-                    robot_a: &self.robots[p.a],
-                    robot_b: &self.robots[p.b],
-                    map_a: input.map(p.a, mapper),
-                    map_b: input.map(p.b, mapper),
-                    camera: &self.camera,
-                    config: &self.config,
-                })
-            })
-            .collect();
+        PairInput {
+            work: p,
+            robot_a: &self.robots[p.a],
+            robot_b: &self.robots[p.b],
+            map_a: input.map(p.a, mapper),
+            map_b: input.map(p.b, mapper),
+            camera: &self.camera,
+            config: &self.config,
+            search_maps,
+        }
+    }
+
+    /// The decision on every pair of robots, by the method's own rule,
+    /// then the join. With a pair budget ([`super::pairbudget`]) the
+    /// frame-based verdicts come first and the map searches after, in rank
+    /// order, skipping robots already joined.
+    fn decide(&mut self, input: &impl MergeInput) {
+        let (outcomes, budget) = if self.pairs.iter().any(|p| p.budget.is_some()) {
+            let (o, b) = self.decide_within_budget(input);
+            (o, Some(b))
+        } else {
+            let o = self
+                .pairs
+                .iter()
+                .map(|p| self.method.decide(&self.pair_input(input, p, true)))
+                .collect();
+            (o, None)
+        };
         for (p, o) in self.pairs.iter_mut().zip(&outcomes) {
             p.outcome = Some(o.clone());
         }
-        self.outcome = Some(self.join(outcomes));
+        let mut outcome = self.join(outcomes);
+        outcome.budget = budget;
+        self.outcome = Some(outcome);
+    }
+
+    /// [`MergeJob::decide`] with a pair budget (step 4 of
+    /// [`super::pairbudget`]'s doc).
+    fn decide_within_budget(&self, input: &impl MergeInput) -> (Vec<PairOutcome>, BudgetSummary) {
+        let mut summary = BudgetSummary {
+            pairs: self.pairs.len(),
+            ..Default::default()
+        };
+        let mut outcomes: Vec<PairOutcome> = Vec::with_capacity(self.pairs.len());
+        for p in &self.pairs {
+            let b = p.budget.unwrap_or_default();
+            summary.partners_per_robot = b.partners;
+            let o = match b.plan {
+                PairPlan::Full => {
+                    summary.matched += 1;
+                    let mut o = self.method.decide(&self.pair_input(input, p, false));
+                    o.check = Some("full");
+                    o
+                }
+                _ => self.unmatched(p, &b),
+            };
+            outcomes.push(o);
+        }
+        let mut joined = Components::new(self.robots.len());
+        for (p, o) in self.pairs.iter().zip(&outcomes) {
+            if o.status == MergeStatus::Merged {
+                joined.join(p.a, p.b);
+            }
+        }
+        // The map searches, likeliest pairs first.
+        let mut order: Vec<usize> = Vec::new();
+        for (k, o) in outcomes.iter_mut().enumerate() {
+            let b = self.pairs[k].budget.unwrap_or_default();
+            let ambiguous = o.verdict.as_ref().is_some_and(|d| d.ambiguous);
+            if o.status == MergeStatus::Merged || b.plan == PairPlan::NotChecked || ambiguous {
+                continue;
+            }
+            if b.search {
+                order.push(k);
+            } else {
+                o.reason = format!(
+                    "{}; maps not searched: neither robot ranks the other among its {} likeliest partners by coarse map overlap ({:.2})",
+                    o.reason, b.partners, b.overlap
+                );
+                o.check = Some("frames");
+            }
+        }
+        order.sort_by_key(|&k| (self.pairs[k].budget.map_or(usize::MAX, |b| b.rank), k));
+        for k in order {
+            let p = &self.pairs[k];
+            let o = &mut outcomes[k];
+            if joined.same(p.a, p.b) {
+                summary.searches_skipped += 1;
+                o.reason = format!(
+                    "{}; maps not searched: {} and {} are already joined through merged pairs",
+                    o.reason, o.a, o.b
+                );
+                o.check = Some(if o.check == Some("full") {
+                    "frames"
+                } else {
+                    "none"
+                });
+                continue;
+            }
+            summary.maps_searched += 1;
+            *o = self
+                .method
+                .search_after(&self.pair_input(input, p, true), o.clone());
+            if o.status == MergeStatus::Merged {
+                joined.join(p.a, p.b);
+            }
+        }
+        summary.not_checked = outcomes.iter().filter(|o| o.check == Some("none")).count();
+        (outcomes, summary)
+    }
+
+    /// The outcome of a pair whose frames the budget left unmatched: not
+    /// checked, or (plan `MapsOnly`) waiting for its map search.
+    fn unmatched(&self, p: &PairWork, b: &PairBudget) -> PairOutcome {
+        let k = b.partners;
+        let (reason, check) = match b.plan {
+            PairPlan::MapsOnly => (
+                format!(
+                    "frames not matched within the budget: by visual votes ({:.3}) neither robot ranks the other among its {k} likeliest partners, by coarse map overlap ({:.2}) one does",
+                    b.votes, b.overlap
+                ),
+                "maps",
+            ),
+            _ => (
+                format!(
+                    "not checked within the budget: neither robot ranks the other among its {k} likeliest partners by visual votes ({:.3}) or by coarse map overlap ({:.2})",
+                    b.votes, b.overlap
+                ),
+                "none",
+            ),
+        };
+        PairOutcome {
+            a: self.robots[p.a].name.clone(),
+            b: self.robots[p.b].name.clone(),
+            status: MergeStatus::NoMerge,
+            reason,
+            confidence: 0.0,
+            pose: None,
+            candidates: 0,
+            support: 0,
+            best: None,
+            second: None,
+            distance: None,
+            check: Some(check),
+            verdict: None,
+        }
     }
 
     /// Joins the pairwise results along the most confident spanning tree.
@@ -520,6 +658,7 @@ impl MergeJob {
             )
         };
         MergeOutcome {
+            budget: None,
             status,
             reason,
             confidence: if confidence.is_finite() {
@@ -589,13 +728,21 @@ impl MergeJob {
         });
         match closest {
             None => format!("{name} is the only robot: there is nothing to merge"),
-            Some(o) => format!(
-                "{name} joined no other robot: none of its {} pairs merged; closest, {} + {}: {}",
-                mine.len(),
-                o.a,
-                o.b,
-                o.reason
-            ),
+            Some(o) => {
+                let unchecked = mine.iter().filter(|o| o.check == Some("none")).count();
+                let budget = if unchecked > 0 {
+                    format!(" ({unchecked} of them not checked within the budget)")
+                } else {
+                    String::new()
+                };
+                format!(
+                    "{name} joined no other robot: none of its {} pairs merged{budget}; closest, {} + {}: {}",
+                    mine.len(),
+                    o.a,
+                    o.b,
+                    o.reason
+                )
+            }
         }
     }
 

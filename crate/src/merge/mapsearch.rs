@@ -248,9 +248,28 @@ fn hough_spectrum(grid: &OccupancyGrid) -> (Vec<f64>, usize) {
 /// folded Hough spectra, refined by a parabola through it and its
 /// neighbours.
 pub fn dominant_rotation(a: &OccupancyGrid, b: &OccupancyGrid) -> Option<f64> {
-    let (ha, na) = hough_spectrum(a);
-    let (hb, nb) = hough_spectrum(b);
-    if na < 10 || nb < 10 {
+    rotation_between(&WallSpectrum::of(a), &WallSpectrum::of(b))
+}
+
+/// A map's folded Hough spectrum ([`hough_spectrum`]), computed once per
+/// map when many pairs are compared ([`super::pairbudget`]).
+#[derive(Clone, Debug)]
+pub struct WallSpectrum {
+    folded: Vec<f64>,
+    walls: usize,
+}
+
+impl WallSpectrum {
+    pub fn of(grid: &OccupancyGrid) -> WallSpectrum {
+        let (folded, walls) = hough_spectrum(grid);
+        WallSpectrum { folded, walls }
+    }
+}
+
+/// [`dominant_rotation`] from the two maps' spectra.
+pub fn rotation_between(a: &WallSpectrum, b: &WallSpectrum) -> Option<f64> {
+    let (ha, hb) = (&a.folded, &b.folded);
+    if a.walls < 10 || b.walls < 10 {
         return None;
     }
     let n = ha.len();
@@ -397,6 +416,47 @@ fn correlate(a: &Raster, b: &Raster) -> Correlation {
         }
     }
     Correlation { t0, nx, ny, acc }
+}
+
+/// How well map B can lie on map A at all, from a coarse search: the
+/// rotation from the spectra, then the best translation of each of the
+/// four rotations at `cell_m` (steps 1 and 2 of the module doc, without
+/// refinement or verdict). Returns the best correlation score over the
+/// coarse wall cells of the smaller map, counted both ways (about 1 when
+/// one map's walls all lie on the other's, lower where they fall on
+/// unknown ground or in free space, 0 when nothing fits). A ranking figure
+/// for [`super::pairbudget`], never a reason to merge: a maze's lattice
+/// lays unrelated maps partly on each other too.
+pub fn coarse_overlap(
+    a: &OccupancyGrid,
+    b: &OccupancyGrid,
+    spectra: (&WallSpectrum, &WallSpectrum),
+    cell_m: f64,
+    free_penalty: i32,
+) -> f64 {
+    let Some(delta) = rotation_between(spectra.0, spectra.1) else {
+        return 0.0;
+    };
+    let cell = cell_m.max(a.resolution_m());
+    let Some(ra) = Raster::draw(a, 0.0, cell, free_penalty) else {
+        return 0.0;
+    };
+    let mut best = 0i64;
+    let mut walls_b = 0;
+    for k in 0..4 {
+        let theta = wrap_angle(delta + k as f64 * FRAC_PI_2);
+        let Some(rb) = Raster::draw(b, theta, cell, free_penalty) else {
+            return 0.0;
+        };
+        walls_b = rb.walls.len();
+        let corr = correlate(&ra, &rb);
+        best = best.max(corr.acc.iter().copied().max().unwrap_or(0) as i64);
+    }
+    let smaller = ra.walls.len().min(walls_b);
+    if smaller == 0 {
+        return 0.0;
+    }
+    (best as f64 / (2 * smaller) as f64).max(0.0)
 }
 
 /// Whether two transforms of B differ by more than the settings allow, at

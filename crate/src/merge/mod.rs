@@ -64,6 +64,7 @@ pub mod mapsearch;
 pub mod method;
 pub mod offline;
 pub mod offline_search;
+pub mod pairbudget;
 pub mod refine;
 pub mod rigid;
 pub mod selection;

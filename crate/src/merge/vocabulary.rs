@@ -510,6 +510,29 @@ fn top_k(scores: &[f64], k: usize) -> Vec<(usize, f64)> {
     v
 }
 
+/// One more than the largest word of any of `bags` (0 when they are empty).
+pub fn word_count<'a>(bags: impl IntoIterator<Item = &'a Bag>) -> usize {
+    bags.into_iter()
+        .flat_map(|b| b.words.iter().map(|(w, _)| *w as usize + 1))
+        .max()
+        .unwrap_or(0)
+}
+
+/// The inverted file of `bags`: for each of `words` words (at least
+/// [`word_count`] of them), the bags that hold it, as (position, weight).
+pub fn inverted_file<'a>(
+    bags: impl IntoIterator<Item = &'a Bag>,
+    words: usize,
+) -> Vec<Vec<(u32, f32)>> {
+    let mut postings: Vec<Vec<(u32, f32)>> = vec![Vec::new(); words];
+    for (j, bag) in bags.into_iter().enumerate() {
+        for &(w, v) in &bag.words {
+            postings[w as usize].push((j as u32, v));
+        }
+    }
+    postings
+}
+
 /// Frame pairs `(index in bags_a, index in bags_b, similarity)` worth
 /// verifying, best first: each frame of either robot nominates its
 /// `per_frame` most similar frames of the other, and the union is cut to
@@ -524,18 +547,7 @@ pub fn propose_pairs(
         return Vec::new();
     }
     // Inverted file over B.
-    let words = bags_a
-        .iter()
-        .chain(bags_b)
-        .flat_map(|b| b.words.iter().map(|(w, _)| *w as usize + 1))
-        .max()
-        .unwrap_or(0);
-    let mut postings: Vec<Vec<(u32, f32)>> = vec![Vec::new(); words];
-    for (j, bag) in bags_b.iter().enumerate() {
-        for &(w, v) in &bag.words {
-            postings[w as usize].push((j as u32, v));
-        }
-    }
+    let postings = inverted_file(bags_b, word_count(bags_a.iter().chain(bags_b)));
     // The full similarity matrix, row by row.
     let mut matrix = vec![0f64; bags_a.len() * bags_b.len()];
     for (i, bag) in bags_a.iter().enumerate() {

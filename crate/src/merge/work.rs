@@ -5,6 +5,7 @@
 //! their features, each pair of robots' to-do list of frame pairs and its
 //! checked cells (the matched-pair table), and the decision on each pair.
 
+use super::pairbudget::PairBudget;
 use super::thesis::DistanceSolution;
 use super::verdict::PairDecision;
 use super::{Candidate, FrameInfo, MergeStatus};
@@ -55,6 +56,10 @@ pub struct PairWork {
     pub todo: Vec<(usize, usize)>,
     pub cells: Vec<Cell>,
     pub outcome: Option<PairOutcome>,
+    /// The pair budget's plan for this pair ([`super::pairbudget`]);
+    /// `None` when every pair is checked in full (few robots, or a method
+    /// without a budget).
+    pub budget: Option<PairBudget>,
 }
 
 /// The decision on one pair of robots.
@@ -75,6 +80,14 @@ pub struct PairOutcome {
     pub best: Option<[usize; 2]>,
     pub second: Option<[usize; 2]>,
     pub distance: Option<DistanceSolution>,
+    /// With many robots ([`super::pairbudget`]), how much of the pair was
+    /// checked: `"full"` (frames matched; maps searched if needed),
+    /// `"frames"` (frames matched; maps not searched: the robots were
+    /// joined already, or the maps did not rank the pair), `"maps"` (maps searched alone), `"none"` (not
+    /// checked within the budget). Absent when every pair is checked in
+    /// full.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub check: Option<&'static str>,
     /// Automatic method: the verdict behind the outcome, with the agreeing
     /// candidates (indices into the pair's candidates, in cell order) and
     /// the independent places they show. Not part of the report.

@@ -15,11 +15,15 @@ use super::{pose3, MethodStages, PairInput};
 use crate::geom::wrap_angle;
 use crate::merge::config::MergeConfig;
 use crate::merge::mapsearch::search_maps;
+use crate::merge::pairbudget::{
+    map_overlaps, partners_per_robot, plan_pairs, visual_votes, PairBudget, PairPlan,
+};
 use crate::merge::verdict::{decide_pair_after_search, SearchSummary};
 use crate::merge::verify::{PairCheck, VerifyConfig};
 use crate::merge::vocabulary::{propose_pairs, Bag, Vocabulary};
 use crate::merge::work::{PairOutcome, PairWork, RobotFrames};
 use crate::merge::{Candidate, FrameInfo, MergeStatus};
+use crate::slam::OccupancyGrid;
 use crate::surf::Features;
 
 /// The `auto` method.
@@ -53,14 +57,33 @@ impl MethodStages for Auto {
 
     /// The vocabulary's proposals: trained on every described frame of
     /// every robot, then each robot pair's frames nominate their partners.
-    fn propose(&self, robots: &[RobotFrames], pairs: &mut [PairWork], config: &MergeConfig) {
+    /// With many robots only the pairs the budget keeps are proposed
+    /// ([`pair_budget`]).
+    fn propose(
+        &self,
+        robots: &[RobotFrames],
+        pairs: &mut [PairWork],
+        maps: &[&OccupancyGrid],
+        config: &MergeConfig,
+    ) {
         let sets: Vec<&Features> = robots.iter().flat_map(|r| r.features.iter()).collect();
         let vocabulary = Vocabulary::train(&sets, &config.vocabulary, config.seed ^ 0x766f_6361);
         let bags: Vec<Vec<Bag>> = robots
             .iter()
             .map(|r| r.features.iter().map(|f| vocabulary.bag(f)).collect())
             .collect();
+        let budget = pair_budget(robots, &bags, maps, config);
+        let n = robots.len();
         for p in pairs {
+            // Pairs (a, b), a < b, in order: the index of (a, b).
+            p.budget = budget
+                .as_ref()
+                .and_then(|b| b.get(p.a * n - p.a * (p.a + 1) / 2 + p.b - p.a - 1))
+                .copied();
+            if p.budget.is_some_and(|b| b.plan != PairPlan::Full) {
+                p.todo.clear();
+                continue;
+            }
             let proposals = propose_pairs(
                 &bags[p.a],
                 &bags[p.b],
@@ -97,27 +120,8 @@ impl MethodStages for Auto {
                 .unwrap_or(0),
             min_inliers: config.verify.min_inliers,
         };
-        let mut d =
-            decide_pair_after_search(&cands, &summary, pair.map_a, pair.map_b, &config.verdict);
-        // Vision found nothing the maps confirm (and was not torn between
-        // two transforms): ask the maps alone.
-        if let Some(ms) = config
-            .map_search
-            .as_ref()
-            .filter(|_| d.status != MergeStatus::Merged && !d.ambiguous)
-        {
-            let m = search_maps(pair.map_a, pair.map_b, ms, &config.verdict);
-            if m.status == MergeStatus::Merged {
-                d.status = MergeStatus::Merged;
-                d.pose = m.pose;
-                d.confidence = m.confidence;
-                d.support.clear();
-                d.reason = format!("merged: {} (vision: {})", m.reason, d.reason);
-            } else {
-                d.reason = format!("{}; {}", d.reason, m.reason);
-            }
-        }
-        PairOutcome {
+        let d = decide_pair_after_search(&cands, &summary, pair.map_a, pair.map_b, &config.verdict);
+        let outcome = PairOutcome {
             a: pair.robot_a.name.clone(),
             b: pair.robot_b.name.clone(),
             status: d.status,
@@ -129,7 +133,71 @@ impl MethodStages for Auto {
             best: None,
             second: None,
             distance: None,
+            check: None,
             verdict: Some(d),
+        };
+        if pair.search_maps {
+            self.search_after(pair, outcome)
+        } else {
+            outcome
         }
     }
+
+    /// Vision found nothing the maps confirm (and was not torn between two
+    /// transforms): ask the maps alone.
+    fn search_after(&self, pair: &PairInput, mut o: PairOutcome) -> PairOutcome {
+        let config = pair.config;
+        let ambiguous = o.verdict.as_ref().is_some_and(|d| d.ambiguous);
+        let Some(ms) = config
+            .map_search
+            .as_ref()
+            .filter(|_| o.status != MergeStatus::Merged && !ambiguous)
+        else {
+            return o;
+        };
+        let m = search_maps(pair.map_a, pair.map_b, ms, &config.verdict);
+        if m.status == MergeStatus::Merged {
+            o.status = MergeStatus::Merged;
+            o.pose = m.pose.as_ref().map(pose3);
+            o.confidence = m.confidence;
+            o.support = 0;
+            o.reason = format!("merged: {} (vision: {})", m.reason, o.reason);
+        } else {
+            o.reason = format!("{}; {}", o.reason, m.reason);
+        }
+        if let Some(d) = o.verdict.as_mut() {
+            d.status = o.status;
+            d.pose = m
+                .pose
+                .filter(|_| m.status == MergeStatus::Merged)
+                .or(d.pose);
+            d.confidence = o.confidence;
+            if m.status == MergeStatus::Merged {
+                d.support.clear();
+            }
+            d.reason = o.reason.clone();
+        }
+        o
+    }
+}
+
+/// The pair budget of a run with many robots ([`crate::merge::pairbudget`]):
+/// each pair's plan, in the order (a, b), a < b; `None` (every pair in
+/// full) up to `all_pairs_up_to` robots.
+fn pair_budget(
+    robots: &[RobotFrames],
+    bags: &[Vec<Bag>],
+    maps: &[&OccupancyGrid],
+    config: &MergeConfig,
+) -> Option<Vec<PairBudget>> {
+    let cfg = &config.pair_budget;
+    let n = robots.len();
+    if n <= cfg.all_pairs_up_to || maps.len() != n {
+        return None;
+    }
+    let frames: usize = robots.iter().map(|r| r.selected.len()).sum();
+    let k = partners_per_robot(n, frames as f64 / n as f64);
+    let votes = visual_votes(bags, cfg.votes_per_frame);
+    let overlaps = map_overlaps(maps, cfg);
+    Some(plan_pairs(&votes, &overlaps, k))
 }

@@ -44,6 +44,7 @@ impl MethodStages for MapOnly {
             best: None,
             second: None,
             distance: None,
+            check: None,
             verdict: None,
         }
     }

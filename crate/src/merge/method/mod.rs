@@ -41,6 +41,11 @@ pub struct PairInput<'a> {
     pub map_b: &'a OccupancyGrid,
     pub camera: &'a PinholeCamera,
     pub config: &'a MergeConfig,
+    /// Whether [`MethodStages::decide`] may also search the maps when the
+    /// frames find nothing. With many robots the job asks for the searches
+    /// later, in rank order ([`MethodStages::search_after`]), and skips
+    /// those of robots already joined ([`super::pairbudget`]).
+    pub search_maps: bool,
 }
 
 /// The stages of one merge method, as [`super::job::MergeJob`] calls them.
@@ -57,8 +62,17 @@ pub trait MethodStages: Sync {
     fn select(&self, infos: &[FrameInfo], config: &MergeConfig) -> Vec<usize>;
 
     /// Fills every robot pair's to-do list (`todo`, positions in the two
-    /// robots' `selected` lists), once every selected frame is described.
-    fn propose(&self, _robots: &[RobotFrames], _pairs: &mut [PairWork], _config: &MergeConfig) {}
+    /// robots' `selected` lists), once every selected frame is described;
+    /// a method may also set each pair's budget (`budget`) from the frames
+    /// and the robots' `maps`.
+    fn propose(
+        &self,
+        _robots: &[RobotFrames],
+        _pairs: &mut [PairWork],
+        _maps: &[&OccupancyGrid],
+        _config: &MergeConfig,
+    ) {
+    }
 
     /// The verification settings of the matching stage (a pair the user
     /// opens is always checked with every setting on).
@@ -71,6 +85,13 @@ pub trait MethodStages: Sync {
 
     /// The decision on one pair of robots.
     fn decide(&self, pair: &PairInput) -> PairOutcome;
+
+    /// A second look at a pair [`MethodStages::decide`] did not merge
+    /// (asked with `search_maps` false): the automatic method's search of
+    /// the maps alone. The default changes nothing.
+    fn search_after(&self, _pair: &PairInput, decided: PairOutcome) -> PairOutcome {
+        decided
+    }
 }
 
 /// The stages of `method`.

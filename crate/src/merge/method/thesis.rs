@@ -13,6 +13,7 @@ use crate::merge::thesis::{thesis_merge, PairMatch};
 use crate::merge::verify::PairCheck;
 use crate::merge::work::{PairOutcome, PairWork, RobotFrames};
 use crate::merge::FrameInfo;
+use crate::slam::OccupancyGrid;
 
 /// The `thesis` method.
 pub struct Thesis;
@@ -23,7 +24,13 @@ impl MethodStages for Thesis {
     }
 
     /// Every kept frame of one robot against every kept frame of the other.
-    fn propose(&self, robots: &[RobotFrames], pairs: &mut [PairWork], _config: &MergeConfig) {
+    fn propose(
+        &self,
+        robots: &[RobotFrames],
+        pairs: &mut [PairWork],
+        _maps: &[&OccupancyGrid],
+        _config: &MergeConfig,
+    ) {
         for p in pairs {
             let (na, nb) = (robots[p.a].selected.len(), robots[p.b].selected.len());
             p.todo = (0..na).flat_map(|i| (0..nb).map(move |j| (i, j))).collect();
@@ -63,6 +70,7 @@ impl MethodStages for Thesis {
             best: t.best.map(|(i, j)| [i, j]),
             second: t.second.map(|(i, j)| [i, j]),
             distance: t.distance,
+            check: None,
             verdict: None,
         }
     }
