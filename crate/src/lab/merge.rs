@@ -139,20 +139,20 @@ pub struct TableView {
     pub best: Option<[u32; 2]>,
 }
 
-fn pose3(p: &Pose2) -> [f64; 3] {
+pub(super) fn pose3(p: &Pose2) -> [f64; 3] {
     [p.x, p.y, p.theta]
 }
 
-fn pose_of(p: [f64; 3]) -> Pose2 {
+pub(super) fn pose_of(p: [f64; 3]) -> Pose2 {
     Pose2::new(p[0], p[1], p[2])
 }
 
-fn round6(x: f64) -> f64 {
+pub(super) fn round6(x: f64) -> f64 {
     (x * 1e6).round() / 1e6
 }
 
 /// Transforms with their poses rounded for the report.
-fn rounded(transforms: &[RobotTransform]) -> Vec<RobotTransform> {
+pub(super) fn rounded(transforms: &[RobotTransform]) -> Vec<RobotTransform> {
     transforms
         .iter()
         .map(|t| RobotTransform {
@@ -538,28 +538,41 @@ impl Lab {
         let sim = self.simulation().ok_or("nothing has run yet")?;
         let job = self.merge.as_ref().ok_or("no merge has been started")?;
         let outcome = job.outcome().ok_or("the merge has not finished yet")?;
-        let mut pic = GridPicture::new(g, width, height)?;
-        if g.width() == 0 {
-            return Ok(pic.into_rgba());
-        }
-        for t in &outcome.transforms {
-            let Some(i) = sim.robots.iter().position(|r| r.spec.name == t.robot) else {
-                continue;
-            };
-            let frame = pose_of(t.pose);
-            let est = sim.robots[i].mapping.estimates();
-            let path: Vec<DVec2> = est
-                .iter()
-                .map(|p| frame.transform_point(p.position()))
-                .collect();
-            let [r, gr, b] = crate::palette::robot_colour(i);
-            pic.polyline(&path, [r, gr, b, 220], 1.5);
-            if let Some(last) = est.last() {
-                pic.dot(frame.compose(last).position(), 4.0, [r, gr, b, 220]);
-            }
-        }
-        Ok(pic.into_rgba())
+        picture(sim, g, &outcome.transforms, width, height)
     }
+}
+
+/// The grid `g` fitted to `width × height` as RGBA pixels, with the SLAM
+/// path of each robot of `transforms` (its map frame placed at its pose in
+/// `g`'s frame) in the robot's colour, and a dot where it stands.
+pub(super) fn picture(
+    sim: &crate::sim::Simulation,
+    g: &OccupancyGrid,
+    transforms: &[RobotTransform],
+    width: u32,
+    height: u32,
+) -> Result<Vec<u8>, String> {
+    let mut pic = GridPicture::new(g, width, height)?;
+    if g.width() == 0 {
+        return Ok(pic.into_rgba());
+    }
+    for t in transforms {
+        let Some(i) = sim.robots.iter().position(|r| r.spec.name == t.robot) else {
+            continue;
+        };
+        let frame = pose_of(t.pose);
+        let est = sim.robots[i].mapping.estimates();
+        let path: Vec<DVec2> = est
+            .iter()
+            .map(|p| frame.transform_point(p.position()))
+            .collect();
+        let [r, gr, b] = crate::palette::robot_colour(i);
+        pic.polyline(&path, [r, gr, b, 220], 1.5);
+        if let Some(last) = est.last() {
+            pic.dot(frame.compose(last).position(), 4.0, [r, gr, b, 220]);
+        }
+    }
+    Ok(pic.into_rgba())
 }
 
 /// Size, resolution and origin of the merged map.
