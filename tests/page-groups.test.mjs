@@ -67,7 +67,7 @@ test('several groups: the panel lists the CLI\u2019s groups, draws each group\u2
   const why = expected[2].reason.replace(/^robot5 joined no other robot: /, '');
   assert.ok(why.length > 20 && items[2].startsWith('robot5 alone: '), items[2]);
   assert.ok(items[2].includes(why.slice(0, 40)), `the reason shown: ${items[2]}`);
-  assert.match(await page.locator('#merge-groups').innerText(), /3 groups that saw nothing in common/);
+  assert.match(await page.locator('#merge-groups').innerText(), /These robots form 3 groups that saw nothing in common/);
   assert.match(await page.locator('#status').innerText(), /^Maps merged in 2 groups \(robot1 \+ robot2; robot3 \+ robot4\); robot5 stays alone\./);
 
   // One tab per group with a merged map; each draws that group in its robots' colours only.
@@ -108,8 +108,12 @@ test('several groups: the panel lists the CLI\u2019s groups, draws each group\u2
   assert.ok(m, 'a binary PGM');
   assert.equal(pgm.length, m[0].length + Number(m[1]) * Number(m[2]));
 
-  // The arrow keys move between the tabs.
-  await tabs.nth(1).focus();
+  // "merged map" in the list shows that group; the arrow keys move between the tabs.
+  await page.locator('#merge-group-list li[data-group="0"] button').click();
+  assert.equal(await tabs.first().getAttribute('aria-selected'), 'true');
+  assert.equal(await page.evaluate(() => document.activeElement.id), 'merge-group-tab-0');
+  await page.keyboard.press('ArrowRight');
+  assert.equal(await tabs.nth(1).getAttribute('aria-selected'), 'true');
   await page.keyboard.press('ArrowLeft');
   assert.equal(await tabs.first().getAttribute('aria-selected'), 'true');
   assert.equal(await page.evaluate(() => document.activeElement.id), 'merge-group-tab-0');

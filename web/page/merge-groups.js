@@ -102,17 +102,20 @@ export class GroupsView {
     this.box.hidden = false;
     const mapped = groups.map((g, k) => [g, k]).filter(([g]) => g.robots.length > 1);
     const alone = groups.length - mapped.length;
-    this.intro.textContent = `The merge joins robots whose maps or camera views overlap. Here the robots form ` +
-      `${groups.length} groups that saw nothing in common with each other` +
-      (mapped.length ? `, so each group of two or more has its own merged map, drawn in the frame of its first robot` : '') +
-      (alone ? `; ${alone === 1 ? 'a robot' : 'robots'} nobody overlapped ${alone === 1 ? 'stays' : 'stay'} alone, with the reason.` : '.');
+    this.intro.textContent = `These robots form ${groups.length} groups that saw nothing in common with each other` +
+      (mapped.length ? ': each group of two or more has its own merged map, drawn in its first robot\u2019s frame' : '') +
+      (alone ? `; ${alone === 1 ? 'a robot' : 'robots'} nobody overlapped ${alone === 1 ? 'stays' : 'stay'} alone, and the list says why.` : '.');
     this.list.replaceChildren(...groups.map((g, k) => {
       if (g.robots.length === 1) {
         return el('li', { class: 'merge-group-alone', 'data-group': String(k) },
           this.name(g.robots[0]), ` alone: ${aloneReason(g)}`);
       }
       const names = g.robots.flatMap((n, i) => (i ? [', ', this.name(n)] : [this.name(n)]));
-      return el('li', { 'data-group': String(k) }, el('span', { text: `Group ${k + 1}: ` }), ...names, ' \u2014 merged map');
+      // "merged map" shows that group's map (a link-like button when there is a choice).
+      const show = mapped.length > 1
+        ? el('button', { type: 'button', class: 'merge-group-show', text: 'merged map', onclick: () => this.select(k, true) })
+        : 'merged map';
+      return el('li', { 'data-group': String(k) }, el('span', { text: `Group ${k + 1}: ` }), ...names, ' \u2014 ', show);
     }));
     this.tabs.replaceChildren(...mapped.map(([g, k]) => {
       const b = el('button', { type: 'button', role: 'tab', class: 'merge-group-tab', id: `merge-group-tab-${k}`,
@@ -128,12 +131,13 @@ export class GroupsView {
     return this.selected;
   }
 
-  /** Shows group `k` (a group with a merged map). */
-  select(k) {
+  /** Shows group `k` (a group with a merged map); `focus` moves the focus to its tab. */
+  select(k, focus = false) {
     if (!this.groups[k] || this.groups[k].robots.length < 2) return;
     this.selected = k;
     this.mark();
     this.hooks.select(k);
+    if (focus) this.tabs.querySelector(`[data-group="${k}"]`)?.focus();
   }
 
   mark() {
@@ -151,6 +155,7 @@ export class GroupsView {
     const to = { ArrowRight: at + 1, ArrowDown: at + 1, ArrowLeft: at - 1, ArrowUp: at - 1, Home: 0, End: tabs.length - 1 }[e.key];
     if (to === undefined || !tabs.length) return;
     e.preventDefault();
+    e.stopPropagation(); // the page's own arrow keys (Step, nudge) stay out of the tabs
     const b = tabs[(to + tabs.length) % tabs.length];
     this.select(Number(b.dataset.group));
     b.focus();
