@@ -24,7 +24,7 @@
 //! A robot nobody joined is a group of one, with the merge's reason; its
 //! "merged map" is its own map.
 
-use super::merge::{picture, pose3, pose_error, pose_of, round6, rounded, TransformError};
+use super::merge::{picture, pose_of, rounded, transform_error, TransformError};
 use super::Lab;
 use crate::geom::Pose2;
 use crate::merge::frames::MergeInput;
@@ -81,13 +81,7 @@ impl Lab {
                 .iter()
                 .filter_map(|t| {
                     let truth = first?.inverse().compose(&start(&t.robot)?);
-                    let (m, deg) = pose_error(&pose_of(t.pose), &truth);
-                    Some(TransformError {
-                        robot: t.robot.clone(),
-                        truth: pose3(&truth).map(round6),
-                        error_m: round6(m),
-                        error_deg: round6(deg),
-                    })
+                    Some(transform_error(t, &truth))
                 })
                 .collect();
             GroupView {

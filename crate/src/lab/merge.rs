@@ -139,7 +139,7 @@ pub struct TableView {
     pub best: Option<[u32; 2]>,
 }
 
-pub(super) fn pose3(p: &Pose2) -> [f64; 3] {
+fn pose3(p: &Pose2) -> [f64; 3] {
     [p.x, p.y, p.theta]
 }
 
@@ -147,7 +147,7 @@ pub(super) fn pose_of(p: [f64; 3]) -> Pose2 {
     Pose2::new(p[0], p[1], p[2])
 }
 
-pub(super) fn round6(x: f64) -> f64 {
+fn round6(x: f64) -> f64 {
     (x * 1e6).round() / 1e6
 }
 
@@ -168,6 +168,18 @@ pub fn pose_error(estimate: &Pose2, truth: &Pose2) -> (f64, f64) {
         (estimate.position() - truth.position()).length(),
         wrap_angle(estimate.theta - truth.theta).to_degrees(),
     )
+}
+
+/// The error of transform `t` against `truth` (the true pose of its map
+/// frame), rounded as the report gives it.
+pub(super) fn transform_error(t: &RobotTransform, truth: &Pose2) -> TransformError {
+    let (m, deg) = pose_error(&pose_of(t.pose), truth);
+    TransformError {
+        robot: t.robot.clone(),
+        truth: pose3(truth).map(round6),
+        error_m: round6(m),
+        error_deg: round6(deg),
+    }
 }
 
 impl Lab {
@@ -346,16 +358,7 @@ impl Lab {
         let errors = outcome
             .transforms
             .iter()
-            .filter_map(|t| {
-                let truth = truth_in_first(index(&t.robot)?);
-                let (m, deg) = pose_error(&pose_of(t.pose), &truth);
-                Some(TransformError {
-                    robot: t.robot.clone(),
-                    truth: pose3(&truth).map(round6),
-                    error_m: round6(m),
-                    error_deg: round6(deg),
-                })
-            })
+            .filter_map(|t| Some(transform_error(t, &truth_in_first(index(&t.robot)?))))
             .collect();
         let pair_errors = outcome
             .pairs
