@@ -118,6 +118,17 @@ test('several groups: the panel lists the CLI\u2019s groups, draws each group\u2
   assert.equal(await tabs.first().getAttribute('aria-selected'), 'true');
   assert.equal(await page.evaluate(() => document.activeElement.id), 'merge-group-tab-0');
 
+  // The Summary lists the groups and shows group 2's merged map.
+  await page.getByRole('button', { name: 'Summary of the run, printable' }).click();
+  await page.waitForFunction(() => !document.querySelector('#summary').hidden);
+  const lines = await page.locator('.summary-groups li').allInnerTexts();
+  assert.equal(lines.length, 3);
+  assert.match(lines[1], /^Group 2: robot3, robot4 — merged map in robot3’s frame \(worst error 0\.\d{3} m against the ground truth\)$/);
+  assert.ok(lines[2].startsWith(items[2]), lines[2]);
+  assert.equal(await page.locator('#summary img[alt="The merged map of group 2"]').count(), 1);
+  await page.keyboard.press('Escape');
+  await page.waitForFunction(() => document.querySelector('#summary').hidden);
+
   // A phone-sized screen keeps the list and the map readable.
   await page.setViewportSize({ width: 390, height: 844 });
   await page.locator('#merge-groups').scrollIntoViewIfNeeded();
