@@ -206,6 +206,8 @@ export class MergePanel {
     this.active = false;
     this.hold = false;
     this.view = null;
+    this.groupList = null;
+    this.group = 0;
     this.results = {};
     this.drawChart();
     this.matchTable.reset();
@@ -253,6 +255,8 @@ export class MergePanel {
       this.hold = false;
       this.active = true;
       this.view = null;
+      this.groupList = null;
+      this.group = 0;
       this.result.hidden = true;
       this.matchTable.reset();
       this.tableBox.hidden = this.method === 'map-only';
