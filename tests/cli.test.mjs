@@ -2,20 +2,11 @@
 // Run by ./build.sh test after ./build.sh build.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawnSync } from 'node:child_process';
-import { mkdtempSync, mkdirSync, writeFileSync, readFileSync } from 'node:fs';
-import { tmpdir } from 'node:os';
+import { mkdirSync, writeFileSync, readFileSync } from 'node:fs';
 import path from 'node:path';
-import { fileURLToPath } from 'node:url';
+import { CLI as cli, ROOT as root, runCli as run, tempDir } from './support/cli.mjs';
 
-const root = path.join(path.dirname(fileURLToPath(import.meta.url)), '..');
-const cli = path.join(root, 'web', 'cli.mjs');
-const tmp = mkdtempSync(path.join(tmpdir(), 'slamlab-cli-'));
-
-function run(...args) {
-  const r = spawnSync(process.execPath, [cli, ...args], { cwd: root, encoding: 'utf8', maxBuffer: 1 << 28 });
-  return { code: r.status, stdout: r.stdout, stderr: r.stderr };
-}
+const tmp = tempDir('cli');
 
 function scenarioFile(name, obj) {
   const p = path.join(tmp, name);

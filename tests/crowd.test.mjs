@@ -12,21 +12,12 @@
 //   finds every overlapping group, checked the same way.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawnSync } from 'node:child_process';
-import { mkdtempSync, writeFileSync } from 'node:fs';
-import { tmpdir } from 'node:os';
+import { writeFileSync } from 'node:fs';
 import path from 'node:path';
-import { fileURLToPath } from 'node:url';
 import { crowdMaze } from './bench/crowd_maze.mjs';
+import { runCli as run, tempDir } from './support/cli.mjs';
 
-const root = path.join(path.dirname(fileURLToPath(import.meta.url)), '..');
-const cli = path.join(root, 'web', 'cli.mjs');
-const tmp = mkdtempSync(path.join(tmpdir(), 'slamlab-crowd-'));
-
-function run(...args) {
-  const r = spawnSync(process.execPath, [cli, ...args], { cwd: root, encoding: 'utf8', maxBuffer: 1 << 28 });
-  return { code: r.status, stdout: r.stdout, stderr: r.stderr };
-}
+const tmp = tempDir('crowd');
 
 /** A report without its wall-clock timings. */
 function strip(text) {

@@ -18,16 +18,12 @@
 // all on a 2-core machine. Alone: node --test tests/exercises.test.mjs
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawnSync } from 'node:child_process';
-import { existsSync, mkdtempSync, readFileSync, readdirSync, writeFileSync } from 'node:fs';
-import { tmpdir } from 'node:os';
+import { existsSync, readFileSync, readdirSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
-import { fileURLToPath } from 'node:url';
+import { ROOT as root, runCli, tempDir } from './support/cli.mjs';
 
-const root = path.join(path.dirname(fileURLToPath(import.meta.url)), '..');
-const cli = path.join(root, 'web', 'cli.mjs');
 const docs = path.join(root, 'docs', 'exercises');
-const tmp = mkdtempSync(path.join(tmpdir(), 'slamlab-exercises-'));
+const tmp = tempDir('exercises');
 
 /** The side sonars sit this far from the robot's centre (crate/src/sensors/sonar.rs):
  *  a follower holding `distance` on the sonar keeps its centre this much further. */
@@ -46,12 +42,8 @@ function scenariosOf(text) {
 
 /** Runs `web/cli.mjs run FILE --json ARGS…` and returns the parsed report. */
 function run(file, ...args) {
-  const r = spawnSync(process.execPath, [cli, 'run', file, '--json', ...args], {
-    cwd: root,
-    encoding: 'utf8',
-    maxBuffer: 1 << 29,
-  });
-  assert.equal(r.status, 0, `run ${file} ${args.join(' ')} exited ${r.status}: ${r.stderr}`);
+  const r = runCli('run', file, '--json', ...args);
+  assert.equal(r.code, 0, `run ${file} ${args.join(' ')} exited ${r.code}: ${r.stderr}`);
   return JSON.parse(r.stdout);
 }
 

@@ -5,20 +5,13 @@
 // and --out. Run by ./build.sh test after ./build.sh build.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawnSync } from 'node:child_process';
-import { mkdtempSync, writeFileSync, existsSync, readFileSync } from 'node:fs';
-import { tmpdir } from 'node:os';
+import { writeFileSync, existsSync, readFileSync } from 'node:fs';
 import path from 'node:path';
-import { fileURLToPath } from 'node:url';
+import { runCli, tempDir } from './support/cli.mjs';
 
-const root = path.join(path.dirname(fileURLToPath(import.meta.url)), '..');
-const cli = path.join(root, 'web', 'cli.mjs');
-const tmp = mkdtempSync(path.join(tmpdir(), 'slamlab-maps-'));
+const tmp = tempDir('maps');
 
-function run(...args) {
-  const r = spawnSync(process.execPath, [cli, 'merge-maps', ...args], { cwd: root, encoding: 'utf8', maxBuffer: 1 << 28 });
-  return { code: r.status, stdout: r.stdout, stderr: r.stderr };
-}
+const run = (...args) => runCli('merge-maps', ...args);
 
 /** Distance from point p to segment [a, b]. */
 function segDist([px, py], [[ax, ay], [bx, by]]) {

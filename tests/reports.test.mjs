@@ -17,14 +17,11 @@
 // Run by ./build.sh test after ./build.sh build (about 20 runs of 1-3 s).
 import { after, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawnSync } from 'node:child_process';
 import { createHash } from 'node:crypto';
 import { existsSync, readFileSync, readdirSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
-import { fileURLToPath } from 'node:url';
+import { ROOT as root, runCli } from './support/cli.mjs';
 
-const root = path.join(path.dirname(fileURLToPath(import.meta.url)), '..');
-const cli = path.join(root, 'web', 'cli.mjs');
 const goldenFile = path.join(root, 'tests', 'golden', 'reports.json');
 const update = process.env.UPDATE_GOLDEN === '1';
 
@@ -65,12 +62,8 @@ const recorded = {};
 for (const args of runs) {
   const key = args.join(' ');
   test(`run ${key}: report identical to the recorded one`, () => {
-    const r = spawnSync(process.execPath, [cli, 'run', ...args, '--json'], {
-      cwd: root,
-      encoding: 'utf8',
-      maxBuffer: 1 << 30,
-    });
-    assert.equal(r.status, 0, `run ${key} exited ${r.status}: ${r.stderr}`);
+    const r = runCli('run', ...args, '--json');
+    assert.equal(r.code, 0, `run ${key} exited ${r.code}: ${r.stderr}`);
     const report = JSON.parse(r.stdout);
     const sha256 = createHash('sha256').update(JSON.stringify(withoutTimings(report))).digest('hex');
     const entry = { sha256, ...headline(report) };

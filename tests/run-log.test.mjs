@@ -4,21 +4,12 @@
 // Run by ./build.sh test after ./build.sh build.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawnSync } from 'node:child_process';
-import { mkdtempSync, writeFileSync, readFileSync, existsSync } from 'node:fs';
+import { writeFileSync, readFileSync, existsSync } from 'node:fs';
 import { gzipSync } from 'node:zlib';
-import { tmpdir } from 'node:os';
 import path from 'node:path';
-import { fileURLToPath } from 'node:url';
+import { CLI as cli, ROOT as root, runCli as run, tempDir } from './support/cli.mjs';
 
-const root = path.join(path.dirname(fileURLToPath(import.meta.url)), '..');
-const cli = path.join(root, 'web', 'cli.mjs');
-const tmp = mkdtempSync(path.join(tmpdir(), 'slamlab-runlog-'));
-
-function run(...args) {
-  const r = spawnSync(process.execPath, [cli, ...args], { cwd: root, encoding: 'utf8', maxBuffer: 1 << 28 });
-  return { code: r.status, stdout: r.stdout, stderr: r.stderr };
-}
+const tmp = tempDir('runlog');
 
 // A 12 x 8 m room with two pillars: wall segments [x1, y1, x2, y2].
 const walls = [

@@ -263,6 +263,24 @@ export class Lab {
     return this.raw.mergedYaml(image);
   }
 
+  /** Every group of robots the merge joined, each in its first robot's frame,
+   *  with its errors against the truth: `[{group, robots, transforms, reason?, errors}]`. */
+  mergeGroups() {
+    return JSON.parse(this.raw.mergeGroupsJson());
+  }
+
+  drawGroupMerged(ctx, group, width, height) {
+    this.raw.drawGroupMerged(ctx, group, width, height);
+  }
+
+  groupMergedPgm(group) {
+    return this.raw.groupMergedPgm(group);
+  }
+
+  groupMergedYaml(group, image) {
+    return this.raw.groupMergedYaml(group, image);
+  }
+
   // --- Describing frames in other threads (web/cli/describe-pool.mjs) ----------------
 
   /** Frames a merge with `method` would describe that are not yet: `[{robot, index}]`. */

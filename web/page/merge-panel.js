@@ -15,6 +15,10 @@
 // ground truth puts more than 0.5 m or 5° off is called a wrong merge, in
 // red, however confident the method was (web/page/merge-words.js).
 //
+// With several groups of robots (issue 22), a list names them and tabs
+// pick the group whose merged map, transforms and downloads the panel
+// shows (web/page/merge-groups.js); robot 1's group is the report's own.
+//
 // The panel remembers each method's result on the current run, and a small
 // chart compares their transform errors (position and heading against the
 // ground truth) as the user merges with one method after another; a new run
@@ -27,6 +31,7 @@ import { PairView } from './pair-view.js';
 import { MatchTable } from './match-table.js';
 import { fitCanvas } from './hidpi.js';
 import { isWrong, plainReason, verdictTitle, worstError, wrongMerge, wrongWords } from './merge-words.js';
+import { GroupsView, groupsReason, groupsStatus, showsGroups } from './merge-groups.js';
 
 const SLICE_MS = 12;
 const MAP_W = 330;
@@ -95,17 +100,26 @@ export class MergePanel {
     // Robots do not know the world frame, so neither does the merge: say
     // why the merged map can look turned against the maze view.
     this.mapNote = el('p', { class: 'hint merge-map-note' });
+    this.mapLegend = el('div', { id: 'merge-map-legend', class: 'merge-legend merge-map-legend', hidden: '' });
+    this.groups = new GroupsView({
+      select: (k) => this.showGroup(k),
+      index: (name) => this.view?.robots.findIndex((x) => x.name === name) ?? 0,
+    });
+    this.group = 0; // the group whose map the panel shows (0: robot 1's, the report's own)
+    this.groupList = null; // lab.mergeGroups() when the panel lists the groups
     this.downloads = el('div', { class: 'merge-downloads' });
     for (const [label, fn] of [
       // The picture the panel shows (map and every robot's path), at 4 × its size.
       ['Merged map PNG', () => {
         const c = el('canvas', { width: String(4 * MAP_W), height: String(4 * MAP_H) });
-        this.lab().drawMerged(c.getContext('2d'), c.width, c.height);
-        c.toBlob((blob) => this.hooks.download('merged.png', blob, 'image/png'), 'image/png');
+        this.drawGroup(this.group, c.getContext('2d'), c.width, c.height);
+        c.toBlob((blob) => this.hooks.download(`${this.fileStem()}.png`, blob, 'image/png'), 'image/png');
       }],
       ['ROS map (PGM + YAML)', () => {
-        this.hooks.download('merged.pgm', this.lab().mergedPgm(), 'image/x-portable-graymap');
-        this.hooks.download('merged.yaml', this.lab().mergedYaml('merged.pgm'), 'text/yaml');
+        const [k, stem] = [this.group, this.fileStem()];
+        const lab = this.lab();
+        this.hooks.download(`${stem}.pgm`, k > 0 ? lab.groupMergedPgm(k) : lab.mergedPgm(), 'image/x-portable-graymap');
+        this.hooks.download(`${stem}.yaml`, k > 0 ? lab.groupMergedYaml(k, `${stem}.pgm`) : lab.mergedYaml(`${stem}.pgm`), 'text/yaml');
       }],
       ['Report JSON', () => this.hooks.download('report.json', this.hooks.report(), 'application/json')],
     ]) {
@@ -119,7 +133,8 @@ export class MergePanel {
       });
       this.downloads.append(b);
     }
-    this.result = el('div', { class: 'merge-result', hidden: '' }, this.verdict, this.distance, this.transforms, this.map, this.mapNote, this.downloads);
+    this.result = el('div', { class: 'merge-result', hidden: '' }, this.verdict, this.groups.box, this.distance,
+      this.transforms, this.map, this.mapLegend, this.mapNote, this.downloads);
     this.chart = el('canvas', {
       id: 'merge-methods-chart', class: 'merge-chart', width: String(CHART_W), height: String(CHART_H),
       role: 'img', 'aria-label': 'Transform error of each method: no method has merged this run yet',
@@ -151,25 +166,39 @@ export class MergePanel {
   /**
    * What the run summary (web/page/summary.js) shows of the merge: the
    * report (null before a merge), the matched-pair table and the merged map
-   * as PNG data URLs, and every method's result on this run.
+   * as PNG data URLs, every method's result on this run, and with several
+   * groups the groups (`lab.mergeGroups()`) and the other groups' merged maps.
    */
   summary() {
     const view = this.view;
     if (!view) return { report: null, results: this.results };
-    let mergedImage = null;
-    if (view.report?.status === 'merged') {
+    const image = (k) => {
       const c = document.createElement('canvas');
       c.width = 480;
       c.height = 350;
-      this.lab().drawMerged(c.getContext('2d'), c.width, c.height);
-      mergedImage = c.toDataURL('image/png');
-    }
+      this.drawGroup(k, c.getContext('2d'), c.width, c.height);
+      return c.toDataURL('image/png');
+    };
+    const others = (this.groupList ?? []).filter((g) => g.group > 0 && g.robots.length > 1);
     return {
       report: view.report,
       tableImage: this.tableBox.hidden ? null : this.table.toDataURL('image/png'),
-      mergedImage,
+      mergedImage: view.report?.status === 'merged' ? image(0) : null,
+      groups: this.groupList,
+      groupImages: others.map((g) => ({ group: g.group, robots: g.robots, src: image(g.group) })),
       results: this.results,
     };
+  }
+
+  /** Draws group `k`'s merged map (0: the report's merged map) into `ctx`. */
+  drawGroup(k, ctx, width, height) {
+    if (k > 0) this.lab().drawGroupMerged(ctx, k, width, height);
+    else this.lab().drawMerged(ctx, width, height);
+  }
+
+  /** Download names: `merged` for robot 1's group, `merged-group2` for group 2. */
+  fileStem() {
+    return this.group > 0 ? `merged-group${this.group + 1}` : 'merged';
   }
 
   /** Called when the run changed: any merge of the old maps is gone. */
@@ -177,6 +206,8 @@ export class MergePanel {
     this.active = false;
     this.hold = false;
     this.view = null;
+    this.groupList = null;
+    this.group = 0;
     this.results = {};
     this.drawChart();
     this.matchTable.reset();
@@ -224,6 +255,8 @@ export class MergePanel {
       this.hold = false;
       this.active = true;
       this.view = null;
+      this.groupList = null;
+      this.group = 0;
       this.result.hidden = true;
       this.matchTable.reset();
       this.tableBox.hidden = this.method === 'map-only';
@@ -330,51 +363,87 @@ export class MergePanel {
     this.result.hidden = false;
     const merged = r.status === 'merged';
     const wrong = wrongMerge(r);
+    const several = showsGroups(r, this.view.robots.length);
+    const reason = several ? groupsReason(r) : plainReason(r.reason);
     this.verdict.className = `merge-verdict ${wrong ? 'wrong' : merged ? 'ok' : 'no'}`;
     this.verdict.replaceChildren(
       el('b', { text: verdictTitle(r, fmt) }),
       wrong ? el('span', { text: '. The method trusted what the robots saw; the ground truth, which it never sees, says ' +
-        `it joined the wrong places. Its reason: ${plainReason(r.reason)}` })
-        : el('span', { text: merged ? `: ${plainReason(r.reason)}` : `, because ${plainReason(r.reason)}` }),
+        `it joined the wrong places. Its reason: ${reason}` })
+        : el('span', { text: merged ? `: ${reason}` : `, because ${reason}` }),
     );
+    this.showDistance(r);
+    this.groupList = null;
+    let first = merged ? 0 : -1;
+    if (several) {
+      try {
+        this.groupList = this.lab().mergeGroups();
+        first = this.groups.show(r);
+      } catch (e) {
+        this.hooks.onError(e);
+      }
+    } else {
+      this.groups.hide();
+    }
+    this.showGroup(first);
+    this.remember(r);
+    this.hooks.setStatus(
+      wrong ? `Wrong merge: ${wrongWords(wrong)} (against the ground truth), though the method reports success.`
+        : this.groupList ? groupsStatus(r) : merged ? `Maps merged: ${r.transforms.length} robots joined.` : `No merge: ${plainReason(r.reason)}`,
+      wrong ? 'error' : merged || first >= 0 ? 'ok' : 'warn',
+    );
+  }
+
+  /**
+   * Shows group `k`'s transforms, merged map and downloads: 0 is robot 1's
+   * group (the report's own transforms and errors), -1 none (no group has a
+   * merged map).
+   */
+  showGroup(k) {
+    const r = this.view?.report;
+    if (!r) return;
+    this.group = Math.max(0, k);
+    const has = k >= 0;
+    const g = k > 0 ? this.groupList?.[k] : null;
+    const transforms = g ? g.transforms : r.transforms;
+    const errors = g ? g.errors : r.errors;
+    const first = transforms[0]?.robot ?? 'the first robot';
     const head = el('tr', {}, ...['robot', 'x (m)', 'y (m)', 'θ (°)', 'error'].map((t) => el('th', { text: t })));
-    const rows = r.transforms.map((t) => {
-      const e = r.errors.find((x) => x.robot === t.robot);
+    const rows = transforms.map((t) => {
+      const e = errors.find((x) => x.robot === t.robot);
       const i = this.view.robots.findIndex((x) => x.name === t.robot);
       const name = el('td', { text: t.robot });
       name.style.color = robotColour(i);
       return el('tr', {}, name, el('td', { text: fmt(t.pose[0]) }), el('td', { text: fmt(t.pose[1]) }),
         el('td', { text: fmt(deg(t.pose[2]), 1) }),
-        el('td', { class: isWrong(e) && i > 0 ? 'bad' : '', text: e ? `${fmt(e.error_m, 3)} m, ${fmt(e.error_deg, 2)}°` : '–' }));
+        el('td', { class: isWrong(e) && t.robot !== first ? 'bad' : '', text: e ? `${fmt(e.error_m, 3)} m, ${fmt(e.error_deg, 2)}°` : '–' }));
     });
     this.transforms.replaceChildren(
-      el('caption', { text: 'Each robot\u2019s map frame in the merged frame (the first robot\u2019s); error against the ground truth' }),
+      el('caption', { text: g ? `Group ${k + 1}: each robot’s map frame in the group’s merged frame (${first}’s); error against the ground truth`
+        : 'Each robot’s map frame in the merged frame (the first robot’s); error against the ground truth' }),
       head, ...rows);
-    this.transforms.hidden = !merged;
-    this.showDistance(r);
-    this.map.hidden = !merged;
-    this.mapNote.hidden = !merged;
-    const first = r.transforms[0]?.robot ?? 'the first robot';
-    this.mapNote.textContent = `Drawn in ${first}\u2019s map frame (its start is the origin, its start heading ` +
-      'points right), not the world\u2019s: robots never learn the world frame, so the map may look turned ' +
+    this.transforms.hidden = !has;
+    this.map.hidden = !has;
+    this.mapNote.hidden = !has;
+    this.map.setAttribute('aria-label', g ? `Merged map of group ${k + 1}: ${transforms.map((t) => t.robot).join(', ')}` : 'Merged map');
+    this.mapNote.textContent = `Drawn in ${first}’s map frame (its start is the origin, its start heading ` +
+      'points right), not the world’s: robots never learn the world frame, so the map may look turned ' +
       'against the maze view.';
-    this.downloads.querySelectorAll('button').forEach((b, k) => {
-      b.hidden = !merged && k < 2;
+    this.mapLegend.hidden = !has || !this.groupList;
+    this.mapLegend.replaceChildren(...(this.groupList && has ? this.groups.legend(this.group) : []));
+    this.downloads.querySelectorAll('button').forEach((b, n) => {
+      b.hidden = !has && n < 2;
     });
-    if (merged) {
-      try {
-        fitCanvas(this.map, MAP_W, MAP_H);
-        this.lab().drawMerged(this.map.getContext('2d'), this.map.width, this.map.height);
-      } catch (e) {
-        this.hooks.onError(e);
-      }
+    const [png, ros] = this.downloads.querySelectorAll('button');
+    png.textContent = g ? `Group ${k + 1} map PNG` : 'Merged map PNG';
+    ros.textContent = g ? `Group ${k + 1} ROS map (PGM + YAML)` : 'ROS map (PGM + YAML)';
+    if (!has) return;
+    try {
+      fitCanvas(this.map, MAP_W, MAP_H);
+      this.drawGroup(this.group, this.map.getContext('2d'), this.map.width, this.map.height);
+    } catch (e) {
+      this.hooks.onError(e);
     }
-    this.remember(r);
-    this.hooks.setStatus(
-      wrong ? `Wrong merge: ${wrongWords(wrong)} (against the ground truth), though the method reports success.`
-        : merged ? `Maps merged: ${r.transforms.length} robots joined.` : `No merge: ${plainReason(r.reason)}`,
-      wrong ? 'error' : merged ? 'ok' : 'warn',
-    );
   }
 
   /** Keeps this method's result for the comparison chart. With more than

@@ -18,6 +18,7 @@
 import { deg, el, fmt } from './dom.js';
 import { message, setStatus } from './status.js';
 import { isWrong, plainReason, verdictTitle, wrongMerge } from './merge-words.js';
+import { aloneReason } from './merge-groups.js';
 
 const pct = (x) => (Number.isFinite(x) ? `${(100 * x).toFixed(0)} %` : '–');
 
@@ -33,6 +34,21 @@ function figure(src, alt, caption, cls = '') {
   return el('figure', { class: cls }, el('img', { src, alt }), el('figcaption', { text: caption }));
 }
 
+/** With several groups of robots: the list, and each other group's merged map. */
+function groupParts(m) {
+  const line = (g) => (g.robots.length > 1
+    ? `Group ${g.group + 1}: ${g.robots.join(', ')} \u2014 merged map in ${g.robots[0]}\u2019s frame` +
+      ` (worst error ${fmt(Math.max(...g.errors.map((e) => e.error_m)), 3)} m against the ground truth)`
+    : `${g.robots[0]} alone: ${aloneReason(g)}`);
+  return [
+    el('h3', { text: `The robots form ${m.groups.length} groups` }),
+    el('ul', { class: 'summary-groups' }, ...m.groups.map((g) => el('li', { text: line(g) }))),
+    el('div', { class: 'summary-figures' }, ...m.groupImages.map((g) =>
+      figure(g.src, `The merged map of group ${g.group + 1}`,
+        `Group ${g.group + 1}\u2019s merged map (${g.robots.join(', ')}), in ${g.robots[0]}\u2019s frame.`))),
+  ];
+}
+
 const METHOD_NAMES = { auto: 'Automatic', thesis: 'Thesis §6.2', 'map-only': 'Map-only baseline' };
 
 /**
@@ -40,7 +56,8 @@ const METHOD_NAMES = { auto: 'Automatic', thesis: 'Thesis §6.2', 'map-only': 'M
  * {scenario, link, when: Date, run: {time_s, finished, steps},
  *  robots: [{name, follow, distance, frames, bumps, figures}],
  *  worldImage, plots: [{name, src}],
- *  merge: null | {report, view, tableImage, mergedImage, chartImage, results}}
+ *  merge: null | {report, view, tableImage, mergedImage, chartImage, results,
+ *                 groups?: [{group, robots, reason?, errors}], groupImages?: [{group, robots, src}]}}
  */
 export function buildSummary(host, data, { onPrint, onClose }) {
   const s = data.scenario;
@@ -111,6 +128,7 @@ export function buildSummary(host, data, { onPrint, onClose }) {
     parts.push(el('div', { class: 'summary-figures' },
       figure(m.tableImage, 'The matched-pair table', 'Matched-pair table: inliers per frame pair (orange: the best pair).'),
       figure(m.mergedImage, 'The merged map', 'The merged map with every joined robot\u2019s path.')));
+    if (m.groups) parts.push(...groupParts(m));
   }
   const results = m?.results ?? {};
   const ran = Object.keys(METHOD_NAMES).filter((k) => results[k]);

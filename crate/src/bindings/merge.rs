@@ -209,4 +209,63 @@ impl Lab {
     pub fn merged_png(&self) -> Result<Vec<u8>, JsError> {
         self.inner.merged_png().map_err(err)
     }
+
+    /// Every group of robots the finished merge joined, as JSON: `[{group,
+    /// robots, transforms, reason (groups of one), errors}]`, each group in
+    /// the frame of its first robot, robot 1's group first, with each
+    /// member's error against the ground truth (`crate::lab::groups`).
+    #[wasm_bindgen(js_name = mergeGroupsJson)]
+    pub fn merge_groups_json(&self) -> Result<String, JsError> {
+        json(&self.inner.merge_groups().map_err(err)?)
+    }
+
+    /// Draws group `group`'s merged map, fitted, with its robots' paths,
+    /// into a canvas context of `width × height`.
+    #[wasm_bindgen(js_name = drawGroupMerged)]
+    pub fn draw_group_merged(
+        &self,
+        ctx: &web_sys::CanvasRenderingContext2d,
+        group: u32,
+        width: u32,
+        height: u32,
+    ) -> Result<(), JsError> {
+        let rgba = self
+            .inner
+            .group_merged_rgba(group as usize, width, height)
+            .map_err(err)?;
+        put_rgba(ctx, &rgba, width, height)
+    }
+
+    /// Group `group`'s merged map as straight RGBA pixels (for node and tests).
+    #[wasm_bindgen(js_name = groupMergedRgba)]
+    pub fn group_merged_rgba(
+        &self,
+        group: u32,
+        width: u32,
+        height: u32,
+    ) -> Result<Vec<u8>, JsError> {
+        self.inner
+            .group_merged_rgba(group as usize, width, height)
+            .map_err(err)
+    }
+
+    /// Group `group`'s merged map as ROS map_server files: binary PGM ...
+    #[wasm_bindgen(js_name = groupMergedPgm)]
+    pub fn group_merged_pgm(&self, group: u32) -> Result<Vec<u8>, JsError> {
+        self.inner.group_merged_pgm(group as usize).map_err(err)
+    }
+
+    /// ... the YAML naming `image` ...
+    #[wasm_bindgen(js_name = groupMergedYaml)]
+    pub fn group_merged_yaml(&self, group: u32, image: &str) -> Result<String, JsError> {
+        self.inner
+            .group_merged_yaml(group as usize, image)
+            .map_err(err)
+    }
+
+    /// ... and a PNG of the same pixels.
+    #[wasm_bindgen(js_name = groupMergedPng)]
+    pub fn group_merged_png(&self, group: u32) -> Result<Vec<u8>, JsError> {
+        self.inner.group_merged_png(group as usize).map_err(err)
+    }
 }

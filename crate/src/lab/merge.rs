@@ -148,7 +148,7 @@ fn pose3(p: &Pose2) -> [f64; 3] {
     [p.x, p.y, p.theta]
 }
 
-fn pose_of(p: [f64; 3]) -> Pose2 {
+pub(super) fn pose_of(p: [f64; 3]) -> Pose2 {
     Pose2::new(p[0], p[1], p[2])
 }
 
@@ -157,7 +157,7 @@ fn round6(x: f64) -> f64 {
 }
 
 /// Transforms with their poses rounded for the report.
-fn rounded(transforms: &[RobotTransform]) -> Vec<RobotTransform> {
+pub(super) fn rounded(transforms: &[RobotTransform]) -> Vec<RobotTransform> {
     transforms
         .iter()
         .map(|t| RobotTransform {
@@ -173,6 +173,18 @@ pub fn pose_error(estimate: &Pose2, truth: &Pose2) -> (f64, f64) {
         (estimate.position() - truth.position()).length(),
         wrap_angle(estimate.theta - truth.theta).to_degrees(),
     )
+}
+
+/// The error of transform `t` against `truth` (the true pose of its map
+/// frame), rounded as the report gives it.
+pub(super) fn transform_error(t: &RobotTransform, truth: &Pose2) -> TransformError {
+    let (m, deg) = pose_error(&pose_of(t.pose), truth);
+    TransformError {
+        robot: t.robot.clone(),
+        truth: pose3(truth).map(round6),
+        error_m: round6(m),
+        error_deg: round6(deg),
+    }
 }
 
 impl Lab {
@@ -351,16 +363,7 @@ impl Lab {
         let errors = outcome
             .transforms
             .iter()
-            .filter_map(|t| {
-                let truth = truth_in_first(index(&t.robot)?);
-                let (m, deg) = pose_error(&pose_of(t.pose), &truth);
-                Some(TransformError {
-                    robot: t.robot.clone(),
-                    truth: pose3(&truth).map(round6),
-                    error_m: round6(m),
-                    error_deg: round6(deg),
-                })
-            })
+            .filter_map(|t| Some(transform_error(t, &truth_in_first(index(&t.robot)?))))
             .collect();
         let pair_errors = outcome
             .pairs
@@ -544,28 +547,41 @@ impl Lab {
         let sim = self.simulation().ok_or("nothing has run yet")?;
         let job = self.merge.as_ref().ok_or("no merge has been started")?;
         let outcome = job.outcome().ok_or("the merge has not finished yet")?;
-        let mut pic = GridPicture::new(g, width, height)?;
-        if g.width() == 0 {
-            return Ok(pic.into_rgba());
-        }
-        for t in &outcome.transforms {
-            let Some(i) = sim.robots.iter().position(|r| r.spec.name == t.robot) else {
-                continue;
-            };
-            let frame = pose_of(t.pose);
-            let est = sim.robots[i].mapping.estimates();
-            let path: Vec<DVec2> = est
-                .iter()
-                .map(|p| frame.transform_point(p.position()))
-                .collect();
-            let [r, gr, b] = crate::palette::robot_colour(i);
-            pic.polyline(&path, [r, gr, b, 220], 1.5);
-            if let Some(last) = est.last() {
-                pic.dot(frame.compose(last).position(), 4.0, [r, gr, b, 220]);
-            }
-        }
-        Ok(pic.into_rgba())
+        picture(sim, g, &outcome.transforms, width, height)
     }
+}
+
+/// The grid `g` fitted to `width × height` as RGBA pixels, with the SLAM
+/// path of each robot of `transforms` (its map frame placed at its pose in
+/// `g`'s frame) in the robot's colour, and a dot where it stands.
+pub(super) fn picture(
+    sim: &crate::sim::Simulation,
+    g: &OccupancyGrid,
+    transforms: &[RobotTransform],
+    width: u32,
+    height: u32,
+) -> Result<Vec<u8>, String> {
+    let mut pic = GridPicture::new(g, width, height)?;
+    if g.width() == 0 {
+        return Ok(pic.into_rgba());
+    }
+    for t in transforms {
+        let Some(i) = sim.robots.iter().position(|r| r.spec.name == t.robot) else {
+            continue;
+        };
+        let frame = pose_of(t.pose);
+        let est = sim.robots[i].mapping.estimates();
+        let path: Vec<DVec2> = est
+            .iter()
+            .map(|p| frame.transform_point(p.position()))
+            .collect();
+        let [r, gr, b] = crate::palette::robot_colour(i);
+        pic.polyline(&path, [r, gr, b, 220], 1.5);
+        if let Some(last) = est.last() {
+            pic.dot(frame.compose(last).position(), 4.0, [r, gr, b, 220]);
+        }
+    }
+    Ok(pic.into_rgba())
 }
 
 /// Size, resolution and origin of the merged map.

@@ -16,6 +16,7 @@
 //! |---|---|
 //! | `mod.rs` | the scenario, the run, the top view, the camera, frames and logs |
 //! | [`merge`] | merging the run's maps, the merge's views, scoring it against the truth |
+//! | [`groups`] | each group of robots the merge joined: its merged map, its errors |
 //! | [`described`] | a stored frame's parts, for another lab to render and describe |
 //! | [`maps`] | a robot's maps as files and pictures, their figures against the truth |
 //! | [`report`] | the JSON report of a run (`web/cli.mjs run --json`) |
@@ -37,6 +38,7 @@ use std::fmt::Write;
 use tiny_skia::Pixmap;
 
 pub mod described;
+pub mod groups;
 pub mod maps;
 pub mod merge;
 pub mod report;
