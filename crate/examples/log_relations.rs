@@ -7,38 +7,14 @@
 //! each corrected log with drifting odometry against its own poses.
 //!
 //! `SLAMLAB_LOG_SLAM="key_sigma_m=0.1,loop_every=1"` changes settings of
-//! `LogSlamConfig` for an experiment (the names below); the figures in
+//! `LogSlamConfig` for an experiment (the names in `tests/real_support`); the figures in
 //! BENCHMARKS.md use the defaults unless they say otherwise.
-
-use slamlab::slam::logslam::LogSlamConfig;
 
 #[path = "../../tests/real_support/mod.rs"]
 mod support;
 
-/// The defaults with the overrides of `$SLAMLAB_LOG_SLAM`.
-fn config() -> LogSlamConfig {
-    let mut cfg = LogSlamConfig::default();
-    let Ok(list) = std::env::var("SLAMLAB_LOG_SLAM") else {
-        return cfg;
-    };
-    for item in list.split(',').filter(|s| !s.is_empty()) {
-        let (key, value) = item.split_once('=').expect("SLAMLAB_LOG_SLAM: key=value");
-        let v: f64 = value.parse().expect("SLAMLAB_LOG_SLAM: a number");
-        match key {
-            "key_sigma_m" => cfg.key_sigma_m = v,
-            "key_sigma_deg" => cfg.key_sigma_rad = v.to_radians(),
-            "loop_sigma_m" => cfg.loops.sigma_m = v,
-            "loop_sigma_deg" => cfg.loops.sigma_rad = v.to_radians(),
-            "loop_every" => cfg.loop_every = v as usize,
-            _ => panic!("SLAMLAB_LOG_SLAM: unknown setting {key}"),
-        }
-    }
-    println!("settings: {list}");
-    cfg
-}
-
 fn main() {
-    let cfg = config();
+    let cfg = support::config_from_env();
     let args: Vec<String> = std::env::args().skip(1).collect();
     let all = [
         "mit-csail.clf.gz",

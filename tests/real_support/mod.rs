@@ -154,3 +154,32 @@ pub fn table(name: &str, o: &Outcome) -> String {
     }
     s
 }
+
+/// The defaults with the overrides of `$SLAMLAB_LOG_SLAM`.
+pub fn config_from_env() -> LogSlamConfig {
+    let mut cfg = LogSlamConfig::default();
+    let Ok(list) = std::env::var("SLAMLAB_LOG_SLAM") else {
+        return cfg;
+    };
+    for item in list.split(',').filter(|s| !s.is_empty()) {
+        let (key, value) = item.split_once('=').expect("SLAMLAB_LOG_SLAM: key=value");
+        let v: f64 = value.parse().expect("SLAMLAB_LOG_SLAM: a number");
+        match key {
+            "key_sigma_m" => cfg.key_sigma_m = v,
+            "key_sigma_deg" => cfg.key_sigma_rad = v.to_radians(),
+            "loop_sigma_m" => cfg.loops.sigma_m = v,
+            "loop_sigma_deg" => cfg.loops.sigma_rad = v.to_radians(),
+            "loop_every" => cfg.loop_every = v as usize,
+            "loop_min_score" => cfg.loops.min_score = v,
+            "confirm_m" => cfg.confirm_m = v,
+            "confirm_deg" => cfg.confirm_rad = v.to_radians(),
+            "max_closure_chi2" => cfg.max_closure_chi2 = v,
+            "dcs_phi" => cfg.dcs_phi = v,
+            "velocity_prior" => cfg.velocity_prior = v != 0.0,
+            "dcs_incremental" => cfg.dcs_incremental = v != 0.0,
+            _ => panic!("SLAMLAB_LOG_SLAM: unknown setting {key}"),
+        }
+    }
+    println!("settings: {list}");
+    cfg
+}

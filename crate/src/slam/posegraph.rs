@@ -99,6 +99,26 @@ fn linearise(nodes: &[Pose2], e: &Edge) -> ([f64; 3], [[f64; 3]; 3], [[f64; 3]; 
     (err, a, b)
 }
 
+/// The information of edge `e` in one Gauss–Newton step: as measured, or
+/// for a loop closure under Dynamic Covariance Scaling with `phi`, scaled
+/// by `s² = min(1, 2Φ / (Φ + χ²))²` (Agarwal et al. 2013, eq. 15).
+fn dcs_information(e: &Edge, err: &[f64; 3], phi: Option<f64>) -> [[f64; 3]; 3] {
+    let mut w = e.information;
+    let Some(phi) = phi.filter(|_| e.loop_closure) else {
+        return w;
+    };
+    let chi2: f64 = (0..3)
+        .map(|r| (0..3).map(|c| err[r] * w[r][c] * err[c]).sum::<f64>())
+        .sum();
+    let s = (2.0 * phi / (phi + chi2)).min(1.0);
+    for row in &mut w {
+        for v in row.iter_mut() {
+            *v *= s * s;
+        }
+    }
+    w
+}
+
 fn mul_t(a: &[[f64; 3]; 3], w: &[[f64; 3]; 3], b: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
     let mut out = [[0.0; 3]; 3];
     for r in 0..3 {
@@ -135,12 +155,24 @@ impl PoseGraph {
     /// steps taken, or an error if the system is singular (a node without
     /// any edge).
     pub fn optimise(&mut self, iterations: usize) -> Result<usize, String> {
+        self.optimise_robust(iterations, None)
+    }
+
+    /// [`PoseGraph::optimise`] with Dynamic Covariance Scaling of the loop
+    /// closures when `phi` is given (see the module doc): each step weighs
+    /// a closure's information by `s²`, `s = min(1, 2Φ / (Φ + χ²))` at the
+    /// current poses.
+    pub fn optimise_robust(
+        &mut self,
+        iterations: usize,
+        phi: Option<f64>,
+    ) -> Result<usize, String> {
         let n = self.nodes.len();
         if n < 2 {
             return Ok(0);
         }
         for it in 0..iterations {
-            let (h, b) = self.normal_equations();
+            let (h, b) = self.normal_equations(phi);
             let dim = 3 * (n - 1);
             let triplets: Vec<Triplet<usize, usize, f64>> = h
                 .iter()
@@ -181,7 +213,10 @@ impl PoseGraph {
     /// `H` as 3 × 3 blocks (lower triangle, unknown `k − 1` for node `k`)
     /// and `b`.
     #[allow(clippy::type_complexity)]
-    fn normal_equations(&self) -> (BTreeMap<(usize, usize), [[f64; 3]; 3]>, Vec<f64>) {
+    fn normal_equations(
+        &self,
+        phi: Option<f64>,
+    ) -> (BTreeMap<(usize, usize), [[f64; 3]; 3]>, Vec<f64>) {
         let n = self.nodes.len();
         let mut h: BTreeMap<(usize, usize), [[f64; 3]; 3]> = BTreeMap::new();
         let mut b = vec![0.0; 3 * (n - 1)];
@@ -195,7 +230,7 @@ impl PoseGraph {
         }
         for e in &self.edges {
             let (err, ja, jb) = linearise(&self.nodes, e);
-            let w = &e.information;
+            let w = &dcs_information(e, &err, phi);
             let parts = [(e.from, ja), (e.to, jb)];
             for &(p, jp) in &parts {
                 if p == 0 {

@@ -1,0 +1,137 @@
+//! Where the log SLAM goes wrong, per log: every accepted loop closure's
+//! measured relative pose compared with the reference's, and the key-to-key
+//! edges of the front end (successive scan matching) that disagree with the
+//! reference by more than 0.1 m or 1°.
+//!
+//! `cargo run --release -p slamlab --example log_closures [LOG ...]`
+//!
+//! The reference is the corrected logs' own poses (replayed with the same
+//! drifting odometry as `log_relations`), and GMapping's poses for the raw
+//! MIT CSAIL log, where a key scan without a GMapping pose takes the nearest
+//! scan's that has one, moved by our own estimate between the two (a few
+//! scans apart: locally accurate). `SLAMLAB_LOG_SLAM` as in `log_relations`.
+
+use slamlab::geom::Pose2;
+use slamlab::slam::logslam::LogSlam;
+use slamlab::slam::relations::{drift_odometry, DriftModel};
+
+#[path = "../../tests/real_support/mod.rs"]
+mod support;
+
+/// The reference pose of every scan (approximated where missing, see above).
+fn raw_reference(est: &[Pose2]) -> Vec<Pose2> {
+    let path = support::data_dir().join("carmen/mit-csail_gmapping_reference.txt");
+    let text = std::fs::read_to_string(&path).expect("reference file");
+    let mut known: Vec<(usize, Pose2)> = Vec::new();
+    for line in text
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
+    {
+        let f: Vec<f64> = line
+            .split_whitespace()
+            .map(|v| v.parse().expect("number"))
+            .collect();
+        known.push((f[0] as usize, Pose2::new(f[5], f[6], f[7])));
+    }
+    (0..est.len())
+        .map(|s| {
+            let &(r, pose) = known
+                .iter()
+                .min_by_key(|(r, _)| r.abs_diff(s))
+                .expect("reference poses");
+            pose.compose(&est[r].between(&est[s]))
+        })
+        .collect()
+}
+
+/// The error (m, deg) of a measured relation against the reference's.
+fn error(measured: &Pose2, reference: &[Pose2], a: usize, b: usize) -> (f64, f64) {
+    let e = reference[a].between(&reference[b]).between(measured);
+    (e.position().length(), e.theta.to_degrees().abs())
+}
+
+fn report(name: &str, slam: &LogSlam, reference: &[Pose2]) {
+    // The log index of each key scan.
+    let mut key_scan = vec![0; slam.graph.nodes.len()];
+    for s in &slam.scans {
+        if s.relative == Pose2::IDENTITY {
+            key_scan[s.key] = s.index;
+        }
+    }
+    println!(
+        "{name}: {} keys, stats {:?}",
+        slam.graph.nodes.len(),
+        slam.stats
+    );
+    let (mut wrong, mut total) = (0, 0);
+    let mut seq = Vec::new();
+    for e in &slam.graph.edges {
+        let (a, b) = (key_scan[e.from], key_scan[e.to]);
+        let (t, r) = error(&e.measurement, reference, a, b);
+        if e.loop_closure {
+            total += 1;
+            let bad = t > 0.2 || r > 2.0;
+            wrong += bad as usize;
+            println!(
+                "  closure keys {:5} -> {:5} (scans {:5} -> {:5}) error {:6.3} m {:6.2} deg{}",
+                e.from,
+                e.to,
+                a,
+                b,
+                t,
+                r,
+                if bad { "  WRONG" } else { "" }
+            );
+        } else {
+            seq.push((t, r, a, b, e.information[0][0]));
+        }
+    }
+    println!("  closures: {total}, wrong (> 0.2 m or > 2 deg): {wrong}");
+    let n = seq.len().max(1) as f64;
+    let (mt, mr) = seq
+        .iter()
+        .fold((0.0, 0.0), |(x, y), s| (x + s.0 / n, y + s.1 / n));
+    println!(
+        "  front end: {} key edges, mean error {mt:.4} m {mr:.3} deg",
+        seq.len()
+    );
+    for (t, r, a, b, info) in &seq {
+        if *t > 0.1 || *r > 1.0 {
+            let kind = if *info < 100.0 { " (odometry)" } else { "" };
+            println!("    key edge scans {a:5} -> {b:5} error {t:6.3} m {r:6.2} deg{kind}");
+        }
+    }
+}
+
+fn main() {
+    let cfg = support::config_from_env();
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let all = [
+        "mit-csail.clf.gz",
+        "intel-corrected.log.gz",
+        "aces-corrected.log.gz",
+        "csail-corrected.log.gz",
+        "freiburg-079-corrected.log.gz",
+    ];
+    let names: Vec<&str> = if args.is_empty() {
+        all.to_vec()
+    } else {
+        args.iter().map(|s| s.as_str()).collect()
+    };
+    for name in names {
+        let log = support::load(name);
+        if name == "mit-csail.clf.gz" {
+            let (est, slam, _) = support::replay(&log, None, &cfg);
+            report(name, &slam, &raw_reference(&est));
+        } else {
+            let reference: Vec<Pose2> = log
+                .scans
+                .iter()
+                .map(|s| s.logged_pose.expect("FLASER pose"))
+                .collect();
+            let odom = drift_odometry(&reference, &DriftModel::default(), support::DRIFT_SEED);
+            let (_, slam, _) = support::replay(&log, Some(&odom), &cfg);
+            report(name, &slam, &reference);
+        }
+    }
+}
