@@ -14,7 +14,7 @@ const thesis = readFileSync(new URL('../scenarios/thesis.json', import.meta.url)
 /** Binding methods the facade leaves out on purpose: pixels for tests and workers, and memory management. */
 const RAW_ONLY = new Set([
   'constructor', '__destroy_into_raw', 'free',
-  'cameraGray', 'frameGray', 'mergedRgba', 'renderFrame', 'renderRgba', 'renderFrameSpec',
+  'cameraGray', 'frameGray', 'mergedRgba', 'groupMergedRgba', 'renderFrame', 'renderRgba', 'renderFrameSpec',
 ]);
 
 test('every method of the binding has its facade method (parsed ones drop "Json")', () => {

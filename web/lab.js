@@ -281,6 +281,11 @@ export class Lab {
     return this.raw.groupMergedYaml(group, image);
   }
 
+  /** Group `group`'s fused map as a PNG (the ROS map's picture, as `mergedPng`). */
+  groupMergedPng(group) {
+    return this.raw.groupMergedPng(group);
+  }
+
   // --- Describing frames in other threads (web/cli/describe-pool.mjs) ----------------
 
   /** Frames a merge with `method` would describe that are not yet: `[{robot, index}]`. */
