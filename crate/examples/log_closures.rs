@@ -20,19 +20,7 @@ mod support;
 
 /// The reference pose of every scan (approximated where missing, see above).
 fn raw_reference(est: &[Pose2]) -> Vec<Pose2> {
-    let path = support::data_dir().join("carmen/mit-csail_gmapping_reference.txt");
-    let text = std::fs::read_to_string(&path).expect("reference file");
-    let mut known: Vec<(usize, Pose2)> = Vec::new();
-    for line in text
-        .lines()
-        .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
-    {
-        let f: Vec<f64> = line
-            .split_whitespace()
-            .map(|v| v.parse().expect("number"))
-            .collect();
-        known.push((f[0] as usize, Pose2::new(f[5], f[6], f[7])));
-    }
+    let known = support::csail_gmapping_reference();
     (0..est.len())
         .map(|s| {
             let &(r, pose) = known
@@ -105,20 +93,8 @@ fn report(name: &str, slam: &LogSlam, reference: &[Pose2]) {
 
 fn main() {
     let cfg = support::config_from_env();
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let all = [
-        "mit-csail.clf.gz",
-        "intel-corrected.log.gz",
-        "aces-corrected.log.gz",
-        "csail-corrected.log.gz",
-        "freiburg-079-corrected.log.gz",
-    ];
-    let names: Vec<&str> = if args.is_empty() {
-        all.to_vec()
-    } else {
-        args.iter().map(|s| s.as_str()).collect()
-    };
-    for name in names {
+    for name in support::logs_from_args() {
+        let name = name.as_str();
         let log = support::load(name);
         if name == "mit-csail.clf.gz" {
             let (est, slam, _) = support::replay(&log, None, &cfg);

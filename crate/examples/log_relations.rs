@@ -15,20 +15,8 @@ mod support;
 
 fn main() {
     let cfg = support::config_from_env();
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let all = [
-        "mit-csail.clf.gz",
-        "intel-corrected.log.gz",
-        "aces-corrected.log.gz",
-        "csail-corrected.log.gz",
-        "freiburg-079-corrected.log.gz",
-    ];
-    let names: Vec<&str> = if args.is_empty() {
-        all.to_vec()
-    } else {
-        args.iter().map(|s| s.as_str()).collect()
-    };
-    for name in names {
+    for name in support::logs_from_args() {
+        let name = name.as_str();
         if name == "mit-csail.clf.gz" {
             let (o, recorded) = support::csail_raw_with(&cfg);
             print!("{}", support::table(name, &o));

@@ -101,23 +101,45 @@ pub fn csail_raw() -> (Outcome, f64) {
 }
 
 /// [`csail_raw`] with other SLAM settings.
-pub fn csail_raw_with(cfg: &LogSlamConfig) -> (Outcome, f64) {
-    let log = load("mit-csail.clf.gz");
+/// The five logs of `../shared/data/carmen`, the raw one first.
+pub const LOGS: [&str; 5] = [
+    "mit-csail.clf.gz",
+    "intel-corrected.log.gz",
+    "aces-corrected.log.gz",
+    "csail-corrected.log.gz",
+    "freiburg-079-corrected.log.gz",
+];
+
+/// The logs named on the command line, or all of [`LOGS`].
+pub fn logs_from_args() -> Vec<String> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.is_empty() {
+        LOGS.iter().map(|s| s.to_string()).collect()
+    } else {
+        args
+    }
+}
+
+/// GMapping's pose for some of the raw MIT CSAIL log's scans:
+/// `(scan index, pose)` from `mit-csail_gmapping_reference.txt`.
+pub fn csail_gmapping_reference() -> Vec<(usize, Pose2)> {
     let path = data_dir().join("carmen/mit-csail_gmapping_reference.txt");
     let text = std::fs::read_to_string(&path).expect("reference file");
-    let mut idx = Vec::new();
-    let mut reference = Vec::new();
-    for line in text
-        .lines()
+    text.lines()
         .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
-    {
-        let f: Vec<f64> = line
-            .split_whitespace()
-            .map(|v| v.parse().expect("number"))
-            .collect();
-        idx.push(f[0] as usize);
-        reference.push(Pose2::new(f[5], f[6], f[7]));
-    }
+        .map(|line| {
+            let f: Vec<f64> = line
+                .split_whitespace()
+                .map(|v| v.parse().expect("number"))
+                .collect();
+            (f[0] as usize, Pose2::new(f[5], f[6], f[7]))
+        })
+        .collect()
+}
+
+pub fn csail_raw_with(cfg: &LogSlamConfig) -> (Outcome, f64) {
+    let log = load("mit-csail.clf.gz");
+    let (idx, reference): (Vec<usize>, Vec<Pose2>) = csail_gmapping_reference().into_iter().unzip();
     let (est, slam, seconds) = replay(&log, None, cfg);
     let ours: Vec<Pose2> = idx.iter().map(|&i| est[i]).collect();
     let odom: Vec<Pose2> = idx.iter().map(|&i| log.scans[i].odometry).collect();
