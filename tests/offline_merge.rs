@@ -53,33 +53,44 @@ fn building(seed: u64, w: f64, h: f64) -> Vec<Segment> {
     walls
 }
 
-/// A map of `walls` whose image's lower-left corner is at `frame` (world),
-/// `size` metres, showing only the part of the building with
-/// `seen(x, y)`, and written with YAML origin `origin`.
-fn cut(
-    name: &str,
-    walls: &[Segment],
-    (w, h): (f64, f64),
-    frame: Pose2,
-    size: DVec2,
-    seen: impl Fn(DVec2) -> bool,
-    origin: Pose2,
-) -> RosMap {
-    let r = 0.05;
-    let (nx, ny) = ((size.x / r) as usize, (size.y / r) as usize);
-    let mut data = vec![-1i8; nx * ny];
-    for iy in 0..ny {
-        for ix in 0..nx {
-            let p = frame.transform_point(DVec2::new(ix as f64 + 0.5, iy as f64 + 0.5) * r);
-            let inside = p.x > -0.1 && p.y > -0.1 && p.x < w + 0.1 && p.y < h + 0.1;
-            if !inside || !seen(p) {
-                continue;
-            }
-            let near = walls.iter().any(|s| s.distance_to_point(p) <= 0.04);
-            data[iy * nx + ix] = if near { 100 } else { 0 };
-        }
+/// A building's plan: its walls inside a `size` = (w, h) metre rectangle.
+struct Plan<'a> {
+    walls: &'a [Segment],
+    size: (f64, f64),
+}
+
+impl<'a> Plan<'a> {
+    fn new(walls: &'a [Segment], size: (f64, f64)) -> Plan<'a> {
+        Plan { walls, size }
     }
-    RosMap::from_values(name, nx, ny, r, origin, data).unwrap()
+
+    /// A map of the plan whose image's lower-left corner is at `frame`
+    /// (world), `size` metres, showing only the part of the building with
+    /// `seen(x, y)`, and written with YAML origin `origin`.
+    fn cut(
+        &self,
+        name: &str,
+        frame: Pose2,
+        size: DVec2,
+        seen: impl Fn(DVec2) -> bool,
+        origin: Pose2,
+    ) -> RosMap {
+        let (r, (w, h)) = (0.05, self.size);
+        let (nx, ny) = ((size.x / r) as usize, (size.y / r) as usize);
+        let mut data = vec![-1i8; nx * ny];
+        for iy in 0..ny {
+            for ix in 0..nx {
+                let p = frame.transform_point(DVec2::new(ix as f64 + 0.5, iy as f64 + 0.5) * r);
+                let inside = p.x > -0.1 && p.y > -0.1 && p.x < w + 0.1 && p.y < h + 0.1;
+                if !inside || !seen(p) {
+                    continue;
+                }
+                let near = self.walls.iter().any(|s| s.distance_to_point(p) <= 0.04);
+                data[iy * nx + ix] = if near { 100 } else { 0 };
+            }
+        }
+        RosMap::from_values(name, nx, ny, r, origin, data).unwrap()
+    }
 }
 
 /// The map frame of a map whose image frame is `frame` (world) and whose
@@ -124,37 +135,23 @@ fn a_pair_cut_from_one_building_merges_to_the_known_transform() {
 fn three_maps_join_along_the_spanning_tree() {
     let (w, h) = (36.0, 24.0);
     let walls = building(5, w, h);
+    let plan = Plan {
+        walls: &walls,
+        size: (w, h),
+    };
     let fa = Pose2::new(-1.0, -1.0, 0.0);
     let oa = Pose2::IDENTITY;
-    let a = cut(
-        "a.yaml",
-        &walls,
-        (w, h),
-        fa,
-        DVec2::new(22.0, 26.0),
-        |p| p.x <= 20.0,
-        oa,
-    );
+    let a = plan.cut("a.yaml", fa, DVec2::new(22.0, 26.0), |p| p.x <= 20.0, oa);
     let fb = turned_frame(8.0, 30.0, h, -1.2, 34.0);
-    let b = cut(
+    let b = plan.cut(
         "b.yaml",
-        &walls,
-        (w, h),
         fb,
         DVec2::new(34.0, 34.0),
         |p| (8.0..=30.0).contains(&p.x),
         oa,
     );
     let fc = turned_frame(10.0, 37.0, h, 2.5, 38.0);
-    let c = cut(
-        "c.yaml",
-        &walls,
-        (w, h),
-        fc,
-        DVec2::new(38.0, 38.0),
-        |p| p.x >= 10.0,
-        oa,
-    );
+    let c = plan.cut("c.yaml", fc, DVec2::new(38.0, 38.0), |p| p.x >= 10.0, oa);
     let r = merge_all(&[a, b, c], &OfflineConfig::default(), &mut |line| {
         println!("{line}")
     });
@@ -174,25 +171,10 @@ fn two_buildings() -> (RosMap, RosMap, Pose2) {
     let fa = Pose2::new(-1.0, -1.0, 0.0);
     let (sa, sb) = ((36.0, 24.0), (30.0, 20.0));
     let all = |_: DVec2| true;
-    let a = cut(
-        "a.yaml",
-        &building(3, sa.0, sa.1),
-        sa,
-        fa,
-        DVec2::new(38.0, 26.0),
-        all,
-        Pose2::IDENTITY,
-    );
+    let (wa, wb) = (building(3, sa.0, sa.1), building(8, sb.0, sb.1));
+    let a = Plan::new(&wa, sa).cut("a.yaml", fa, DVec2::new(38.0, 26.0), all, Pose2::IDENTITY);
     let fb = turned_frame(0.0, 30.0, 20.0, 0.4, 38.0);
-    let b = cut(
-        "b.yaml",
-        &building(8, sb.0, sb.1),
-        sb,
-        fb,
-        DVec2::new(38.0, 38.0),
-        all,
-        Pose2::IDENTITY,
-    );
+    let b = Plan::new(&wb, sb).cut("b.yaml", fb, DVec2::new(38.0, 38.0), all, Pose2::IDENTITY);
     (a, b, fa.between(&fb))
 }
 
@@ -265,26 +247,14 @@ fn east_west_pair() -> (RosMap, RosMap, Pose2) {
 fn east_west_pair_with(oa: Pose2, ob: Pose2) -> (RosMap, RosMap, Pose2) {
     let (w, h) = (36.0, 24.0);
     let walls = building(11, w, h);
+    let plan = Plan {
+        walls: &walls,
+        size: (w, h),
+    };
     let fa = Pose2::new(-1.0, -1.0, 0.0);
-    let a = cut(
-        "a.yaml",
-        &walls,
-        (w, h),
-        fa,
-        DVec2::new(26.0, 26.0),
-        |p| p.x <= 24.0,
-        oa,
-    );
+    let a = plan.cut("a.yaml", fa, DVec2::new(26.0, 26.0), |p| p.x <= 24.0, oa);
     let fb = turned_frame(12.0, 37.0, h, 0.7, 36.0);
-    let b = cut(
-        "b.yaml",
-        &walls,
-        (w, h),
-        fb,
-        DVec2::new(36.0, 36.0),
-        |p| p.x >= 12.0,
-        ob,
-    );
+    let b = plan.cut("b.yaml", fb, DVec2::new(36.0, 36.0), |p| p.x >= 12.0, ob);
     let truth = map_frame(&fa, &oa).between(&map_frame(&fb, &ob));
     (a, b, truth)
 }
@@ -379,27 +349,15 @@ fn symmetric_building(seed: u64, w: f64, h: f64) -> Vec<Segment> {
 fn refine_merges_a_symmetric_building_the_automatic_merge_declines() {
     let (w, h) = (40.0, 20.0);
     let walls = symmetric_building(21, w, h);
+    let plan = Plan {
+        walls: &walls,
+        size: (w, h),
+    };
     let all = |_: DVec2| true;
     let fa = Pose2::new(-1.0, -1.0, 0.0);
-    let a = cut(
-        "a.yaml",
-        &walls,
-        (w, h),
-        fa,
-        DVec2::new(42.0, 22.0),
-        all,
-        Pose2::IDENTITY,
-    );
+    let a = plan.cut("a.yaml", fa, DVec2::new(42.0, 22.0), all, Pose2::IDENTITY);
     let fb = turned_frame(-1.0, 41.0, h, 0.9, 44.0);
-    let b = cut(
-        "b.yaml",
-        &walls,
-        (w, h),
-        fb,
-        DVec2::new(44.0, 44.0),
-        all,
-        Pose2::IDENTITY,
-    );
+    let b = plan.cut("b.yaml", fb, DVec2::new(44.0, 44.0), all, Pose2::IDENTITY);
     let truth = fa.between(&fb);
     let maps = [a, b];
     let mut r = merge_all(&maps, &OfflineConfig::default(), &mut |_| {});
