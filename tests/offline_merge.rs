@@ -135,10 +135,7 @@ fn a_pair_cut_from_one_building_merges_to_the_known_transform() {
 fn three_maps_join_along_the_spanning_tree() {
     let (w, h) = (36.0, 24.0);
     let walls = building(5, w, h);
-    let plan = Plan {
-        walls: &walls,
-        size: (w, h),
-    };
+    let plan = Plan::new(&walls, (w, h));
     let fa = Pose2::new(-1.0, -1.0, 0.0);
     let oa = Pose2::IDENTITY;
     let a = plan.cut("a.yaml", fa, DVec2::new(22.0, 26.0), |p| p.x <= 20.0, oa);
@@ -247,10 +244,7 @@ fn east_west_pair() -> (RosMap, RosMap, Pose2) {
 fn east_west_pair_with(oa: Pose2, ob: Pose2) -> (RosMap, RosMap, Pose2) {
     let (w, h) = (36.0, 24.0);
     let walls = building(11, w, h);
-    let plan = Plan {
-        walls: &walls,
-        size: (w, h),
-    };
+    let plan = Plan::new(&walls, (w, h));
     let fa = Pose2::new(-1.0, -1.0, 0.0);
     let a = plan.cut("a.yaml", fa, DVec2::new(26.0, 26.0), |p| p.x <= 24.0, oa);
     let fb = turned_frame(12.0, 37.0, h, 0.7, 36.0);
@@ -349,10 +343,7 @@ fn symmetric_building(seed: u64, w: f64, h: f64) -> Vec<Segment> {
 fn refine_merges_a_symmetric_building_the_automatic_merge_declines() {
     let (w, h) = (40.0, 20.0);
     let walls = symmetric_building(21, w, h);
-    let plan = Plan {
-        walls: &walls,
-        size: (w, h),
-    };
+    let plan = Plan::new(&walls, (w, h));
     let all = |_: DVec2| true;
     let fa = Pose2::new(-1.0, -1.0, 0.0);
     let a = plan.cut("a.yaml", fa, DVec2::new(42.0, 22.0), all, Pose2::IDENTITY);
