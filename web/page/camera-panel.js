@@ -22,7 +22,6 @@ import { robotColour } from './palette.js';
 
 const LIVE_INTERVAL_MS = 120; // live views refresh at about 8 per second
 const THUMB_W = 64;
-const THUMB_H = 48;
 
 export class CameraPanel {
   /**
@@ -37,7 +36,6 @@ export class CameraPanel {
     this.key = '';
     this.lastLiveMs = 0;
     this.turn = -1; // the on-screen block whose live view was refreshed last
-    this.scratch = document.createElement('canvas');
     this.camera = { width: 320, height: 240, hfov_deg: 60 };
     /** Live renders per robot (for the page tests: hidden blocks render none while running). */
     this.liveDraws = [];
@@ -63,8 +61,6 @@ export class CameraPanel {
     this.seen?.disconnect();
     this.blocks = scenario.robots.map((r, i) => this.makeBlock(r.name, i));
     this.liveDraws = this.blocks.map(() => 0);
-    this.scratch.width = this.camera.width;
-    this.scratch.height = this.camera.height;
     this.picked();
     this.refresh(true);
   }
@@ -246,22 +242,24 @@ export class CameraPanel {
       if (b.selected !== null && !have.has(b.selected)) this.select({ robot: b.robot, index: null });
     }
     const shown = new Set(b.shown);
-    const sctx = this.scratch.getContext('2d');
+    // Thumbnails are rendered at their own size, not drawn full size and
+    // scaled down (issue 22: the strip's frames were most of the camera cost).
+    const tw = Math.min(THUMB_W, this.camera.width);
+    const th = Math.max(1, Math.round((tw * this.camera.height) / this.camera.width));
     const atEnd = b.strip.scrollLeft + b.strip.clientWidth >= b.strip.scrollWidth - 4;
     for (const m of metas) {
       if (shown.has(m.index)) continue;
-      lab.drawFrame(b.robot, m.index, sctx);
       const t = document.createElement('canvas');
       t.className = 'cam-thumb';
-      t.width = THUMB_W;
-      t.height = THUMB_H;
+      t.width = tw;
+      t.height = th;
+      lab.drawFrameThumb(b.robot, m.index, tw, t.getContext('2d'));
       t.dataset.index = String(m.index);
       t.tabIndex = -1;
       t.setAttribute('role', 'option');
       t.setAttribute('aria-selected', 'false');
       t.setAttribute('aria-label', `frame ${m.index} at ${m.time_s.toFixed(0)} s`);
       t.title = `frame ${m.index} · t = ${m.time_s.toFixed(1)} s — click to view it and see where it was taken`;
-      t.getContext('2d').drawImage(this.scratch, 0, 0, THUMB_W, THUMB_H);
       const pick = () => this.select({ robot: b.robot, index: m.index });
       t.addEventListener('click', pick);
       t.addEventListener('keydown', (e) => {
