@@ -21,6 +21,8 @@
 import { robotColour } from './palette.js';
 
 const LIVE_INTERVAL_MS = 120; // live views refresh at about 8 per second
+const LIVE_SHARE = 4; // ... and at most every 4 times what one took
+const STRIP_INTERVAL_MS = 500; // strips grow at most twice a second while running
 const THUMB_W = 64;
 
 export class CameraPanel {
@@ -36,6 +38,7 @@ export class CameraPanel {
     this.key = '';
     this.lastLiveMs = 0;
     this.turn = -1; // the on-screen block whose live view was refreshed last
+    this.liveMs = 0; // what the last refresh took
     this.camera = { width: 320, height: 240, hfov_deg: 60 };
     /** Live renders per robot (for the page tests: hidden blocks render none while running). */
     this.liveDraws = [];
@@ -192,11 +195,17 @@ export class CameraPanel {
     if (!this.blocks.length || !changed) return;
     // One on-screen block per turn, so that each refreshes about every
     // LIVE_INTERVAL_MS and no single frame renders them all.
+    // And at most every LIVE_SHARE times what the last refresh took, so that
+    // live views take at most a quarter of the time however many are on
+    // screen (issue 22: four 16-robot views in turn took a render a frame).
     const shown = this.blocks.filter((b) => b.visible);
-    if (!shown.length || nowMs - this.lastLiveMs < LIVE_INTERVAL_MS / shown.length) return;
+    const gap = Math.max(LIVE_INTERVAL_MS / Math.max(1, shown.length), LIVE_SHARE * this.liveMs);
+    if (!shown.length || nowMs - this.lastLiveMs < gap) return;
     this.lastLiveMs = nowMs;
     this.turn = (this.turn + 1) % shown.length;
+    const t0 = performance.now();
     this.refreshBlock(shown[this.turn], false);
+    this.liveMs = performance.now() - t0;
   }
 
   /** Redraws the live views and grows the strips: every block when
@@ -229,8 +238,14 @@ export class CameraPanel {
   }
 
   syncStrip(lab, b, force) {
+    // While running, a strip grows at most every STRIP_INTERVAL_MS: reading
+    // the robot's frame list is linear in its length (issue 22: at 50× two
+    // strips re-read hundreds of frames ten times a second).
+    const now = performance.now();
+    if (!force && now - (b.stripMs ?? -Infinity) < STRIP_INTERVAL_MS) return;
     const count = lab.frameCount(b.robot);
     if (!force && count === b.shown.length) return;
+    b.stripMs = now;
     const metas = lab.frames(b.robot);
     const have = new Set(metas.map((m) => m.index));
     // Frames can vanish (a reset, or thinning at the memory cap).
