@@ -599,7 +599,9 @@ fn a_scaled_camera_renders_a_frame_as_its_thumbnail() {
             let draw = |cam: &PinholeCamera| {
                 let mut bank = sim.textures.lock();
                 let walls = &sim.scenario.walls;
-                render(cam, &f.truth, &sim.world, walls, &f.others, &mut bank, false, None)
+                render(
+                    cam, &f.truth, &sim.world, walls, &f.others, &mut bank, false, None,
+                )
             };
             let (big, thumb) = (draw(&full), draw(&small));
             let mut diff = 0.0;

@@ -192,7 +192,11 @@ fn many_robots_draw_their_lasers_as_fans() {
         s.robots.push(r);
     }
     assert!(s.robots.len() > slamlab::render::RAY_ROBOTS);
-    assert!(s.placement_problems().is_empty(), "{:?}", s.placement_problems());
+    assert!(
+        s.placement_problems().is_empty(),
+        "{:?}",
+        s.placement_problems()
+    );
     let mut lab = Lab::new(&s.to_json_pretty()).unwrap();
     lab.step(30).unwrap();
     let mut v = RenderOptions {
@@ -217,7 +221,8 @@ fn many_robots_draw_their_lasers_as_fans() {
             continue;
         }
         let a = r.truth.theta + slamlab::sensors::laser::beam_bearing(b);
-        let p = r.truth.position() + glam::DVec2::new(a.cos(), a.sin()) * 0.6 * r.last_scan.ranges_m[b];
+        let p =
+            r.truth.position() + glam::DVec2::new(a.cos(), a.sin()) * 0.6 * r.last_scan.ranges_m[b];
         let (x, y) = v.to_px(p);
         let c = pixel(&fans, 400, x as u32, y as u32);
         beams += 1;
@@ -226,10 +231,20 @@ fn many_robots_draw_their_lasers_as_fans() {
         }
     }
     assert!(beams >= 5, "{beams} beams to look at");
-    assert!(tinted * 10 >= beams * 9, "{tinted} of {beams} fan points tinted");
+    assert!(
+        tinted * 10 >= beams * 9,
+        "{tinted} of {beams} fan points tinted"
+    );
     v.selected_robot = Some(1);
     lab.set_view(v).unwrap();
     let rays = lab.render().unwrap().data().to_vec();
-    let differ = fans.chunks(4).zip(rays.chunks(4)).filter(|(a, b)| a != b).count();
-    assert!(differ > 100, "selecting robot 2 draws its rays ({differ} pixels differ)");
+    let differ = fans
+        .chunks(4)
+        .zip(rays.chunks(4))
+        .filter(|(a, b)| a != b)
+        .count();
+    assert!(
+        differ > 100,
+        "selecting robot 2 draws its rays ({differ} pixels differ)"
+    );
 }
