@@ -571,3 +571,55 @@ fn camera_settings_are_validated() {
     );
     let _ = Segment::new(DVec2::ZERO, DVec2::X);
 }
+
+/// The film strip's thumbnails (issue 22): a camera scaled to 64 pixels keeps
+/// the field of view (its columns look along the same bearings as the
+/// centres of the full camera's 5-column blocks) and renders what the full
+/// frame shows averaged over 5 × 5 blocks, up to the walls' edges and the
+/// texture detail a 64-pixel image cannot hold.
+#[wasm_bindgen_test(unsupported = test)]
+fn a_scaled_camera_renders_a_frame_as_its_thumbnail() {
+    let mut s = Scenario::from_json(THESIS).unwrap();
+    s.duration_s = 5.0;
+    let mut sim = Simulation::new(&s).unwrap();
+    sim.run_to_end();
+    let full = sim.camera.clone();
+    let small = full.scaled(64);
+    assert_eq!((small.width, small.height), (64, 48));
+    assert_eq!(small.hfov_rad, full.hfov_rad);
+    for c in 0..64 {
+        let a = small.column_ray(c);
+        let offset = 5.0 * small.column_offset(c);
+        let b = DVec2::new(full.f_px, -offset).normalize();
+        assert!(a.angle_to(b).abs() < 1e-12, "column {c}");
+    }
+    let mut worst = 0.0f64;
+    for r in &sim.robots {
+        for f in &r.frames.frames {
+            let draw = |cam: &PinholeCamera| {
+                let mut bank = sim.textures.lock();
+                let walls = &sim.scenario.walls;
+                render(
+                    cam, &f.truth, &sim.world, walls, &f.others, &mut bank, false, None,
+                )
+            };
+            let (big, thumb) = (draw(&full), draw(&small));
+            let mut diff = 0.0;
+            for y in 0..48 {
+                for x in 0..64 {
+                    let mut sum = 0.0;
+                    for dy in 0..5 {
+                        for dx in 0..5 {
+                            sum += big.gray[(5 * y + dy) * 320 + 5 * x + dx] as f64;
+                        }
+                    }
+                    diff += (sum / 25.0 - thumb.gray[y * 64 + x] as f64).abs();
+                }
+            }
+            worst = worst.max(diff / (64.0 * 48.0));
+        }
+    }
+    // Measured 0.0 (see the message); a wrong field of view or mount
+    // shifts whole walls and gives tens of grey levels.
+    assert!(worst < 8.0, "mean difference {worst:.2} grey levels");
+}

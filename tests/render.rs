@@ -174,3 +174,78 @@ fn compare(a: &[u8], b: &[u8]) {
         "cached walls differ from fresh ones by {worst} levels"
     );
 }
+
+/// With more than `RAY_ROBOTS` robots (issue 22) each robot's laser is a
+/// translucent fan through its beams' end points, except the selected
+/// robot's, which stays as rays: a point 60 % along a hitting beam is
+/// tinted red (background 250, 250, 247; the fan's alpha 0.2 of 220, 40, 40
+/// gives about 244, 208, 206) and the selection changes only that robot's
+/// drawing.
+#[wasm_bindgen_test(unsupported = test)]
+fn many_robots_draw_their_lasers_as_fans() {
+    let mut s = Scenario::from_json(THESIS).unwrap();
+    let extra: [[f64; 3]; 3] = [[10.0, 7.5, 0.0], [5.0, 11.0, 1.0], [14.5, 4.0, 2.0]];
+    for (k, start) in extra.iter().enumerate() {
+        let mut r = s.robots[0].clone();
+        r.name = format!("extra{k}");
+        r.start = *start;
+        s.robots.push(r);
+    }
+    assert!(s.robots.len() > slamlab::render::RAY_ROBOTS);
+    assert!(
+        s.placement_problems().is_empty(),
+        "{:?}",
+        s.placement_problems()
+    );
+    let mut lab = Lab::new(&s.to_json_pretty()).unwrap();
+    lab.step(30).unwrap();
+    let mut v = RenderOptions {
+        width: 400,
+        height: 300,
+        center: [10.0, 7.5],
+        scale: 20.0,
+        layers: Layers {
+            grid: false,
+            truth_path: false,
+            odometry_path: false,
+            ..Layers::default()
+        },
+        ..RenderOptions::default()
+    };
+    lab.set_view(v.clone()).unwrap();
+    let fans = lab.render().unwrap().data().to_vec();
+    let r = &lab.simulation().unwrap().robots[1];
+    let (mut tinted, mut beams) = (0, 0);
+    // Inner beams: the first and last are the fan's edges.
+    for b in (5..r.last_scan.ranges_m.len() - 5).step_by(10) {
+        if r.last_scan.max_range[b] || r.last_scan.ranges_m[b] < 1.5 {
+            continue;
+        }
+        let a = r.truth.theta + slamlab::sensors::laser::beam_bearing(b);
+        let p =
+            r.truth.position() + glam::DVec2::new(a.cos(), a.sin()) * 0.6 * r.last_scan.ranges_m[b];
+        let (x, y) = v.to_px(p);
+        let c = pixel(&fans, 400, x as u32, y as u32);
+        beams += 1;
+        if (190..=225).contains(&c[1]) && c[0] > c[1] + 20 {
+            tinted += 1;
+        }
+    }
+    assert!(beams >= 5, "{beams} beams to look at");
+    assert!(
+        tinted * 10 >= beams * 9,
+        "{tinted} of {beams} fan points tinted"
+    );
+    v.selected_robot = Some(1);
+    lab.set_view(v).unwrap();
+    let rays = lab.render().unwrap().data().to_vec();
+    let differ = fans
+        .chunks(4)
+        .zip(rays.chunks(4))
+        .filter(|(a, b)| a != b)
+        .count();
+    assert!(
+        differ > 100,
+        "selecting robot 2 draws its rays ({differ} pixels differ)"
+    );
+}

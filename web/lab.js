@@ -165,6 +165,11 @@ export class Lab {
     this.raw.drawFrame(robot, index, ctx);
   }
 
+  /** Frame `index` as a thumbnail `width` pixels wide (the height in proportion). */
+  drawFrameThumb(robot, index, width, ctx) {
+    this.raw.drawFrameThumb(robot, index, width, ctx);
+  }
+
   framePng(robot, index) {
     return this.raw.framePng(robot, index);
   }

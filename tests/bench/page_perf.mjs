@@ -2,13 +2,14 @@
 // tasks and simulated-time rate while running in headless Chromium.
 //
 // Usage: node tests/bench/page_perf.mjs SCENARIO.json [--speed 50] [--seconds 10]
-//        [--width 1366 --height 768]
+//        [--width 1366 --height 768] [--shot FILE.png]
 // Imports the scenario through the page's Import button, sets the speed
 // slider, presses Run, and for `--seconds` of wall time counts animation
 // frames, records every long task (PerformanceObserver 'longtask') and reads
 // the simulated clock. Prints one JSON line:
 // {walls, robots, fps, frames, longtasks, longest_ms, sim_rate}, sim_rate =
-// simulated seconds per wall second. Needs ./build.sh build and Chromium.
+// simulated seconds per wall second. `--shot` saves a screenshot of the page
+// at the end of the run. Needs ./build.sh build and Chromium.
 import path from 'node:path';
 import { readFile } from 'node:fs/promises';
 import { chromium } from 'playwright-core';
@@ -68,6 +69,8 @@ try {
     t: window.slamlab.lab.timeS(),
   }));
   const wall = (Date.now() - w0) / 1000;
+  const shot = args.indexOf('--shot');
+  if (shot >= 0) await page.screenshot({ path: args[shot + 1] });
   console.log(
     JSON.stringify({
       walls: scenario.walls.length,

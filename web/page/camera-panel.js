@@ -21,8 +21,9 @@
 import { robotColour } from './palette.js';
 
 const LIVE_INTERVAL_MS = 120; // live views refresh at about 8 per second
+const LIVE_SHARE = 4; // ... and at most every 4 times what one took
+const STRIP_INTERVAL_MS = 500; // strips grow at most twice a second while running
 const THUMB_W = 64;
-const THUMB_H = 48;
 
 export class CameraPanel {
   /**
@@ -37,7 +38,7 @@ export class CameraPanel {
     this.key = '';
     this.lastLiveMs = 0;
     this.turn = -1; // the on-screen block whose live view was refreshed last
-    this.scratch = document.createElement('canvas');
+    this.liveMs = 0; // what the last refresh took
     this.camera = { width: 320, height: 240, hfov_deg: 60 };
     /** Live renders per robot (for the page tests: hidden blocks render none while running). */
     this.liveDraws = [];
@@ -63,8 +64,6 @@ export class CameraPanel {
     this.seen?.disconnect();
     this.blocks = scenario.robots.map((r, i) => this.makeBlock(r.name, i));
     this.liveDraws = this.blocks.map(() => 0);
-    this.scratch.width = this.camera.width;
-    this.scratch.height = this.camera.height;
     this.picked();
     this.refresh(true);
   }
@@ -196,11 +195,17 @@ export class CameraPanel {
     if (!this.blocks.length || !changed) return;
     // One on-screen block per turn, so that each refreshes about every
     // LIVE_INTERVAL_MS and no single frame renders them all.
+    // And at most every LIVE_SHARE times what the last refresh took, so that
+    // live views take at most a quarter of the time however many are on
+    // screen (issue 22: four 16-robot views in turn took a render a frame).
     const shown = this.blocks.filter((b) => b.visible);
-    if (!shown.length || nowMs - this.lastLiveMs < LIVE_INTERVAL_MS / shown.length) return;
+    const gap = Math.max(LIVE_INTERVAL_MS / Math.max(1, shown.length), LIVE_SHARE * this.liveMs);
+    if (!shown.length || nowMs - this.lastLiveMs < gap) return;
     this.lastLiveMs = nowMs;
     this.turn = (this.turn + 1) % shown.length;
+    const t0 = performance.now();
     this.refreshBlock(shown[this.turn], false);
+    this.liveMs = performance.now() - t0;
   }
 
   /** Redraws the live views and grows the strips: every block when
@@ -233,8 +238,14 @@ export class CameraPanel {
   }
 
   syncStrip(lab, b, force) {
+    // While running, a strip grows at most every STRIP_INTERVAL_MS: reading
+    // the robot's frame list is linear in its length (issue 22: at 50× two
+    // strips re-read hundreds of frames ten times a second).
+    const now = performance.now();
+    if (!force && now - (b.stripMs ?? -Infinity) < STRIP_INTERVAL_MS) return;
     const count = lab.frameCount(b.robot);
     if (!force && count === b.shown.length) return;
+    b.stripMs = now;
     const metas = lab.frames(b.robot);
     const have = new Set(metas.map((m) => m.index));
     // Frames can vanish (a reset, or thinning at the memory cap).
@@ -246,22 +257,24 @@ export class CameraPanel {
       if (b.selected !== null && !have.has(b.selected)) this.select({ robot: b.robot, index: null });
     }
     const shown = new Set(b.shown);
-    const sctx = this.scratch.getContext('2d');
+    // Thumbnails are rendered at their own size, not drawn full size and
+    // scaled down (issue 22: the strip's frames were most of the camera cost).
+    const tw = Math.min(THUMB_W, this.camera.width);
+    const th = Math.max(1, Math.round((tw * this.camera.height) / this.camera.width));
     const atEnd = b.strip.scrollLeft + b.strip.clientWidth >= b.strip.scrollWidth - 4;
     for (const m of metas) {
       if (shown.has(m.index)) continue;
-      lab.drawFrame(b.robot, m.index, sctx);
       const t = document.createElement('canvas');
       t.className = 'cam-thumb';
-      t.width = THUMB_W;
-      t.height = THUMB_H;
+      t.width = tw;
+      t.height = th;
+      lab.drawFrameThumb(b.robot, m.index, tw, t.getContext('2d'));
       t.dataset.index = String(m.index);
       t.tabIndex = -1;
       t.setAttribute('role', 'option');
       t.setAttribute('aria-selected', 'false');
       t.setAttribute('aria-label', `frame ${m.index} at ${m.time_s.toFixed(0)} s`);
       t.title = `frame ${m.index} · t = ${m.time_s.toFixed(1)} s — click to view it and see where it was taken`;
-      t.getContext('2d').drawImage(this.scratch, 0, 0, THUMB_W, THUMB_H);
       const pick = () => this.select({ robot: b.robot, index: m.index });
       t.addEventListener('click', pick);
       t.addEventListener('keydown', (e) => {

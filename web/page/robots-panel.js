@@ -38,6 +38,20 @@ export class RobotsPanel {
     this.actions = actions;
     this.key = '';
     this.cards = [];
+    /** The state last written (`update`), for cards that scroll into view. */
+    this.state = null;
+    // With many robots most cards are scrolled out of view; while running
+    // only those on screen are written (issue 22: 16 cards' readouts ten
+    // times a second made the page lay itself out again every frame). A card
+    // that scrolls into view is written at once.
+    this.seen = typeof IntersectionObserver === 'undefined' ? null : new IntersectionObserver((entries) => {
+      for (const e of entries) {
+        const i = this.cards.findIndex((c) => c.root === e.target);
+        if (i < 0) continue;
+        this.cards[i].visible = e.isIntersecting;
+        if (e.isIntersecting) this.write(i, this.state);
+      }
+    });
   }
 
   /** Rebuilds the cards if the robots or the editing state changed. */
@@ -56,6 +70,8 @@ export class RobotsPanel {
     this.root.replaceChildren();
     this.cards = scenario.robots.map((r, i) => this.card(r, i, editable, selected === i, problems.has(i)));
     this.root.append(...this.cards.map((c) => c.root));
+    this.seen?.disconnect();
+    for (const c of this.cards) this.seen?.observe(c.root);
     if (focusId) document.getElementById(focusId)?.focus();
   }
 
@@ -177,47 +193,55 @@ export class RobotsPanel {
     return { root, v, sonarCells, log, bumps };
   }
 
-  /** Writes the live state (or clears it at t = 0). */
-  update(state) {
-    const live = state && state.robots.length === this.cards.length ? state.robots : null;
+  /** Writes the live state (or clears it at t = 0): into every card when
+   *  `all`, else only into those on screen. */
+  update(state, all = true) {
+    this.state = state;
     this.cards.forEach((c, i) => {
-      const r = live ? live[i] : null;
-      if (!r) {
-        c.v.mode.textContent = 'not started';
-        c.v.modeWords.textContent = '';
-        c.v.truth.textContent = '–';
-        c.v.odometry.textContent = '–';
-        c.v.error.textContent = '–';
-        c.v.laser.textContent = '–';
-        c.bumps.textContent = '';
-        c.log.setAttribute('aria-disabled', 'true');
-        c.sonarCells.forEach((s) => {
-          s.val.textContent = '–';
-          s.bar.style.height = '0%';
-          s.cell.classList.remove('no-echo');
-        });
-        return;
-      }
-      c.v.mode.textContent = r.mode.replace(/_/g, ' ');
-      c.v.mode.title = MODE_WORDS[r.mode] ?? '';
-      c.v.mode.dataset.words = MODE_WORDS[r.mode] ?? '';
-      // The rare modes are said in words on the card; every mode has its words as a tooltip.
-      c.v.modeWords.textContent = ['yield', 'pass', 'recover'].includes(r.mode) ? ` (${MODE_WORDS[r.mode]})` : '';
-      c.v.truth.textContent = pose(r.truth);
-      c.v.odometry.textContent = pose(r.odometry);
-      c.v.error.textContent = `${fmt(r.odometry_error_m)} m`;
-      c.v.laser.textContent = r.laser_min
-        ? `nearest ${fmt(r.laser_min[0])} m at ${fmt(r.laser_min[1], 0)}° · ${r.laser_returns}/181 hit`
-        : 'no return';
-      c.bumps.textContent = ` · ${r.bumps} bump${r.bumps === 1 ? '' : 's'}`;
-      c.log.setAttribute('aria-disabled', 'false');
-      r.sonar_m.forEach((m, k) => {
-        const s = c.sonarCells[k];
-        s.val.textContent = fmt(m, 2);
-        s.bar.style.height = `${Math.min(100, (m / (this.sonarRange ?? 2)) * 100).toFixed(0)}%`;
-        s.cell.classList.toggle('no-echo', !!r.sonar_no_echo[k]);
-        s.cell.title = `sonar ${k + 1}: ${fmt(m, 2)} m${r.sonar_no_echo[k] ? ' (no echo)' : ''}`;
+      if (all || c.visible !== false) this.write(i, state);
+    });
+  }
+
+  /** Writes card `i`'s readouts from `state`. */
+  write(i, state) {
+    const c = this.cards[i];
+    const live = state && state.robots.length === this.cards.length ? state.robots : null;
+    const r = live ? live[i] : null;
+    if (!r) {
+      c.v.mode.textContent = 'not started';
+      c.v.modeWords.textContent = '';
+      c.v.truth.textContent = '–';
+      c.v.odometry.textContent = '–';
+      c.v.error.textContent = '–';
+      c.v.laser.textContent = '–';
+      c.bumps.textContent = '';
+      c.log.setAttribute('aria-disabled', 'true');
+      c.sonarCells.forEach((s) => {
+        s.val.textContent = '–';
+        s.bar.style.height = '0%';
+        s.cell.classList.remove('no-echo');
       });
+      return;
+    }
+    c.v.mode.textContent = r.mode.replace(/_/g, ' ');
+    c.v.mode.title = MODE_WORDS[r.mode] ?? '';
+    c.v.mode.dataset.words = MODE_WORDS[r.mode] ?? '';
+    // The rare modes are said in words on the card; every mode has its words as a tooltip.
+    c.v.modeWords.textContent = ['yield', 'pass', 'recover'].includes(r.mode) ? ` (${MODE_WORDS[r.mode]})` : '';
+    c.v.truth.textContent = pose(r.truth);
+    c.v.odometry.textContent = pose(r.odometry);
+    c.v.error.textContent = `${fmt(r.odometry_error_m)} m`;
+    c.v.laser.textContent = r.laser_min
+      ? `nearest ${fmt(r.laser_min[0])} m at ${fmt(r.laser_min[1], 0)}° · ${r.laser_returns}/181 hit`
+      : 'no return';
+    c.bumps.textContent = ` · ${r.bumps} bump${r.bumps === 1 ? '' : 's'}`;
+    c.log.setAttribute('aria-disabled', 'false');
+    r.sonar_m.forEach((m, k) => {
+      const s = c.sonarCells[k];
+      s.val.textContent = fmt(m, 2);
+      s.bar.style.height = `${Math.min(100, (m / (this.sonarRange ?? 2)) * 100).toFixed(0)}%`;
+      s.cell.classList.toggle('no-echo', !!r.sonar_no_echo[k]);
+      s.cell.title = `sonar ${k + 1}: ${fmt(m, 2)} m${r.sonar_no_echo[k] ? ' (no echo)' : ''}`;
     });
   }
 }

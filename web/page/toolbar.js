@@ -77,7 +77,7 @@ export class Toolbar {
     if (!force && now - this.lastReadoutMs < READOUT_INTERVAL_MS) return;
     this.lastReadoutMs = now;
     const st = runner.readState();
-    this.page.robotsPanel.update(st.steps > 0 ? st : null);
+    this.page.robotsPanel.update(st.steps > 0 ? st : null, force);
     $('clock').textContent = `t = ${fmt(st.time_s, 1)} s / ${Number(store.scenario.duration_s.toFixed(1))} s`;
     $('progress').value = st.total_steps ? st.steps / st.total_steps : 0;
     this.refresh(st);

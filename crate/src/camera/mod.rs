@@ -76,6 +76,22 @@ impl PinholeCamera {
         }
     }
 
+    /// The same camera with an image `width` pixels wide and the height in
+    /// proportion (at least one row): the same field of view and mount at a
+    /// coarser pixel pitch. The page's film strip renders its thumbnails
+    /// with it — a 64-pixel-wide frame costs about a twenty-fifth of a
+    /// 320-pixel one, and its coarser pitch samples the coarser mip levels,
+    /// as a downscaled full frame would look.
+    pub fn scaled(&self, width: u32) -> PinholeCamera {
+        let k = width as f64 / self.width as f64;
+        PinholeCamera {
+            width,
+            height: ((self.height as f64 * k).round() as u32).max(1),
+            f_px: self.f_px * k,
+            ..*self
+        }
+    }
+
     /// Horizontal offset of column `c`'s centre from the principal point
     /// (pixels, positive to the right).
     pub fn column_offset(&self, c: u32) -> f64 {
