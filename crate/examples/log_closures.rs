@@ -125,7 +125,11 @@ fn calibration(slam: &LogSlam, reference: &[Pose2], key_scan: &[usize]) {
         let n = chi2.len().max(1) as f64;
         println!(
             "  {} at the reference: mean chi2 {:.2} (heading {:.2}), median {:.2} ({} edges)",
-            if closures { "closures" } else { "matched key edges" },
+            if closures {
+                "closures"
+            } else {
+                "matched key edges"
+            },
             chi2.iter().sum::<f64>() / n,
             heading / n,
             chi2.get(chi2.len() / 2).copied().unwrap_or(0.0),

@@ -317,17 +317,19 @@ impl LogSlam {
         if is_key {
             self.key_cov = match (&found, &self.local) {
                 (Some(_), Some(field)) if self.config.key_covariance => {
-                    response_covariance(field, &points, &pose, &self.config.response).map(|mut c| {
-                        if self.config.key_covariance_plus_sigma {
-                            c[0][0] += self.config.key_sigma_m.powi(2);
-                            c[1][1] += self.config.key_sigma_m.powi(2);
-                            c[2][2] += self.config.key_sigma_rad.powi(2);
-                        }
-                        if self.config.key_covariance_position_only {
-                            c[2][2] = self.config.key_sigma_rad.powi(2);
-                        }
-                        c
-                    })
+                    response_covariance(field, &points, &pose, &self.config.response).map(
+                        |mut c| {
+                            if self.config.key_covariance_plus_sigma {
+                                c[0][0] += self.config.key_sigma_m.powi(2);
+                                c[1][1] += self.config.key_sigma_m.powi(2);
+                                c[2][2] += self.config.key_sigma_rad.powi(2);
+                            }
+                            if self.config.key_covariance_position_only {
+                                c[2][2] = self.config.key_sigma_rad.powi(2);
+                            }
+                            c
+                        },
+                    )
                 }
                 _ => None,
             };
@@ -393,7 +395,10 @@ impl LogSlam {
                 (self.config.key_sigma_m, self.config.key_sigma_rad)
             };
             let mut edge = Edge::new(p, id, z, sm, sr);
-            let info = self.key_cov.take().and_then(|c| edge_information(&c, pose.theta));
+            let info = self
+                .key_cov
+                .take()
+                .and_then(|c| edge_information(&c, pose.theta));
             if let (Some(info), false) = (info, self.unmatched_since_key) {
                 edge.information = info;
             }

@@ -100,7 +100,10 @@ pub fn response_covariance(
     let (mut s, mut xx, mut xy, mut yy) = (0.0, 0.0, 0.0, 0.0);
     for oy in -n..=n {
         for ox in -n..=n {
-            let sum: f32 = cells.iter().map(|c| field.fine_at(c[0] + ox, c[1] + oy)).sum();
+            let sum: f32 = cells
+                .iter()
+                .map(|c| field.fine_at(c[0] + ox, c[1] + oy))
+                .sum();
             let w = sum as f64 / points.len() as f64;
             if w < floor || w <= 0.0 {
                 continue;
