@@ -223,7 +223,10 @@ fn point_tables_match_their_definition() {
 
 /// Scan points on walls, every 5 cm: `(from, to)` segments in the robot
 /// frame, moved by half a 5 cm cell so each lands mid-cell.
-fn wall_points(walls: &[((f64, f64), (f64, f64))]) -> Vec<glam::DVec2> {
+/// A wall from one (x, y) to another.
+type Wall = ((f64, f64), (f64, f64));
+
+fn wall_points(walls: &[Wall]) -> Vec<glam::DVec2> {
     let mut out = Vec::new();
     for &((x0, y0), (x1, y1)) in walls {
         let (a, b) = (glam::DVec2::new(x0, y0), glam::DVec2::new(x1, y1));
