@@ -24,7 +24,11 @@
 //! 3. **Key scans** (every `key_distance_m` or `key_angle_rad` of motion)
 //!    become nodes of the pose graph ([`super::posegraph`]), linked to the
 //!    previous key by the matched relative pose (or, where no match held,
-//!    by odometry with a looser covariance). Other scans are stored relative
+//!    by odometry with a looser covariance). The matched edge's covariance
+//!    is one σ for all (`key_sigma_m`, `key_sigma_rad`), or with
+//!    `key_covariance` the match's own, from the spread of the matcher's
+//!    response ([`super::match_covariance`]; measured in BENCHMARKS.md,
+//!    off by default). Other scans are stored relative
 //!    to their key, so they follow it when the graph moves.
 //! 4. **Loop closures** ([`super::loop_closure`]): every `loop_every` keys
 //!    the new key is matched against older keys near its estimate.
