@@ -220,3 +220,88 @@ fn point_tables_match_their_definition() {
         }
     }
 }
+
+/// Scan points on walls, every 5 cm: `(from, to)` segments in the robot
+/// frame, moved by half a 5 cm cell so each lands mid-cell.
+/// A wall from one (x, y) to another.
+type Wall = ((f64, f64), (f64, f64));
+
+fn wall_points(walls: &[Wall]) -> Vec<glam::DVec2> {
+    let mut out = Vec::new();
+    for &((x0, y0), (x1, y1)) in walls {
+        let (a, b) = (glam::DVec2::new(x0, y0), glam::DVec2::new(x1, y1));
+        let n = (a.distance(b) / 0.05).round() as usize;
+        let half = glam::DVec2::splat(0.025);
+        out.extend((0..=n).map(|i| a.lerp(b, i as f64 / n as f64) + half));
+    }
+    out
+}
+
+fn window() -> slamlab::slam::match_covariance::ResponseWindow {
+    slamlab::slam::match_covariance::ResponseWindow {
+        half_m: 0.3,
+        half_rad: 3f64.to_radians(),
+        drop: 0.1,
+    }
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn a_corridor_match_is_uncertain_along_the_corridor_only() {
+    use slamlab::slam::match_covariance::response_covariance;
+    use slamlab::slam::multires::field_from_points;
+    // Two walls 2 m apart, 6 m long, along x. Moving the scan along x by up
+    // to 0.3 m slides a twentieth of its points off the walls' ends (mean
+    // response ≥ 0.95, counted); across by one 5 cm cell drops every point
+    // to the blur's 0.61 (not counted). So the x variance is the second
+    // moment of the 13 offsets k · 0.05 m, k = −6..6: Σk² / 13 · 0.05² =
+    // 0.035 m² with equal weights, a little less as the outer ones weigh
+    // 0.95; y keeps the floor of one cell's quantisation, 0.05² / 12.
+    let pts = wall_points(&[((-3.0, -1.0), (3.0, -1.0)), ((-3.0, 1.0), (3.0, 1.0))]);
+    let field = field_from_points(&pts, 0.05, 4, 1.0);
+    let c = response_covariance(&field, &pts, &Pose2::IDENTITY, &window()).unwrap();
+    let q = 0.05f64.powi(2) / 12.0;
+    assert!(
+        c[0][0] > 0.033 && c[0][0] <= 0.035,
+        "x variance {}",
+        c[0][0]
+    );
+    assert!(close(c[1][1], q, 1e-12), "y variance {}", c[1][1]);
+    assert!(c[0][1].abs() < 1e-9, "xy {}", c[0][1]);
+    // In a closed 4 × 4 m room every direction is pinned.
+    let room = wall_points(&[
+        ((-2.0, -2.0), (2.0, -2.0)),
+        ((2.0, -2.0), (2.0, 2.0)),
+        ((2.0, 2.0), (-2.0, 2.0)),
+        ((-2.0, 2.0), (-2.0, -2.0)),
+    ]);
+    let field = field_from_points(&room, 0.05, 4, 1.0);
+    let c = response_covariance(&field, &room, &Pose2::IDENTITY, &window()).unwrap();
+    assert!(c[0][0] < 2.0 * q && c[1][1] < 2.0 * q, "room {c:?}");
+    // The corridor's heading: 3 m lever arms, so a tenth of a degree moves
+    // the ends by 5 mm; the heading variance is far below a degree's.
+    assert!(c[2][2] < 1f64.to_radians().powi(2), "heading {}", c[2][2]);
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn a_world_covariance_becomes_the_edge_frame_information() {
+    use slamlab::slam::match_covariance::edge_information;
+    // Long axis along world x (σ 0.2 m), short along y (σ 0.05 m), heading
+    // σ 0.01 rad; a node facing +y sees world x as its −y axis: information
+    // diag(1/0.05², 1/0.2², 1/0.01²) = diag(400, 25, 10000).
+    let cov = [[0.04, 0.0, 0.0], [0.0, 0.0025, 0.0], [0.0, 0.0, 0.0001]];
+    let w = edge_information(&cov, FRAC_PI_2).unwrap();
+    let want = [[400.0, 0.0, 0.0], [0.0, 25.0, 0.0], [0.0, 0.0, 10000.0]];
+    for r in 0..3 {
+        for c in 0..3 {
+            assert!(close(w[r][c], want[r][c], 1e-6), "{w:?}");
+        }
+    }
+    // Unrotated, with a correlation: the inverse of [[a, b], [b, d]] is
+    // [[d, −b], [−b, a]] / (ad − b²).
+    let cov = [[0.04, 0.01, 0.0], [0.01, 0.01, 0.0], [0.0, 0.0, 0.0001]];
+    let w = edge_information(&cov, 0.0).unwrap();
+    let det = 0.04 * 0.01 - 0.0001;
+    assert!(close(w[0][0], 0.01 / det, 1e-6) && close(w[0][1], -0.01 / det, 1e-6));
+    assert!(close(w[1][1], 0.04 / det, 1e-6) && close(w[2][2], 10000.0, 1e-6));
+    assert!(edge_information(&[[0.0; 3]; 3], 0.0).is_none());
+}

@@ -13,6 +13,7 @@
 
 use slamlab::geom::Pose2;
 use slamlab::slam::logslam::LogSlam;
+use slamlab::slam::posegraph::PoseGraph;
 use slamlab::slam::relations::{drift_odometry, DriftModel};
 
 #[path = "../../tests/real_support/mod.rs"]
@@ -75,6 +76,7 @@ fn report(name: &str, slam: &LogSlam, reference: &[Pose2]) {
         }
     }
     println!("  closures: {total}, wrong (> 0.2 m or > 2 deg): {wrong}");
+    calibration(slam, reference, &key_scan);
     let n = seq.len().max(1) as f64;
     let (mt, mr) = seq
         .iter()
@@ -88,6 +90,51 @@ fn report(name: &str, slam: &LogSlam, reference: &[Pose2]) {
             let kind = if *info < 100.0 { " (odometry)" } else { "" };
             println!("    key edge scans {a:5} -> {b:5} error {t:6.3} m {r:6.2} deg{kind}");
         }
+    }
+}
+
+/// How well the edges' information matches their errors: the mean χ² of
+/// each kind of edge at the reference poses (3 if the covariances were
+/// right), and its median (2.37 for a χ²₃).
+fn calibration(slam: &LogSlam, reference: &[Pose2], key_scan: &[usize]) {
+    let graph = PoseGraph {
+        nodes: key_scan.iter().map(|&s| reference[s]).collect(),
+        edges: Vec::new(),
+    };
+    for closures in [false, true] {
+        let mut chi2: Vec<f64> = slam
+            .graph
+            .edges
+            .iter()
+            .filter(|e| e.loop_closure == closures && e.information[0][0] > 20.0)
+            .map(|e| graph.chi2(e))
+            .collect();
+        // The heading's share: χ² of the edge with its heading weight only.
+        let heading: f64 = slam
+            .graph
+            .edges
+            .iter()
+            .filter(|e| e.loop_closure == closures && e.information[0][0] > 20.0)
+            .map(|e| {
+                let mut h = e.clone();
+                h.information = [[0.0; 3], [0.0; 3], [0.0, 0.0, e.information[2][2]]];
+                graph.chi2(&h)
+            })
+            .sum();
+        chi2.sort_by(f64::total_cmp);
+        let n = chi2.len().max(1) as f64;
+        println!(
+            "  {} at the reference: mean chi2 {:.2} (heading {:.2}), median {:.2} ({} edges)",
+            if closures {
+                "closures"
+            } else {
+                "matched key edges"
+            },
+            chi2.iter().sum::<f64>() / n,
+            heading / n,
+            chi2.get(chi2.len() / 2).copied().unwrap_or(0.0),
+            chi2.len()
+        );
     }
 }
 

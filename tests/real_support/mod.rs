@@ -199,6 +199,13 @@ pub fn config_from_env() -> LogSlamConfig {
             "dcs_phi" => cfg.dcs_phi = v,
             "velocity_prior" => cfg.velocity_prior = v != 0.0,
             "dcs_incremental" => cfg.dcs_incremental = v != 0.0,
+            "key_covariance" => cfg.key_covariance = v != 0.0,
+            "loop_covariance" => cfg.loop_covariance = v != 0.0,
+            "key_covariance_plus_sigma" => cfg.key_covariance_plus_sigma = v != 0.0,
+            "key_covariance_position_only" => cfg.key_covariance_position_only = v != 0.0,
+            "response_half_m" => cfg.response.half_m = v,
+            "response_half_deg" => cfg.response.half_rad = v.to_radians(),
+            "response_drop" => cfg.response.drop = v,
             _ => panic!("SLAMLAB_LOG_SLAM: unknown setting {key}"),
         }
     }

@@ -24,7 +24,11 @@
 //! 3. **Key scans** (every `key_distance_m` or `key_angle_rad` of motion)
 //!    become nodes of the pose graph ([`super::posegraph`]), linked to the
 //!    previous key by the matched relative pose (or, where no match held,
-//!    by odometry with a looser covariance). Other scans are stored relative
+//!    by odometry with a looser covariance). The matched edge's covariance
+//!    is one σ for all (`key_sigma_m`, `key_sigma_rad`), or with
+//!    `key_covariance` the match's own, from the spread of the matcher's
+//!    response ([`super::match_covariance`]; measured in BENCHMARKS.md,
+//!    off by default). Other scans are stored relative
 //!    to their key, so they follow it when the graph moves.
 //! 4. **Loop closures** ([`super::loop_closure`]): every `loop_every` keys
 //!    the new key is matched against older keys near its estimate.
@@ -45,6 +49,7 @@
 use super::grid::{GridConfig, OccupancyGrid};
 use super::likelihood::LikelihoodField;
 use super::loop_closure::{find_closure, Closure, LoopConfig};
+use super::match_covariance::{edge_information, response_covariance, ResponseWindow};
 use super::multires::{field_from_points, match_scan, ScanMatch, Window};
 use super::posegraph::{Edge, PoseGraph};
 use crate::carmen::LogScan;
@@ -93,6 +98,22 @@ pub struct LogSlamConfig {
     /// Whether DCS also weighs the optimisations that accept closures (else
     /// only the final one, started from the accepted graph).
     pub dcs_incremental: bool,
+    /// Weigh each matched key edge by its own match's covariance (the
+    /// spread of the matcher's response, [`super::match_covariance`])
+    /// instead of `key_sigma_m` / `key_sigma_rad`.
+    pub key_covariance: bool,
+    /// The same for loop closures (instead of `loops.sigma_m` /
+    /// `loops.sigma_rad`).
+    pub loop_covariance: bool,
+    /// With `key_covariance`: add `key_sigma_m` / `key_sigma_rad` to the
+    /// match's covariance (independent errors add): the local map the key
+    /// was matched against has its own error, which the response cannot see.
+    pub key_covariance_plus_sigma: bool,
+    /// With `key_covariance`: take only the positional block from the
+    /// response and keep `key_sigma_rad` for the heading.
+    pub key_covariance_position_only: bool,
+    /// Where the response is sampled for those covariances.
+    pub response: ResponseWindow,
 }
 
 impl Default for LogSlamConfig {
@@ -126,6 +147,15 @@ impl Default for LogSlamConfig {
             velocity_prior: true,
             dcs_phi: 0.0,
             dcs_incremental: false,
+            key_covariance: false,
+            loop_covariance: false,
+            key_covariance_plus_sigma: false,
+            key_covariance_position_only: false,
+            response: ResponseWindow {
+                half_m: 0.3,
+                half_rad: 3f64.to_radians(),
+                drop: 0.1,
+            },
         }
     }
 }
@@ -182,6 +212,8 @@ pub struct LogSlam {
     /// Whether the odometry did not change between the last two scans.
     odometry_stale: bool,
     unmatched_since_key: bool,
+    /// The covariance of the match that made the next key (world frame).
+    key_cov: Option<[[f64; 3]; 3]>,
     pending: Vec<Closure>,
     pub closures: Vec<ClosureInfo>,
     pub stats: LogSlamStats,
@@ -251,6 +283,7 @@ impl LogSlam {
             last_step: Pose2::IDENTITY,
             odometry_stale: false,
             unmatched_since_key: false,
+            key_cov: None,
             pending: Vec::new(),
             closures: Vec::new(),
             stats: LogSlamStats::default(),
@@ -267,8 +300,8 @@ impl LogSlam {
             return;
         };
         let predicted = last_pose.compose(&last_odom.between(&scan.odometry));
-        let pose = match self.match_local(&points, &predicted, &last_pose.compose(&self.last_step))
-        {
+        let found = self.match_local(&points, &predicted, &last_pose.compose(&self.last_step));
+        let pose = match &found {
             Some(m) => {
                 self.stats.matched += 1;
                 m.pose
@@ -286,6 +319,24 @@ impl LogSlam {
         let is_key = rel.position().length() >= self.config.key_distance_m
             || rel.theta.abs() >= self.config.key_angle_rad;
         if is_key {
+            self.key_cov = match (&found, &self.local) {
+                (Some(_), Some(field)) if self.config.key_covariance => {
+                    response_covariance(field, &points, &pose, &self.config.response).map(
+                        |mut c| {
+                            if self.config.key_covariance_plus_sigma {
+                                c[0][0] += self.config.key_sigma_m.powi(2);
+                                c[1][1] += self.config.key_sigma_m.powi(2);
+                                c[2][2] += self.config.key_sigma_rad.powi(2);
+                            }
+                            if self.config.key_covariance_position_only {
+                                c[2][2] = self.config.key_sigma_rad.powi(2);
+                            }
+                            c
+                        },
+                    )
+                }
+                _ => None,
+            };
             self.add_key(scan, pose, points, Some(key));
         } else {
             self.scans.push(ScanEntry {
@@ -347,7 +398,15 @@ impl LogSlam {
             } else {
                 (self.config.key_sigma_m, self.config.key_sigma_rad)
             };
-            self.graph.edges.push(Edge::new(p, id, z, sm, sr));
+            let mut edge = Edge::new(p, id, z, sm, sr);
+            let info = self
+                .key_cov
+                .take()
+                .and_then(|c| edge_information(&c, pose.theta));
+            if let (Some(info), false) = (info, self.unmatched_since_key) {
+                edge.information = info;
+            }
+            self.graph.edges.push(edge);
         }
         self.unmatched_since_key = false;
         self.key_points.push(points);
@@ -393,6 +452,7 @@ impl LogSlam {
             id,
             self.config.resolution_m,
             &self.config.loops,
+            Some(&self.config.response).filter(|_| self.config.loop_covariance),
         ) else {
             return;
         };

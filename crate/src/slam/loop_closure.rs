@@ -26,6 +26,7 @@
 //!    ([`super::logslam`]) then optimises the graph and keeps the edge only if
 //!    the result is consistent (see there).
 
+use super::match_covariance::{edge_information, response_covariance, ResponseWindow};
 use super::multires::{field_from_points, match_scan, Window};
 use super::posegraph::Edge;
 use crate::geom::Pose2;
@@ -69,13 +70,16 @@ pub struct Closure {
 }
 
 /// Looks for a closure of key `i` (pose `nodes[i]`, points `key_points[i]`
-/// in its robot frame) against the older keys.
+/// in its robot frame) against the older keys. With `response`, the edge's
+/// information is the match's own ([`super::match_covariance`]) instead of
+/// `cfg.sigma_m` / `cfg.sigma_rad`.
 pub fn find_closure(
     nodes: &[Pose2],
     key_points: &[Vec<DVec2>],
     i: usize,
     resolution_m: f64,
     cfg: &LoopConfig,
+    response: Option<&ResponseWindow>,
 ) -> Option<Closure> {
     if i < cfg.min_key_gap {
         return None;
@@ -105,6 +109,12 @@ pub fn find_closure(
         cfg.sigma_rad,
     );
     edge.loop_closure = true;
+    if let Some(info) = response
+        .and_then(|w| response_covariance(&field, &key_points[i], &m.pose, w))
+        .and_then(|c| edge_information(&c, m.pose.theta))
+    {
+        edge.information = info;
+    }
     Some(Closure {
         edge,
         score: m.score,

@@ -18,6 +18,7 @@
 //! | scoring against ground truth | [`scoring`] | Sturm et al., IROS 2012 (ATE) |
 //! | drawing and ROS map export | [`export`] | ROS `map_server` format |
 //! | tables of scans for real lasers | [`multires`] | Olson, ICRA 2009 |
+//! | a match's covariance from its response | [`match_covariance`] | Olson, ICRA 2009 §IV-C; Konolige et al. 2010 |
 //! | pose graph, sparse least squares | [`posegraph`] | Lu & Milios 1997; Grisetti et al. 2010 |
 //! | loop closure by correlative matching | [`loop_closure`] | Konolige et al. 2010; Hess et al. 2016 |
 //! | SLAM for real laser logs | [`logslam`] | Karto / slam_toolbox, Cartographer |
@@ -37,6 +38,7 @@ pub mod log_replay;
 pub mod logslam;
 pub mod loop_closure;
 pub mod mapper;
+pub mod match_covariance;
 pub mod multires;
 pub mod posegraph;
 pub mod relations;
