@@ -2,7 +2,7 @@
 //! against the truth over time, with what the matcher said.
 //!
 //! ```sh
-//! cargo run --release -p slamlab --example sim_drift -- SCENARIO.json robot5 [robot15 …] [--every 60] [--until 3600] [--no-graph]
+//! cargo run --release -p slamlab --example sim_drift -- SCENARIO.json robot5 [robot15 …] [--every 60] [--until 3600] [--graph]
 //! ```
 //!
 //! The simulation runs with its own mappers off and the named robots' mappers
@@ -12,12 +12,14 @@
 //! than drift), it prints the error of the estimate and of odometry, the
 //! match outcome counts in that stretch, the calibrated odometry bias, the
 //! loop closures accepted so far, and whether the map grid refused to grow.
-//! `--no-graph` runs the filter without its loop-closing back end.
+//! `--graph` runs the filter with the loop-closing back end
+//! ([`slamlab::slam::robot_graph`]), which is off by default.
 
 use slamlab::geom::{wrap_angle, Pose2};
 use slamlab::scenario::Scenario;
 use slamlab::sim::Simulation;
 use slamlab::slam::mapper::{MatchCounts, RobotMapping};
+use slamlab::slam::robot_graph::{RobotGraph, RobotGraphConfig};
 use slamlab::slam::scoring::{ate_m, position_errors_m};
 
 struct Traced {
@@ -31,15 +33,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let path = args
         .first()
-        .ok_or("usage: sim_drift SCENARIO.json ROBOT… [--every S] [--until S] [--no-graph]")?;
+        .ok_or("usage: sim_drift SCENARIO.json ROBOT… [--every S] [--until S] [--graph]")?;
     let mut scenario =
         Scenario::parse(&std::fs::read_to_string(path)?).map_err(|e| format!("{e:?}"))?;
-    let (mut every_s, mut names, mut back_end): (f64, Vec<String>, bool) = (60.0, Vec::new(), true);
+    let (mut every_s, mut names, mut back_end): (f64, Vec<String>, bool) =
+        (60.0, Vec::new(), false);
     let mut it = args[1..].iter();
     while let Some(a) = it.next() {
         match a.as_str() {
             "--every" => every_s = it.next().ok_or("--every S")?.parse()?,
-            "--no-graph" => back_end = false,
+            "--graph" => back_end = true,
             "--until" => scenario.duration_s = it.next().ok_or("--until S")?.parse()?,
             name => names.push(name.to_string()),
         }
@@ -56,8 +59,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .position(|r| &r.spec.name == n)
                 .ok_or(format!("no robot '{n}'"))?;
             let mut mapping = RobotMapping::default();
-            if !back_end {
-                mapping.graph = None;
+            if back_end {
+                mapping.graph = Some(RobotGraph::new(RobotGraphConfig::default()));
+            }
+            // Experiments: a few settings from the environment.
+            let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
+            if let Some(g) = &mut mapping.graph {
+                let c = &mut g.config;
+                c.key_sigma_m = env("GRAPH_KEY_SIGMA_M").unwrap_or(c.key_sigma_m);
+                c.key_sigma_rad =
+                    env("GRAPH_KEY_SIGMA_DEG").map_or(c.key_sigma_rad, f64::to_radians);
+                c.cooldown_keys = env("GRAPH_COOLDOWN").map_or(c.cooldown_keys, |v| v as usize);
+                c.loops.window.linear_m = env("GRAPH_WINDOW_M").unwrap_or(c.loops.window.linear_m);
+                if env("GRAPH_NO_LOOPS").is_some() {
+                    c.loops.min_key_gap = usize::MAX / 2;
+                }
             }
             Ok(Traced {
                 index,
@@ -101,6 +117,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             r.spec.name,
             profile.join(" ")
         );
+        print_edge_errors(r, &t.mapping);
         println!(
             "{}: ATE slam {:.3} m, odometry {:.3} m, path {:.0} m, counts {:?}, back end {:?}",
             r.spec.name,
@@ -135,6 +152,33 @@ fn print_closures(r: &slamlab::sim::RobotSim, mapping: &RobotMapping, seen: usiz
             wrap_angle(e.theta).to_degrees()
         );
     }
+}
+
+/// RMS error of the front end's relative pose between consecutive keys
+/// against the truth's: along, across and in heading (what the key edges'
+/// standard deviations should be).
+fn print_edge_errors(r: &slamlab::sim::RobotSim, mapping: &RobotMapping) {
+    let Some(g) = &mapping.graph else {
+        return;
+    };
+    let (est, truth) = (mapping.estimates(), &r.log.truth);
+    let mut sums = [0.0; 3];
+    let steps = g.key_steps();
+    for w in steps.windows(2) {
+        let z = est[w[0]].between(&est[w[1]]);
+        let e = truth[w[0]].between(&truth[w[1]]).between(&z);
+        sums[0] += e.x * e.x;
+        sums[1] += e.y * e.y;
+        sums[2] += wrap_angle(e.theta).powi(2);
+    }
+    let n = steps.len().saturating_sub(1).max(1) as f64;
+    println!(
+        "{} key edges: rms along {:.4} m, across {:.4} m, heading {:.3}°",
+        r.spec.name,
+        (sums[0] / n).sqrt(),
+        (sums[1] / n).sqrt(),
+        (sums[2] / n).sqrt().to_degrees()
+    );
 }
 
 fn print_row(sim: &Simulation, t: &mut Traced, truth: &Pose2, odometry: &Pose2, err: f64) {

@@ -58,7 +58,7 @@ use super::filter::PoseFilter;
 use super::gauss_newton;
 use super::grid::{beam_directions, GridConfig, OccupancyGrid};
 use super::likelihood::LikelihoodField;
-use super::robot_graph::{FrontEnd, RobotGraph, RobotGraphConfig};
+use super::robot_graph::{FrontEnd, RobotGraph};
 use super::surface::{information_at, refine_to_surface, RefineConfig, Refinement};
 use crate::geom::Pose2;
 use crate::sensors::LaserScan;
@@ -285,7 +285,8 @@ pub struct RobotMapping {
     last_odometry: Pose2,
     pub counts: MatchCounts,
     pub last_outcome: Option<MatchOutcome>,
-    /// The loop-closing back end ([`super::robot_graph`]); `None` runs the
+    /// The loop-closing back end ([`super::robot_graph`]); `None` (the
+    /// default, until it helps every robot: see its module doc) runs the
     /// filter alone.
     pub graph: Option<RobotGraph>,
 }
@@ -315,7 +316,7 @@ impl RobotMapping {
             last_odometry: Pose2::IDENTITY,
             counts: MatchCounts::default(),
             last_outcome: None,
-            graph: Some(RobotGraph::new(RobotGraphConfig::default())),
+            graph: None,
         }
     }
 
