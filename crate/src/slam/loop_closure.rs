@@ -120,3 +120,19 @@ pub fn find_closure(
         score: m.score,
     })
 }
+
+/// Pairwise consistency of two closures `a` and `b` (Olson, "Recognizing
+/// places using spectrally clustered local matches", RAS 2009): the cycle
+/// *old_a → new_a → new_b → old_b → old_a*, made of the two closures and the
+/// relative poses of `nodes` along the two stretches between their ends
+/// (each locally accurate), must compose to within `max_m` and `max_rad` of
+/// the identity.
+pub fn closures_agree(nodes: &[Pose2], a: &Closure, b: &Closure, max_m: f64, max_rad: f64) -> bool {
+    let cycle = a
+        .edge
+        .measurement
+        .compose(&nodes[a.edge.to].between(&nodes[b.edge.to]))
+        .compose(&b.edge.measurement.inverse())
+        .compose(&nodes[b.edge.from].between(&nodes[a.edge.from]));
+    cycle.position().length() <= max_m && cycle.theta.abs() <= max_rad
+}

@@ -58,6 +58,7 @@ use super::filter::PoseFilter;
 use super::gauss_newton;
 use super::grid::{beam_directions, GridConfig, OccupancyGrid};
 use super::likelihood::LikelihoodField;
+use super::robot_graph::{FrontEnd, RobotGraph};
 use super::surface::{information_at, refine_to_surface, RefineConfig, Refinement};
 use crate::geom::Pose2;
 use crate::sensors::LaserScan;
@@ -284,6 +285,10 @@ pub struct RobotMapping {
     last_odometry: Pose2,
     pub counts: MatchCounts,
     pub last_outcome: Option<MatchOutcome>,
+    /// The loop-closing back end ([`super::robot_graph`]); `None` (the
+    /// default, until it helps every robot: see its module doc) runs the
+    /// filter alone.
+    pub graph: Option<RobotGraph>,
 }
 
 impl Default for RobotMapping {
@@ -311,6 +316,7 @@ impl RobotMapping {
             last_odometry: Pose2::IDENTITY,
             counts: MatchCounts::default(),
             last_outcome: None,
+            graph: None,
         }
     }
 
@@ -360,6 +366,17 @@ impl RobotMapping {
         }
         self.slam_map.integrate_scan(&outcome.pose, scan);
         self.estimates.push(outcome.pose);
+        if let Some(graph) = &mut self.graph {
+            graph.add_scan(
+                scan,
+                outcome.status != MatchStatus::OdometryOnly,
+                FrontEnd {
+                    estimates: &mut self.estimates,
+                    pose: &mut self.filter.pose,
+                    map: &mut self.slam_map,
+                },
+            );
+        }
         self.last_odometry = *odometry;
         self.last_outcome = Some(outcome);
     }

@@ -22,6 +22,7 @@
 //! | pose graph, sparse least squares | [`posegraph`] | Lu & Milios 1997; Grisetti et al. 2010 |
 //! | loop closure by correlative matching | [`loop_closure`] | Konolige et al. 2010; Hess et al. 2016 |
 //! | SLAM for real laser logs | [`logslam`] | Karto / slam_toolbox, Cartographer |
+//! | the simulated robots' loop-closing back end | [`robot_graph`] | Konolige et al. 2010; Hess et al. 2016 |
 //! | relation errors against a reference | [`relations`] | Kümmerle et al., Auton. Robots 2009 |
 //!
 //! The simulation feeds every robot's [`RobotMapping`] once per step with
@@ -42,6 +43,7 @@ pub mod match_covariance;
 pub mod multires;
 pub mod posegraph;
 pub mod relations;
+pub mod robot_graph;
 pub mod scoring;
 pub mod surface;
 

@@ -1,0 +1,222 @@
+//! Where a simulated robot's SLAM goes wrong on a long run: its error
+//! against the truth over time, with what the matcher said.
+//!
+//! ```sh
+//! cargo run --release -p slamlab --example sim_drift -- SCENARIO.json robot5 [robot15 …] [--every 60] [--until 3600] [--graph]
+//! ```
+//!
+//! The simulation runs with its own mappers off and the named robots' mappers
+//! fed here (odometry pose and scan, never the truth), exactly as the
+//! simulation would. Every `--every` simulated seconds, and at every step
+//! whose position error changes by more than 5 cm at once (a jump rather
+//! than drift), it prints the error of the estimate and of odometry, the
+//! match outcome counts in that stretch, the calibrated odometry bias, the
+//! loop closures accepted so far, and whether the map grid refused to grow.
+//! `--graph` runs the filter with the loop-closing back end
+//! ([`slamlab::slam::robot_graph`]), which is off by default.
+
+use slamlab::geom::{wrap_angle, Pose2};
+use slamlab::scenario::Scenario;
+use slamlab::sim::Simulation;
+use slamlab::slam::mapper::{MatchCounts, RobotMapping};
+use slamlab::slam::robot_graph::{RobotGraph, RobotGraphConfig};
+use slamlab::slam::scoring::{ate_m, position_errors_m};
+
+struct Traced {
+    index: usize,
+    mapping: RobotMapping,
+    last_err: f64,
+    last_counts: MatchCounts,
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let path = args
+        .first()
+        .ok_or("usage: sim_drift SCENARIO.json ROBOT… [--every S] [--until S] [--graph]")?;
+    let mut scenario =
+        Scenario::parse(&std::fs::read_to_string(path)?).map_err(|e| format!("{e:?}"))?;
+    let (mut every_s, mut names, mut back_end): (f64, Vec<String>, bool) =
+        (60.0, Vec::new(), false);
+    let mut it = args[1..].iter();
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--every" => every_s = it.next().ok_or("--every S")?.parse()?,
+            "--graph" => back_end = true,
+            "--until" => scenario.duration_s = it.next().ok_or("--until S")?.parse()?,
+            name => names.push(name.to_string()),
+        }
+    }
+    let mut sim = Simulation::new(&scenario).map_err(|e| format!("{e:?}"))?;
+    sim.set_capture(false);
+    sim.set_mapping(false);
+    let mut traced: Vec<Traced> = names
+        .iter()
+        .map(|n| {
+            let index = sim
+                .robots
+                .iter()
+                .position(|r| &r.spec.name == n)
+                .ok_or(format!("no robot '{n}'"))?;
+            let mut mapping = RobotMapping::default();
+            if back_end {
+                mapping.graph = Some(RobotGraph::new(RobotGraphConfig::default()));
+            }
+            // Experiments: a few settings from the environment.
+            let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
+            if let Some(g) = &mut mapping.graph {
+                let c = &mut g.config;
+                c.key_sigma_m = env("GRAPH_KEY_SIGMA_M").unwrap_or(c.key_sigma_m);
+                c.key_sigma_rad =
+                    env("GRAPH_KEY_SIGMA_DEG").map_or(c.key_sigma_rad, f64::to_radians);
+                c.cooldown_keys = env("GRAPH_COOLDOWN").map_or(c.cooldown_keys, |v| v as usize);
+                c.loops.window.linear_m = env("GRAPH_WINDOW_M").unwrap_or(c.loops.window.linear_m);
+                if env("GRAPH_NO_LOOPS").is_some() {
+                    c.loops.min_key_gap = usize::MAX / 2;
+                }
+            }
+            Ok(Traced {
+                index,
+                mapping,
+                last_err: 0.0,
+                last_counts: MatchCounts::default(),
+            })
+        })
+        .collect::<Result<_, String>>()?;
+    let every = (every_s / 0.1).round().max(1.0) as usize;
+    while !sim.finished() {
+        sim.step();
+        let step = sim.steps();
+        for t in &mut traced {
+            let r = &sim.robots[t.index];
+            let odometry = r.odometry.pose();
+            let seen = t.mapping.graph.as_ref().map_or(0, |g| g.closures.len());
+            t.mapping.observe(&odometry, &r.last_scan);
+            let start = r.spec.start_pose();
+            print_closures(r, &t.mapping, seen);
+            let truth = start.inverse().compose(&r.truth);
+            let est = t.mapping.estimate();
+            let err = est.position().distance(truth.position());
+            if step % every == 0 || (err - t.last_err).abs() > 0.05 {
+                print_row(&sim, t, &truth, &odometry, err);
+            }
+            t.last_err = err;
+        }
+    }
+    for t in &traced {
+        let r = &sim.robots[t.index];
+        let start = r.spec.start_pose();
+        let errors = position_errors_m(&start, t.mapping.estimates(), &r.log.truth);
+        let profile: Vec<String> = errors
+            .iter()
+            .step_by(every)
+            .map(|e| format!("{e:.2}"))
+            .collect();
+        println!(
+            "{} final error every {every_s} s: {}",
+            r.spec.name,
+            profile.join(" ")
+        );
+        print_edge_errors(r, &t.mapping);
+        println!(
+            "{}: ATE slam {:.3} m, odometry {:.3} m, path {:.0} m, counts {:?}, back end {:?}",
+            r.spec.name,
+            ate_m(&start, t.mapping.estimates(), &r.log.truth),
+            ate_m(&start, &r.log.odometry, &r.log.truth),
+            r.log.path_length_m(),
+            t.mapping.counts,
+            t.mapping.graph.as_ref().map(|g| g.stats)
+        );
+    }
+    Ok(())
+}
+
+/// Accepted closures from the `seen`-th on, with their error against the
+/// truth (the relative pose between the two steps' true poses).
+fn print_closures(r: &slamlab::sim::RobotSim, mapping: &RobotMapping, seen: usize) {
+    let Some(g) = &mapping.graph else {
+        return;
+    };
+    for c in &g.closures[seen..] {
+        let (a, b) = (r.log.truth[c.from_step], r.log.truth[c.to_step]);
+        let e = a.between(&b).between(&c.measurement);
+        println!(
+            "{:>8} closure keys {}→{} (steps {}→{}) score {:.2}: error {:.3} m {:+.2}°",
+            r.spec.name,
+            c.from_key,
+            c.to_key,
+            c.from_step,
+            c.to_step,
+            c.score,
+            e.position().length(),
+            wrap_angle(e.theta).to_degrees()
+        );
+    }
+}
+
+/// RMS error of the front end's relative pose between consecutive keys
+/// against the truth's: along, across and in heading (what the key edges'
+/// standard deviations should be).
+fn print_edge_errors(r: &slamlab::sim::RobotSim, mapping: &RobotMapping) {
+    let Some(g) = &mapping.graph else {
+        return;
+    };
+    let (est, truth) = (mapping.estimates(), &r.log.truth);
+    let mut sums = [0.0; 3];
+    let steps = g.key_steps();
+    for w in steps.windows(2) {
+        let z = est[w[0]].between(&est[w[1]]);
+        let e = truth[w[0]].between(&truth[w[1]]).between(&z);
+        sums[0] += e.x * e.x;
+        sums[1] += e.y * e.y;
+        sums[2] += wrap_angle(e.theta).powi(2);
+    }
+    let n = steps.len().saturating_sub(1).max(1) as f64;
+    println!(
+        "{} key edges: rms along {:.4} m, across {:.4} m, heading {:.3}°",
+        r.spec.name,
+        (sums[0] / n).sqrt(),
+        (sums[1] / n).sqrt(),
+        (sums[2] / n).sqrt().to_degrees()
+    );
+}
+
+fn print_row(sim: &Simulation, t: &mut Traced, truth: &Pose2, odometry: &Pose2, err: f64) {
+    let r = &sim.robots[t.index];
+    let est = t.mapping.estimate();
+    let c = t.mapping.counts;
+    let d = MatchCounts {
+        matched: c.matched - t.last_counts.matched,
+        degenerate: c.degenerate - t.last_counts.degenerate,
+        odometry_only: c.odometry_only - t.last_counts.odometry_only,
+    };
+    t.last_counts = c;
+    let out = t.mapping.last_outcome;
+    let bias = t.mapping.odometry_bias();
+    let closures = t
+        .mapping
+        .graph
+        .as_ref()
+        .map_or(0, |g| g.stats.closures_accepted);
+    println!(
+        "{:>8} t {:7.1} truth ({:6.2},{:6.2}) err {err:.3} ({:+.3},{:+.3}) {:+6.2}°  odo {:.3}  {:?} score {:.2} weak {:.1}  stretch m/d/o {}/{}/{}  bias ({:+.4}, {:+.4})  dropped {}  bumps {}  closures {closures}",
+        r.spec.name,
+        sim.time_s(),
+        r.truth.x,
+        r.truth.y,
+        est.x - truth.x,
+        est.y - truth.y,
+        wrap_angle(est.theta - truth.theta).to_degrees(),
+        odometry.position().distance(truth.position()),
+        out.map(|o| o.status),
+        out.map_or(0.0, |o| o.score),
+        out.map_or(0.0, |o| o.constraint.weak),
+        d.matched,
+        d.degenerate,
+        d.odometry_only,
+        bias[0],
+        bias[1],
+        t.mapping.slam_map.dropped_updates(),
+        r.bumps,
+    );
+}

@@ -1,0 +1,596 @@
+//! # The simulated robot's back end: key scans, loop closures, a pose graph
+//!
+//! The online mapper ([`super::mapper`]) estimates only the current pose: a
+//! filter whose measurement is the scan matched to the map built so far. Its
+//! small errors add up on a long run, and where it goes wrong once (a
+//! stretch the laser cannot pin, a robot in the way) every later wall is
+//! drawn where the wrong pose put it, so the map itself holds the error and
+//! the matcher keeps it. Returning to a place mapped long ago is what can
+//! undo that: this file is the loop-closing back end of graph SLAM, in the
+//! manner of Karto / slam_toolbox (K. Konolige, G. Grisetti, R. Kümmerle,
+//! W. Burgard, B. Limketkai, R. Vincent, "Efficient sparse pose adjustment
+//! for 2D mapping", IROS 2010) and Cartographer (W. Hess, D. Kohler, H. Rapp,
+//! D. Andor, "Real-time loop closure in 2D LIDAR SLAM", ICRA 2016), run
+//! beside the filter, which stays the front end:
+//!
+//! 1. **Key scans.** Every `key_distance_m` of motion (or `key_angle_rad` of
+//!    turn) of the filter's estimate, the scan becomes a key: a node of the
+//!    pose graph ([`super::posegraph`]) at the estimate, and its ranges kept
+//!    compactly, one `u16` in millimetres per beam, as the robot's log keeps
+//!    them. Consecutive keys are linked by the filter's relative motion,
+//!    trusted as `key_sigma_*`, or `loose_sigma_*` when the filter matched
+//!    nothing in between (odometry alone carried it).
+//! 2. **Loop closures** ([`super::loop_closure`]): every `loop_every` keys a
+//!    new key whose scan constrains every direction (not a corridor, where a
+//!    match slides along the walls) is matched, by Olson's correlative
+//!    search, against the older keys near its estimate.
+//! 3. **Consistency.** A closure may ask the graph for no larger a
+//!    correction than the front end can have drifted along the path between
+//!    its two keys (`max_correction_m` plus `drift_per_metre` of it: the
+//!    gate a Mahalanobis test on the chain's covariance would make); a match
+//!    that asks more slid along a corridor. In a maze of identical cells a closure can be wrong by
+//!    a cell, the worst outcome there is: it bends the whole graph onto the
+//!    wrong place. A closure is accepted only when a second one found within
+//!    `confirm_keys` keys agrees with it (Olson's pairwise consistency, as
+//!    the log SLAM does, [`super::logslam`]), and the optimisation that takes
+//!    them must leave both satisfied (χ² at most `max_closure_chi2`), or it is
+//!    undone. A confirmed pair the graph already satisfies (within
+//!    `satisfied_m`) is not added, and after a pair the search rests for
+//!    `cooldown_keys` keys: on the second lap of a tour every key would
+//!    close, and each optimisation of the whole graph costs.
+//! 4. **Correction.** After an accepted closure the graph is optimised (sparse
+//!    least squares), and every step's estimate moves with its key: step `k`
+//!    of key `j` goes to `x_j' ⊕ x_j⁻¹ ⊕ x̂_k`, so the trajectory the lab scores
+//!    is the corrected one, and the filter's current pose moves with the
+//!    newest key. When some key moved by more than `rebuild_m` (a cell), the
+//!    SLAM map is drawn again from the key scans at their new poses: the
+//!    filter must match against walls where the graph now puts them, or it
+//!    would pull the pose straight back.
+//!
+//! ## What the numbers say so far (why it is off by default)
+//! On the one-hour, 16-robot, 60 × 60 m maze of issue 22
+//! (`examples/sim_drift.rs`), the robots whose SLAM diverged follow the
+//! maze's outer wall: a 240 m loop of mostly degenerate corridor (more than
+//! half the scans pin only the direction across the wall), where the
+//! filter's heading drifts by 1–2° per lap and its position by 0.5–1.3 m
+//! before the loop first closes (slow drift, no jump: the matcher's
+//! outcomes show no wrong match, the odometry calibration stays put). The
+//! closures found there are right to a few millimetres (checked against the
+//! truth), and they snap the current pose back to within 2 cm. But one loop
+//! closed around a 240 m chain cannot tell the graph *where* along the chain
+//! the error arose: least squares spreads it evenly, which leaves 0.3–0.9 m
+//! in the middle of the lap, and the next lap then locks onto that corrected
+//! map. ATE went from 1.20 / 0.88 / 0.63 / 0.15 m to 0.22 / 0.08 / 0.25 /
+//! 0.10 m for robots 15, 5, 11, 16, but from 0.49 to 0.65 m for robot 7. Until
+//! it helps every robot the mapper runs without it (`RobotMapping::graph`
+//! is `None`); `sim_drift --graph` runs it.
+
+use super::degeneracy::{constraint_of, scan_normals};
+use super::grid::{beam_directions, GridConfig, OccupancyGrid};
+use super::loop_closure::{closures_agree, find_closure, Closure, LoopConfig};
+use super::multires::Window;
+use super::posegraph::{Edge, PoseGraph};
+use crate::geom::{wrap_angle, Pose2};
+use crate::sensors::LaserScan;
+use glam::DVec2;
+
+/// Settings of the back end.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RobotGraphConfig {
+    pub key_distance_m: f64,
+    pub key_angle_rad: f64,
+    /// Standard deviations of a key-to-key edge where the filter matched.
+    pub key_sigma_m: f64,
+    pub key_sigma_rad: f64,
+    /// … and where it ran on odometry alone for a step or more.
+    pub loose_sigma_m: f64,
+    pub loose_sigma_rad: f64,
+    pub loops: LoopConfig,
+    pub loop_every: usize,
+    /// A key is tried for a closure only if its scan's weak eigenvalue
+    /// ([`super::degeneracy`]) reaches this.
+    pub min_constraint: f64,
+    pub confirm_keys: usize,
+    /// The two closures of a pair must reach old keys at least this many
+    /// keys apart: two matches of one old place agree with each other even
+    /// when both slid along the same corridor.
+    pub confirm_spread_keys: usize,
+    /// Largest correction a closure may ask of the graph: this much plus
+    /// `drift_per_metre` of the path driven between its keys (the front
+    /// end's drift cannot be larger; a match that asks more slid).
+    pub max_correction_m: f64,
+    pub drift_per_metre: f64,
+    pub confirm_m: f64,
+    pub confirm_rad: f64,
+    pub max_closure_chi2: f64,
+    /// Keys after an accepted pair of closures before the next search: the
+    /// graph has just been settled there, and each optimisation costs.
+    pub cooldown_keys: usize,
+    /// A confirmed closure the graph already satisfies within this (m, and
+    /// radians times the laser's reach) adds nothing worth an optimisation.
+    pub satisfied_m: f64,
+    /// A correction moving some key by more than this (m, or radians times
+    /// the laser's reach) redraws the SLAM map.
+    pub rebuild_m: f64,
+}
+
+impl Default for RobotGraphConfig {
+    fn default() -> Self {
+        RobotGraphConfig {
+            key_distance_m: 0.4,
+            key_angle_rad: 20f64.to_radians(),
+            key_sigma_m: 0.02,
+            key_sigma_rad: 0.5f64.to_radians(),
+            loose_sigma_m: 0.1,
+            loose_sigma_rad: 3f64.to_radians(),
+            loops: LoopConfig {
+                search_radius_m: 2.0,
+                min_key_gap: 50,
+                submap_half: 8,
+                window: Window {
+                    linear_m: 1.2,
+                    angular_rad: 10f64.to_radians(),
+                },
+                min_score: 0.6,
+                sigma_m: 0.03,
+                sigma_rad: 1f64.to_radians(),
+            },
+            loop_every: 2,
+            min_constraint: 20.0,
+            confirm_keys: 10,
+            confirm_spread_keys: 2,
+            max_correction_m: 0.1,
+            drift_per_metre: 0.01,
+            confirm_m: 0.1,
+            confirm_rad: 1.5f64.to_radians(),
+            max_closure_chi2: 20.0,
+            cooldown_keys: 10,
+            satisfied_m: 0.02,
+            rebuild_m: 0.05,
+        }
+    }
+}
+
+/// A key scan: ranges in millimetres ([`NO_RETURN`] for none, the top bit
+/// set for a reflective return) and the step it was taken at.
+#[derive(Clone, Debug, PartialEq)]
+struct KeyScan {
+    ranges_mm: Vec<u16>,
+    range_max_m: f64,
+}
+
+/// A beam that met nothing in range.
+const NO_RETURN: u16 = u16::MAX;
+/// The flag bit of a reflective return (another robot).
+const REFLECTIVE: u16 = 0x8000;
+/// Returns this short are not matched (as the front end's points).
+const MIN_RANGE_MM: u16 = 50;
+
+impl KeyScan {
+    fn pack(scan: &LaserScan) -> KeyScan {
+        let ranges_mm = (0..scan.ranges_m.len())
+            .map(|i| {
+                if scan.max_range.get(i) != Some(&false) {
+                    return NO_RETURN;
+                }
+                let mm = (scan.ranges_m[i] * 1000.0).round().clamp(0.0, 32_767.0) as u16;
+                if scan.reflective.get(i) == Some(&true) {
+                    mm | REFLECTIVE
+                } else {
+                    mm
+                }
+            })
+            .collect();
+        KeyScan {
+            ranges_mm,
+            range_max_m: scan.range_max_m,
+        }
+    }
+
+    /// The returns off walls (not other robots), robot frame, beam order.
+    fn points(&self) -> Vec<DVec2> {
+        beam_directions(0.0, self.ranges_mm.len())
+            .zip(&self.ranges_mm)
+            .filter(|&(_, &v)| v != NO_RETURN && v & REFLECTIVE == 0 && v > MIN_RANGE_MM)
+            .map(|(d, &v)| d * (v as f64 / 1000.0))
+            .collect()
+    }
+
+    fn unpack(&self) -> LaserScan {
+        let n = self.ranges_mm.len();
+        let mut scan = LaserScan {
+            ranges_m: vec![self.range_max_m; n],
+            max_range: vec![true; n],
+            reflective: vec![false; n],
+            range_max_m: self.range_max_m,
+        };
+        for (i, &v) in self.ranges_mm.iter().enumerate() {
+            if v != NO_RETURN {
+                scan.ranges_m[i] = (v & !REFLECTIVE) as f64 / 1000.0;
+                scan.max_range[i] = false;
+                scan.reflective[i] = v & REFLECTIVE != 0;
+            }
+        }
+        scan
+    }
+}
+
+/// Counts of what the back end did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct RobotGraphStats {
+    pub keys: usize,
+    pub closures_tried: usize,
+    pub closures_found: usize,
+    pub closures_accepted: usize,
+    pub closures_rejected: usize,
+    /// Closures asking a larger correction than the front end can have
+    /// drifted (dropped).
+    pub closures_implausible: usize,
+    /// Confirmed closures the graph already satisfied (not added).
+    pub closures_satisfied: usize,
+    pub map_rebuilds: usize,
+}
+
+/// An accepted loop closure: its keys, the steps they were taken at, the
+/// measured relative pose and the match score.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClosureRecord {
+    pub from_key: usize,
+    pub to_key: usize,
+    pub from_step: usize,
+    pub to_step: usize,
+    pub measurement: Pose2,
+    pub score: f64,
+}
+
+/// What the front end hands the back end after each integrated scan, and
+/// what the back end may correct: every step's estimate, the filter's pose
+/// and the SLAM map.
+pub struct FrontEnd<'a> {
+    pub estimates: &'a mut Vec<Pose2>,
+    pub pose: &'a mut Pose2,
+    pub map: &'a mut OccupancyGrid,
+}
+
+/// One robot's pose graph of key scans.
+#[derive(Clone, Debug, Default)]
+pub struct RobotGraph {
+    pub config: RobotGraphConfig,
+    pub graph: PoseGraph,
+    keys: Vec<KeyScan>,
+    /// The step (index into the estimates) each key was taken at.
+    key_step: Vec<usize>,
+    /// The path driven up to each key (m, along the key edges).
+    key_path_m: Vec<f64>,
+    /// The key each step's estimate follows (the last key at or before it).
+    step_key: Vec<u32>,
+    /// The filter ran on odometry alone since the last key.
+    loose: bool,
+    pending: Vec<Closure>,
+    /// The key of the last accepted pair (for the cool-down).
+    last_accepted: Option<usize>,
+    pub closures: Vec<ClosureRecord>,
+    pub stats: RobotGraphStats,
+}
+
+impl RobotGraph {
+    pub fn new(config: RobotGraphConfig) -> RobotGraph {
+        RobotGraph {
+            config,
+            ..RobotGraph::default()
+        }
+    }
+
+    /// After the front end integrated `scan` at its newest estimate (the
+    /// last of `front.estimates`), `matched` unless it kept odometry's word: makes a key if the
+    /// robot moved far enough, looks for a loop closure, and applies an
+    /// accepted one to the front end.
+    pub fn add_scan(&mut self, scan: &LaserScan, matched: bool, front: FrontEnd<'_>) {
+        self.loose |= !matched;
+        let Some(&pose) = front.estimates.last() else {
+            return;
+        };
+        let is_key = match self.graph.nodes.last() {
+            None => true,
+            Some(last) => {
+                let rel = last.between(&pose);
+                rel.position().length() >= self.config.key_distance_m
+                    || rel.theta.abs() >= self.config.key_angle_rad
+            }
+        };
+        if is_key {
+            self.add_key(scan, pose);
+            self.key_step.push(front.estimates.len() - 1);
+        }
+        // Steps the front end did not hand over follow the last key too.
+        let last_key = (self.graph.nodes.len() - 1) as u32;
+        self.step_key.resize(front.estimates.len(), last_key);
+        if is_key && self.should_try() {
+            if let Some(closures) = self.try_close(front.map.resolution_m()) {
+                self.accept(closures, front);
+            }
+        }
+    }
+
+    fn add_key(&mut self, scan: &LaserScan, pose: Pose2) {
+        let id = self.graph.nodes.len();
+        if let Some(prev) = id.checked_sub(1) {
+            let z = self.graph.nodes[prev].between(&pose);
+            let c = &self.config;
+            let (sm, sr) = if self.loose {
+                (c.loose_sigma_m, c.loose_sigma_rad)
+            } else {
+                (c.key_sigma_m, c.key_sigma_rad)
+            };
+            self.graph.edges.push(Edge::new(prev, id, z, sm, sr));
+        }
+        let path = match (self.graph.nodes.last(), self.key_path_m.last()) {
+            (Some(prev), Some(&p)) => p + prev.position().distance(pose.position()),
+            _ => 0.0,
+        };
+        self.key_path_m.push(path);
+        self.graph.nodes.push(pose);
+        self.keys.push(KeyScan::pack(scan));
+        self.loose = false;
+        self.stats.keys += 1;
+    }
+
+    /// Whether the newest key is due for a closure search and its scan pins
+    /// every direction.
+    fn should_try(&self) -> bool {
+        let id = self.graph.nodes.len() - 1;
+        if id < self.config.loops.min_key_gap || !id.is_multiple_of(self.config.loop_every.max(1)) {
+            return false;
+        }
+        if self
+            .last_accepted
+            .is_some_and(|k| id < k + self.config.cooldown_keys)
+        {
+            return false;
+        }
+        let points = self.keys[id].points();
+        let normals = scan_normals(&points);
+        let constraint = constraint_of(&normals, &vec![true; points.len()]);
+        !constraint.is_degenerate(self.config.min_constraint)
+    }
+
+    /// The newest key's points and those of the older keys that a closure
+    /// search may read (near its estimate); the rest left empty.
+    fn key_points(&self, i: usize) -> Vec<Vec<DVec2>> {
+        let cfg = &self.config.loops;
+        let here = self.graph.nodes[i].position();
+        let newest_old = i - cfg.min_key_gap;
+        let mut wanted = vec![false; i + 1];
+        wanted[i] = true;
+        for j in 0..=newest_old {
+            if self.graph.nodes[j].position().distance(here) <= cfg.search_radius_m {
+                let hi = (j + cfg.submap_half).min(newest_old);
+                for w in &mut wanted[j.saturating_sub(cfg.submap_half)..=hi] {
+                    *w = true;
+                }
+            }
+        }
+        wanted
+            .iter()
+            .enumerate()
+            .map(|(k, &w)| if w { self.keys[k].points() } else { Vec::new() })
+            .collect()
+    }
+
+    /// Looks for a closure of the newest key; returns two closures that
+    /// agree (the new one and a pending one), else keeps the new one
+    /// pending.
+    fn try_close(&mut self, resolution_m: f64) -> Option<Vec<Closure>> {
+        let id = self.graph.nodes.len() - 1;
+        self.stats.closures_tried += 1;
+        let points = self.key_points(id);
+        let found = find_closure(
+            &self.graph.nodes,
+            &points,
+            id,
+            resolution_m,
+            &self.config.loops,
+        )?;
+        self.stats.closures_found += 1;
+        if !self.plausible(&found) {
+            self.stats.closures_implausible += 1;
+            return None;
+        }
+        let cfg = &self.config;
+        self.pending
+            .retain(|c| c.edge.to + cfg.confirm_keys >= id && c.edge.to != id);
+        let agreeing = self.pending.iter().position(|c| {
+            c.edge.from.abs_diff(found.edge.from) >= cfg.confirm_spread_keys
+                && closures_agree(&self.graph.nodes, c, &found, cfg.confirm_m, cfg.confirm_rad)
+        });
+        match agreeing {
+            Some(k) => {
+                let other = self.pending.remove(k);
+                Some(vec![other, found])
+            }
+            None => {
+                self.pending.push(found);
+                None
+            }
+        }
+    }
+
+    /// Whether the correction a closure asks of the graph (its disagreement
+    /// with the graph's relative pose, in metres and radians times the
+    /// laser's reach) is within what the front end can have drifted over
+    /// the path between its two keys.
+    fn plausible(&self, c: &Closure) -> bool {
+        let n = &self.graph.nodes;
+        let e = n[c.edge.from]
+            .between(&n[c.edge.to])
+            .between(&c.edge.measurement);
+        let reach = self.keys.first().map_or(0.0, |k| k.range_max_m);
+        let path = self.key_path_m[c.edge.to] - self.key_path_m[c.edge.from];
+        e.position().length() + reach * wrap_angle(e.theta).abs()
+            <= self.config.max_correction_m + self.config.drift_per_metre * path
+    }
+
+    /// Adds two agreeing closures, optimises, and moves the front end with
+    /// the graph; undoes it all if a closure stays badly unsatisfied.
+    fn accept(&mut self, closures: Vec<Closure>, front: FrontEnd<'_>) {
+        let id = self.graph.nodes.len() - 1;
+        self.pending.clear();
+        self.last_accepted = Some(id);
+        let reach = self.keys.first().map_or(0.0, |k| k.range_max_m);
+        let satisfied = closures.iter().all(|c| {
+            let n = &self.graph.nodes;
+            let e = n[c.edge.from]
+                .between(&n[c.edge.to])
+                .between(&c.edge.measurement);
+            e.position().length() + reach * wrap_angle(e.theta).abs() <= self.config.satisfied_m
+        });
+        if satisfied {
+            self.stats.closures_satisfied += closures.len();
+            return;
+        }
+        let before = self.graph.nodes.clone();
+        let edges = self.graph.edges.len();
+        self.graph
+            .edges
+            .extend(closures.iter().map(|c| c.edge.clone()));
+        let ok = self.graph.optimise(10).is_ok()
+            && closures
+                .iter()
+                .all(|c| self.graph.chi2(&c.edge) <= self.config.max_closure_chi2);
+        if !ok {
+            self.graph.nodes = before;
+            self.graph.edges.truncate(edges);
+            self.stats.closures_rejected += closures.len();
+            return;
+        }
+        self.stats.closures_accepted += closures.len();
+        self.closures.extend(closures.iter().map(|c| ClosureRecord {
+            from_key: c.edge.from,
+            to_key: c.edge.to,
+            from_step: self.key_step[c.edge.from],
+            to_step: self.key_step[c.edge.to],
+            measurement: c.edge.measurement,
+            score: c.score,
+        }));
+        self.apply(&before, front);
+    }
+
+    /// Moves every step's estimate and the filter's pose with its key, and
+    /// redraws the map if some key moved by more than a cell.
+    fn apply(&mut self, before: &[Pose2], front: FrontEnd<'_>) {
+        let moves: Vec<Pose2> = before
+            .iter()
+            .zip(&self.graph.nodes)
+            .map(|(old, new)| new.compose(&old.inverse()))
+            .collect();
+        for (e, &k) in front.estimates.iter_mut().zip(&self.step_key) {
+            *e = moves[k as usize].compose(e);
+        }
+        if let Some(m) = moves.last() {
+            *front.pose = m.compose(front.pose);
+        }
+        let reach = self.keys.first().map_or(0.0, |k| k.range_max_m);
+        let largest = before
+            .iter()
+            .zip(&self.graph.nodes)
+            .map(|(a, b)| {
+                a.position().distance(b.position()) + reach * wrap_angle(a.theta - b.theta).abs()
+            })
+            .fold(0.0, f64::max);
+        if largest > self.config.rebuild_m {
+            *front.map = self.rebuild(front.map.config.clone());
+            self.stats.map_rebuilds += 1;
+        }
+    }
+
+    /// The SLAM map drawn from the key scans at their current poses.
+    fn rebuild(&self, config: GridConfig) -> OccupancyGrid {
+        let mut map = OccupancyGrid::new(config);
+        for (pose, key) in self.graph.nodes.iter().zip(&self.keys) {
+            map.integrate_scan(pose, &key.unpack());
+        }
+        map
+    }
+
+    /// The step (index into the estimates) each key was taken at.
+    pub fn key_steps(&self) -> &[usize] {
+        &self.key_step
+    }
+
+    /// Memory the key scans hold (bytes), for the lab's budget figures.
+    pub fn key_bytes(&self) -> usize {
+        self.keys.iter().map(|k| 2 * k.ranges_mm.len()).sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scan(ranges: &[f64], max: &[bool], bright: &[bool]) -> LaserScan {
+        LaserScan {
+            ranges_m: ranges.to_vec(),
+            max_range: max.to_vec(),
+            reflective: bright.to_vec(),
+            range_max_m: 4.0,
+        }
+    }
+
+    #[test]
+    fn a_key_scan_keeps_millimetres_and_its_flags() {
+        let s = scan(
+            &[1.2344, 4.0, 0.5, 3.9996],
+            &[false, true, false, false],
+            &[false, false, true, false],
+        );
+        let k = KeyScan::pack(&s);
+        assert_eq!(k.ranges_mm, vec![1234, NO_RETURN, 500 | REFLECTIVE, 4000]);
+        let back = k.unpack();
+        assert_eq!(back.ranges_m, vec![1.234, 4.0, 0.5, 4.0]);
+        assert_eq!(back.max_range, vec![false, true, false, false]);
+        assert_eq!(back.reflective, vec![false, false, true, false]);
+        // Only the two wall returns are matched.
+        assert_eq!(k.points().len(), 2);
+    }
+
+    #[test]
+    fn keys_come_every_key_distance_and_steps_follow_their_key() {
+        let mut g = RobotGraph::new(RobotGraphConfig::default());
+        let s = scan(&[1.0; 5], &[false; 5], &[false; 5]);
+        let mut estimates = vec![Pose2::IDENTITY];
+        let mut pose = Pose2::IDENTITY;
+        let mut map = OccupancyGrid::new(GridConfig::default());
+        // 0.1 m a step along x: a key every 0.4 m (steps 0, 4, 8).
+        for k in 0..=9 {
+            if k > 0 {
+                estimates.push(Pose2::new(0.1 * k as f64, 0.0, 0.0));
+            }
+            let front = FrontEnd {
+                estimates: &mut estimates,
+                pose: &mut pose,
+                map: &mut map,
+            };
+            g.add_scan(&s, true, front);
+        }
+        assert_eq!(g.key_steps(), &[0, 4, 8]);
+        assert_eq!(g.step_key, vec![0, 0, 0, 0, 1, 1, 1, 1, 2, 2]);
+        assert_eq!(g.graph.edges.len(), 2);
+        // Moving key 1 by 0.5 m in y moves steps 4..8 with it, not the rest.
+        let before = g.graph.nodes.clone();
+        g.graph.nodes[1].y += 0.5;
+        g.graph.nodes[2].y += 0.5;
+        let front = FrontEnd {
+            estimates: &mut estimates,
+            pose: &mut pose,
+            map: &mut map,
+        };
+        g.apply(&before, front);
+        assert_eq!(estimates[3].y, 0.0);
+        assert!((estimates[5].y - 0.5).abs() < 1e-12);
+        assert!((estimates[5].x - 0.5).abs() < 1e-12);
+        assert!((pose.y - 0.5).abs() < 1e-12);
+        // The map was drawn again from the three keys.
+        assert_eq!(g.stats.map_rebuilds, 1);
+        assert_eq!(map.scans(), 3);
+    }
+}
