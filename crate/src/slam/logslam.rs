@@ -48,7 +48,7 @@
 
 use super::grid::{GridConfig, OccupancyGrid};
 use super::likelihood::LikelihoodField;
-use super::loop_closure::{find_closure, Closure, LoopConfig};
+use super::loop_closure::{closures_agree, find_closure, Closure, LoopConfig};
 use super::match_covariance::{edge_information, response_covariance, ResponseWindow};
 use super::multires::{field_from_points, match_scan, ScanMatch, Window};
 use super::posegraph::{Edge, PoseGraph};
@@ -460,10 +460,15 @@ impl LogSlam {
         let cfg = &self.config;
         self.pending
             .retain(|c| c.edge.to + cfg.confirm_keys >= id && c.edge.to != id);
-        let agreeing = self
-            .pending
-            .iter()
-            .position(|c| self.cycle_agrees(c, &found));
+        let agreeing = self.pending.iter().position(|c| {
+            closures_agree(
+                &self.graph.nodes,
+                c,
+                &found,
+                self.config.confirm_m,
+                self.config.confirm_rad,
+            )
+        });
         match agreeing {
             Some(k) => {
                 let other = self.pending.remove(k);
@@ -471,22 +476,6 @@ impl LogSlam {
             }
             None => self.pending.push(found),
         }
-    }
-
-    /// Pairwise consistency: does the cycle through the two closures and
-    /// the graph's stretches between their ends close?
-    fn cycle_agrees(&self, a: &Closure, b: &Closure) -> bool {
-        let n = &self.graph.nodes;
-        // old_a → new_a (closure a), new_a → new_b (graph), new_b → old_b
-        // (closure b inverted), old_b → old_a (graph).
-        let cycle = a
-            .edge
-            .measurement
-            .compose(&n[a.edge.to].between(&n[b.edge.to]))
-            .compose(&b.edge.measurement.inverse())
-            .compose(&n[b.edge.from].between(&n[a.edge.from]));
-        cycle.position().length() <= self.config.confirm_m
-            && cycle.theta.abs() <= self.config.confirm_rad
     }
 
     /// Adds confirmed closures, optimises, and undoes it all if a closure
