@@ -36,6 +36,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 spec.name, f.ate_m, f.odometry_ate_m
             );
         }
+        if let Some(sim) = lab.simulation() {
+            let config =
+                slamlab::merge::config::MergeConfig::new(MergeMethod::Auto, sim.scenario.seed);
+            let described = slamlab::merge::described::frames_to_describe(sim, &config);
+            let stored: usize = sim.robots.iter().map(|r| r.frames.frames.len()).sum();
+            println!(
+                "frames: {} stored, {} taking part in the automatic merge",
+                stored,
+                described.len()
+            );
+        }
         println!("simulate (ms): {simulate:.0}");
         return Ok(());
     }

@@ -13,7 +13,7 @@
 //! picture the camera took, while a run keeps a few hundred bytes per frame
 //! instead of 75 kB, and pays for rendering only the frames that are looked
 //! at: the merge describes perhaps half of them (the automatic method's
-//! motion thinning) or a tenth (the thesis's squareness test), and the page
+//! place thinning) or a tenth (the thesis's squareness test), and the page
 //! shows one at a time. [`crate::sim::Simulation::frame_image`] renders one.
 //!
 //! Memory is still bounded by a budget shared by all robots

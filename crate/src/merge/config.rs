@@ -29,9 +29,10 @@ pub struct MergeConfig {
     /// description and matching cost grow with the count, and the weakest
     /// blobs are the least repeatable.
     pub max_keypoints: usize,
-    /// Automatic method: a frame takes part only if the robot moved at
-    /// least `min_motion_m` or turned `min_turn_rad` since the last frame
-    /// that does (consecutive views 0.3 m apart show nearly the same).
+    /// Automatic method: a frame takes part only if no earlier frame that
+    /// does was taken within `min_motion_m` of it facing within
+    /// `min_turn_rad` (consecutive views 0.3 m apart show nearly the same,
+    /// and so do two passes of one corridor).
     pub min_motion_m: f64,
     pub min_turn_rad: f64,
     /// Automatic method: frames of the other robot proposed per frame.

@@ -15,7 +15,7 @@
 //! 1. [`frames_to_describe`]: which frames a merge with a given method will
 //!    describe (the same choice [`super::job::MergeJob::new`] makes), so the
 //!    host can hand them out as soon as they are captured. The automatic
-//!    method's choice, thinning by motion, only ever adds frames as the run
+//!    method's choice, thinning by place, only ever adds frames as the run
 //!    goes on; a frame chosen early and dropped later costs work, not
 //!    correctness.
 //! 2. One frame's parts, as JSON (the session's `FrameSpec`, in

@@ -3,7 +3,7 @@
 //! What a merge reads of a robot's camera: for each stored frame, what the
 //! robot knew when it took it ([`frame_infos`]: the SLAM pose, the odometry
 //! turn, the sonar and laser readings, never the truth); which of them take
-//! part ([`frames_taking_part`]: every frame thinned by motion for the
+//! part ([`frames_taking_part`]: every frame thinned by place for the
 //! automatic method, the thesis's selection of §6.2.2 for its method, none
 //! for a method that reads the maps only); and the SURF features of one
 //! frame, the strongest keypoints only ([`strongest_features`]). The merge
@@ -52,7 +52,7 @@ pub fn frame_infos(sim: &Simulation, i: usize) -> Vec<FrameInfo> {
 }
 
 /// Positions in `infos` of the frames a merge with `config` describes: all
-/// of them thinned by motion for the automatic method, the thesis's
+/// of them thinned by place for the automatic method, the thesis's
 /// selection for its method, none for the map-only one.
 pub fn frames_taking_part(infos: &[FrameInfo], config: &MergeConfig) -> Vec<usize> {
     stages_of(config.method).select(infos, config)

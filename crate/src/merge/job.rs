@@ -10,7 +10,7 @@
 //!
 //! 1. **Selection.** The thesis keeps only frames taken facing a wall
 //!    squarely, thinned by distance (§6.2.2, [`super::selection`]); the
-//!    automatic method keeps every frame, thinned by motion; the map-only
+//!    automatic method keeps every frame, thinned by place; the map-only
 //!    baseline uses none, and the job goes straight to the decision.
 //! 2. **Features.** Upright SURF on each kept frame (the cameras never
 //!    roll, so orientation assignment would only cost time and

@@ -1,7 +1,8 @@
 //! # The automatic method as a merge method
 //!
-//! Every frame takes part, thinned by motion (consecutive views a few
-//! centimetres apart show nearly the same); a bag of visual words trained on
+//! Every frame takes part, thinned by place (consecutive views a few
+//! centimetres apart show nearly the same, as do two passes of one
+//! corridor); a bag of visual words trained on
 //! this run's descriptors proposes the frame pairs most likely to show the
 //! same place ([`crate::merge::vocabulary`]); each is verified by a rigid
 //! fit of keypoints lifted with the laser ([`crate::merge::verify`]), the
@@ -25,26 +26,46 @@ use crate::merge::work::{PairOutcome, PairWork, RobotFrames};
 use crate::merge::{Candidate, FrameInfo, MergeStatus};
 use crate::slam::OccupancyGrid;
 use crate::surf::Features;
+use std::collections::HashMap;
 
 /// The `auto` method.
 pub struct Auto;
 
-/// Positions in `infos` of the frames taken after the robot moved at least
-/// `min_m` or turned `min_rad` (SLAM pose) since the last frame kept; the
+/// Positions in `infos` of the frames that show a new *place*: a frame
+/// takes part unless an earlier frame that takes part was taken within
+/// `min_m` of it (SLAM poses) facing within `min_rad` of its heading. The
 /// first frame is always kept.
-pub fn thin_by_motion(infos: &[FrameInfo], min_m: f64, min_rad: f64) -> Vec<usize> {
+///
+/// Consecutive views a few centimetres apart show nearly the same, and so
+/// does the view of a place the robot passed an hour ago: a robot touring a
+/// maze for an hour passes its corridors many times, and a frame of each
+/// pass would make the description and matching grow with the run's
+/// duration. Compared with every frame kept so far (not only the last),
+/// the frames grow with the places seen, which the world bounds. Frames are
+/// visited in capture order, so the choice only ever adds frames as the
+/// run goes on (what [`crate::merge::described`] relies on). The kept
+/// frames are found through a hash grid of `min_m` cells: each frame looks
+/// at its own cell and the eight around it.
+pub fn thin_by_place(infos: &[FrameInfo], min_m: f64, min_rad: f64) -> Vec<usize> {
     let mut kept: Vec<usize> = Vec::new();
+    let mut cells: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
+    let cell_of = |p: glam::DVec2| ((p.x / min_m).floor() as i64, (p.y / min_m).floor() as i64);
     for (k, f) in infos.iter().enumerate() {
-        let keep = match kept.last() {
-            None => true,
-            Some(&j) => {
-                let last = &infos[j].pose;
-                (f.pose.position() - last.position()).length() >= min_m
-                    || wrap_angle(f.pose.theta - last.theta).abs() >= min_rad
-            }
-        };
-        if keep {
+        let (cx, cy) = cell_of(f.pose.position());
+        let seen = (-1..=1).any(|dx| {
+            (-1..=1).any(|dy| {
+                cells.get(&(cx + dx, cy + dy)).is_some_and(|list| {
+                    list.iter().any(|&j| {
+                        let old = &infos[j].pose;
+                        (f.pose.position() - old.position()).length() < min_m
+                            && wrap_angle(f.pose.theta - old.theta).abs() < min_rad
+                    })
+                })
+            })
+        });
+        if !seen {
             kept.push(k);
+            cells.entry((cx, cy)).or_default().push(k);
         }
     }
     kept
@@ -52,7 +73,7 @@ pub fn thin_by_motion(infos: &[FrameInfo], min_m: f64, min_rad: f64) -> Vec<usiz
 
 impl MethodStages for Auto {
     fn select(&self, infos: &[FrameInfo], config: &MergeConfig) -> Vec<usize> {
-        thin_by_motion(infos, config.min_motion_m, config.min_turn_rad)
+        thin_by_place(infos, config.min_motion_m, config.min_turn_rad)
     }
 
     /// The vocabulary's proposals: trained on every described frame of
