@@ -390,6 +390,7 @@ impl RobotGraph {
             id,
             resolution_m,
             &self.config.loops,
+            None,
         )?;
         self.stats.closures_found += 1;
         if !self.plausible(&found) {
