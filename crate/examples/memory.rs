@@ -43,7 +43,10 @@ unsafe impl GlobalAlloc for Counting {
         // A grown block may be copied: old and new exist at once.
         grew(new_size);
         let p = unsafe { System.realloc(ptr, layout, new_size) };
-        LIVE.fetch_sub(if p.is_null() { new_size } else { layout.size() }, Ordering::Relaxed);
+        LIVE.fetch_sub(
+            if p.is_null() { new_size } else { layout.size() },
+            Ordering::Relaxed,
+        );
         p
     }
 }
@@ -72,7 +75,9 @@ fn line(stage: &str, lab: &Lab) {
 }
 
 fn table(m: &MemoryUse) {
-    println!("| robot | log poses | log sensors | estimates | odometry map | SLAM map | frames (kept) |");
+    println!(
+        "| robot | log poses | log sensors | estimates | odometry map | SLAM map | frames (kept) |"
+    );
     println!("|---|---|---|---|---|---|---|");
     let mut sum = [0usize; 7];
     for r in &m.robots {
@@ -125,7 +130,9 @@ fn table(m: &MemoryUse) {
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
-    let path = args.get(1).ok_or("usage: memory SCENARIO.json [STEPS_PER_REPORT]")?;
+    let path = args
+        .get(1)
+        .ok_or("usage: memory SCENARIO.json [STEPS_PER_REPORT]")?;
     let every: usize = args.get(2).map_or(Ok(6000), |s| s.parse())?;
     let mut lab = Lab::new(&std::fs::read_to_string(path)?)?;
     line("start", &lab);

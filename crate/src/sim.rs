@@ -168,7 +168,9 @@ impl RobotSim {
             // Doubling, but never past the cap: a deque left to double
             // would reserve 16,384 rows (6.4 MB) for 12,000.
             let len = self.log.sensors.len();
-            self.log.sensors.reserve_exact(len.max(64).min(LOG_SENSOR_CAP - len));
+            self.log
+                .sensors
+                .reserve_exact(len.max(64).min(LOG_SENSOR_CAP - len));
         }
         self.log.sensors.push_back(SensorRow {
             step,

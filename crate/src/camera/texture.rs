@@ -298,7 +298,12 @@ impl TextureBank {
             .values()
             .map(|(c, _)| c.gray.iter().map(Vec::capacity).sum::<usize>() + c.rgba.capacity())
             .sum();
-        chunks + self.images.values().map(|i| i.rgba.capacity()).sum::<usize>()
+        chunks
+            + self
+                .images
+                .values()
+                .map(|i| i.rgba.capacity())
+                .sum::<usize>()
     }
 
     pub fn wall_height_m(&self) -> f64 {

@@ -90,7 +90,8 @@ impl Lab {
                     odometry_map: r.mapping.odometry_map.memory_bytes(),
                     slam_map: r.mapping.slam_map.memory_bytes(),
                     frames: vec_bytes(&r.frames.frames) + r.frames.bytes()
-                        - r.frames.frames.len() * size_of::<crate::camera::capture::CapturedFrame>(),
+                        - r.frames.frames.len()
+                            * size_of::<crate::camera::capture::CapturedFrame>(),
                     frames_kept: r.frames.frames.len(),
                 });
             }
@@ -130,6 +131,10 @@ impl Lab {
 fn add_robot_frames(m: &mut MemoryUse, r: &RobotFrames) {
     m.merge_features +=
         r.features.iter().map(features_bytes).sum::<usize>() + vec_bytes(&r.features);
-    m.merge_frames_described += r.features.iter().filter(|f| f.keypoints.capacity() > 0).count();
+    m.merge_frames_described += r
+        .features
+        .iter()
+        .filter(|f| f.keypoints.capacity() > 0)
+        .count();
     m.merge_infos += vec_bytes(&r.infos) + vec_bytes(&r.selected);
 }
