@@ -28,10 +28,10 @@ function strip(text) {
 }
 
 test('frames thinned while workers hold them: the run completes with the report of no workers', () => {
-  // 0.05 MB: about 75 frames a robot for two robots, so each store thins
+  // 3.4 MB: about 75 frames with their features for two robots, so each store thins
   // (drops every other frame, halves its rate) twice in 300 s while
   // two workers are describing its frames.
-  const args = ['run', 'scenarios/thesis.json', '--json', '--frame-budget-mb', '0.05'];
+  const args = ['run', 'scenarios/thesis.json', '--json', '--frame-budget-mb', '3.4'];
   const alone = run(...args, '--workers', '0');
   const helped = run(...args, '--workers', '2');
   assert.equal(alone.code, 0, alone.stderr);

@@ -252,3 +252,18 @@ fn frames_thinned_while_out_are_dropped_and_the_merge_reports_the_same() {
     assert!(x["report"].is_object(), "a verdict");
     assert_eq!(x, y);
 }
+
+/// The frame budget charges each frame the features a merge may keep of it
+/// (`camera::capture::FEATURE_BYTES`): as many bytes as the merge's most
+/// keypoints take with their descriptors.
+#[wasm_bindgen_test(unsupported = test)]
+fn the_frame_budget_charges_what_a_merge_keeps_of_a_frame() {
+    let config = MergeConfig::new(MergeMethod::Auto, 1);
+    let per_keypoint = std::mem::size_of::<slamlab::surf::Keypoint>()
+        + std::mem::size_of::<slamlab::surf::Descriptor>();
+    assert_eq!(per_keypoint, 280);
+    assert_eq!(
+        config.max_keypoints * per_keypoint,
+        slamlab::camera::capture::FEATURE_BYTES
+    );
+}

@@ -84,6 +84,19 @@ pub struct RobotLog {
 }
 
 impl RobotLog {
+    /// An empty log with room for the rows of a run of `steps` steps
+    /// (one more than the steps: row 0 is the start), reserved once
+    /// rather than doubled into (a doubled row list holds up to twice its
+    /// rows, and copies itself at each doubling).
+    pub fn for_steps(steps: usize) -> RobotLog {
+        RobotLog {
+            times_s: Vec::with_capacity(steps + 1),
+            odometry: Vec::with_capacity(steps + 1),
+            truth: Vec::with_capacity(steps + 1),
+            ..RobotLog::default()
+        }
+    }
+
     /// Length of the true path so far (m).
     pub fn path_length_m(&self) -> f64 {
         self.truth
@@ -151,6 +164,13 @@ impl RobotSim {
         if self.log.sensors.len() == LOG_SENSOR_CAP {
             self.log.sensors.pop_front();
             self.log.sensors_dropped += 1;
+        } else if self.log.sensors.len() == self.log.sensors.capacity() {
+            // Doubling, but never past the cap: a deque left to double
+            // would reserve 16,384 rows (6.4 MB) for 12,000.
+            let len = self.log.sensors.len();
+            self.log
+                .sensors
+                .reserve_exact(len.max(64).min(LOG_SENSOR_CAP - len));
         }
         self.log.sensors.push_back(SensorRow {
             step,
@@ -306,7 +326,7 @@ impl Simulation {
                         range_max_m: s.laser_range_m,
                     },
                     last_command: Command::default(),
-                    log: RobotLog::default(),
+                    log: RobotLog::for_steps(scenario_steps(scenario)),
                     mapping: crate::slam::RobotMapping::default(),
                     frames: FrameStore::new(frame_bytes, n_robots, period_steps),
                     camera_rng: Rng::stream(seed, i, Stream::Camera),
@@ -358,7 +378,7 @@ impl Simulation {
 
     /// Total steps the scenario's duration asks for.
     pub fn total_steps(&self) -> usize {
-        (self.scenario.duration_s / CONTROL_DT_S).round() as usize
+        scenario_steps(&self.scenario)
     }
 
     pub fn finished(&self) -> bool {
@@ -634,4 +654,9 @@ impl Simulation {
             self.step();
         }
     }
+}
+
+/// Control steps in a run of `scenario`'s duration.
+fn scenario_steps(scenario: &Scenario) -> usize {
+    (scenario.duration_s / CONTROL_DT_S).round() as usize
 }

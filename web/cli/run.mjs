@@ -13,8 +13,9 @@ export const usage = `usage:
       run the scenario headless, merge the robots' maps (default method: auto)
       and print a report (JSON with --json); N worker threads (default: one
       per core but the main thread's, at most 4) describe camera frames while
-      the robots run; MB: memory all robots' stored frames may take (default
-      16; the store thins its frames beyond it)`;
+      the robots run; MB: memory all robots' stored frames may take with the
+      features a merge describes in them (default 384, about 45 kB a frame;
+      the store thins its frames beyond it)`;
 
 async function run(argv, wasm) {
   const { positional, options } = parseArgs(argv, {

@@ -21,17 +21,36 @@
 //! the store is **thinned**: every other frame is dropped and the capture
 //! period doubles, so the frames kept still span the whole run evenly. The
 //! number of frames dropped is reported.
+//!
+//! A stored frame is small, but the features a merge describes in it are
+//! not: up to [`FEATURE_BYTES`] (160 SURF keypoints with their 64-number
+//! descriptors), a hundred times the frame. Measured on 16 robots × 900 s
+//! (`crate/examples/memory.rs`), the merge's features were 378 MB of a
+//! 923 MB peak, while the stores held 28 MB. So the budget charges each
+//! frame what it may cost with its features ([`FRAME_BYTES`]): it bounds
+//! what the merge will hold, whatever the number of robots and the length
+//! of the run. The default keeps every frame of four robots for half an
+//! hour, of sixteen for nine minutes; beyond, each robot's frames still
+//! span its whole run, sparser.
 
 use crate::camera::RobotBox;
 use crate::geom::Pose2;
 use crate::sensors::{LASER_BEAMS, SONAR_COUNT};
 
-/// Frames of all robots together use at most this much memory (16 MiB:
-/// about 20 hours of frames at one a second for two robots).
-pub const FRAME_BUDGET_BYTES: usize = 16 << 20;
+/// Frames of all robots together, with the features a merge may describe
+/// in them, use at most this much memory (384 MiB: about 8,800 frames, 37 minutes
+/// of frames at one a second for four robots).
+pub const FRAME_BUDGET_BYTES: usize = 384 << 20;
 
-/// What one stored frame costs, roughly: its senses plus two robot bodies.
-pub const FRAME_BYTES: usize = std::mem::size_of::<CapturedFrame>() + 2 * (4 * 16 + 32);
+/// The most a merge keeps of one described frame: its strongest 160 SURF
+/// keypoints (`merge::config::MergeConfig::max_keypoints`), each 24 bytes
+/// with a 64-number descriptor of 256 (checked in `tests/merge_described.rs`).
+pub const FEATURE_BYTES: usize = 160 * (24 + 256);
+
+/// What one stored frame may cost, roughly: its senses plus two robot
+/// bodies, and the features a merge may describe in it.
+pub const FRAME_BYTES: usize =
+    std::mem::size_of::<CapturedFrame>() + 2 * (4 * 16 + 32) + FEATURE_BYTES;
 
 /// One captured frame and the robot's senses at that instant.
 #[derive(Clone, Debug, PartialEq)]

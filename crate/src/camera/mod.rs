@@ -422,10 +422,16 @@ impl WallSampler<'_> {
         let lx = (along - k as f64) * ppm;
         // Neighbouring columns mostly draw from the same chunk: look it
         // up (a string key and a hash) only when it changes.
+        let colour = column_rgb.is_some();
         let chunk = match &self.memo {
-            Some((w, b, c, chunk)) if (*w, *b, *c) == (wi, back, k) => chunk.clone(),
+            Some((w, b, c, chunk))
+                if (*w, *b, *c) == (wi, back, k) && (!colour || !chunk.rgba.is_empty()) =>
+            {
+                chunk.clone()
+            }
             _ => {
-                let chunk = self.bank.chunk(&wall_texture_key(self.walls, wi, back), k);
+                let key = wall_texture_key(self.walls, wi, back);
+                let chunk = self.bank.chunk_for(&key, k, colour);
                 self.memo = Some((wi, back, k, chunk.clone()));
                 chunk
             }

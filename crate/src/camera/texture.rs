@@ -32,6 +32,11 @@ use std::sync::Arc;
 use tiny_skia::{Color, FillRule, Paint, Path, PathBuilder, Pixmap, Rect, Stroke, Transform};
 
 /// Texture resolution (texels per metre).
+///
+/// (A chunk's colour, four bytes a texel, is three quarters of its bytes
+/// and only the page's colour views read it: the cache keeps it only for
+/// chunks a colour view asked for, [`TextureBank::chunk_for`]; a grey one
+/// asked for colour later is painted again, identically.)
 pub const TEXELS_PER_M: u32 = 160;
 /// Most chunks kept in the cache at once (each about 100 KB with its mips).
 pub const CHUNK_CACHE_CAP: usize = 600;
@@ -150,7 +155,7 @@ impl TextureKey {
 }
 
 /// One rasterised chunk: grayscale at three mip levels, and colour at full
-/// resolution for display.
+/// resolution for display (empty unless asked for).
 pub struct Chunk {
     /// `gray[l]` is `(TEXELS_PER_M >> l) × (height >> l)` texels, row 0 at the top.
     pub gray: [Vec<u8>; 3],
@@ -286,6 +291,21 @@ impl TextureBank {
         self.seed
     }
 
+    /// Bytes held by the cached chunks and the loaded pictures.
+    pub fn memory_bytes(&self) -> usize {
+        let chunks: usize = self
+            .chunks
+            .values()
+            .map(|(c, _)| c.gray.iter().map(Vec::capacity).sum::<usize>() + c.rgba.capacity())
+            .sum();
+        chunks
+            + self
+                .images
+                .values()
+                .map(|i| i.rgba.capacity())
+                .sum::<usize>()
+    }
+
     pub fn wall_height_m(&self) -> f64 {
         self.wall_height_m
     }
@@ -318,11 +338,21 @@ impl TextureBank {
     /// renderer can hold on to the chunk it is drawing from column after
     /// column without looking it up again.
     pub fn chunk(&mut self, key: &TextureKey, k: i64) -> Arc<Chunk> {
+        self.chunk_for(key, k, true)
+    }
+
+    /// Chunk `k` of texture `key`, with its colour only if `colour` (see
+    /// [`TEXELS_PER_M`]'s note): the grey levels are the same either way.
+    pub fn chunk_for(&mut self, key: &TextureKey, k: i64, colour: bool) -> Arc<Chunk> {
         self.tick += 1;
         let id = (key.clone(), k);
         if let Some((c, used)) = self.chunks.get_mut(&id) {
-            *used = self.tick;
-            return c.clone();
+            if !colour || !c.rgba.is_empty() {
+                *used = self.tick;
+                return c.clone();
+            }
+            // Grey only, and colour wanted: painted again below.
+            self.chunks.remove(&id);
         }
         if self.chunks.len() >= CHUNK_CACHE_CAP {
             // A scan of the cap's entries, against painting a chunk (~1 ms).
@@ -335,7 +365,11 @@ impl TextureBank {
                 self.chunks.remove(&old);
             }
         }
-        let chunk = Arc::new(self.paint_chunk(key, k));
+        let mut painted = self.paint_chunk(key, k);
+        if !colour {
+            painted.rgba = Vec::new();
+        }
+        let chunk = Arc::new(painted);
         self.chunks.insert(id, (chunk.clone(), self.tick));
         chunk
     }

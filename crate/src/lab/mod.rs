@@ -18,6 +18,7 @@
 //! | [`merge`] | merging the run's maps, the merge's views, scoring it against the truth |
 //! | [`groups`] | each group of robots the merge joined: its merged map, its errors |
 //! | [`described`] | a stored frame's parts, for another lab to render and describe |
+//! | [`memory`] | where the session's bytes are, structure by structure |
 //! | [`maps`] | a robot's maps as files and pictures, their figures against the truth |
 //! | [`report`] | the JSON report of a run (`web/cli.mjs run --json`) |
 //! | [`views`] | the small JSON views the page reads |
@@ -40,6 +41,7 @@ use tiny_skia::Pixmap;
 pub mod described;
 pub mod groups;
 pub mod maps;
+pub mod memory;
 pub mod merge;
 pub mod report;
 pub mod views;

@@ -171,6 +171,17 @@ impl DescribedFrames {
         self.features.len()
     }
 
+    /// Heap bytes of the features kept (keypoints and descriptors).
+    pub fn memory_bytes(&self) -> usize {
+        self.features
+            .values()
+            .map(|f| {
+                f.keypoints.capacity() * std::mem::size_of::<Keypoint>()
+                    + f.descriptors.capacity() * std::mem::size_of::<Descriptor>()
+            })
+            .sum()
+    }
+
     pub fn is_empty(&self) -> bool {
         self.features.is_empty()
     }

@@ -64,7 +64,8 @@
 //! wall on a cell boundary splits its hits between two rows, each holding
 //! the mean of its half; weighted by their counts the two give the wall back
 //! ([`super::surface`]). A cell cleared to free loses its surface. The
-//! layer costs 6 bytes per cell, so only the SLAM map keeps it.
+//! layer costs 6 bytes per cell where hits are, kept by blocks only there
+//! ([`super::surface_blocks`]), and only the SLAM map keeps it.
 //!
 //! ## Growth and origin bookkeeping
 //! Cells are addressed by *global* indices `(⌊x / r⌋, ⌊y / r⌋)` in the odometry
@@ -81,6 +82,7 @@
 //! dropped (and counted in [`OccupancyGrid::dropped_updates`]), and the
 //! matcher keeps working on what is mapped.
 
+use super::surface_blocks::SurfaceBlocks;
 use crate::geom::Pose2;
 use crate::sensors::laser::beam_bearing;
 use crate::sensors::LaserScan;
@@ -138,16 +140,6 @@ pub enum CellState {
     Occupied,
 }
 
-/// Where the surface lies inside one cell: the running mean of the hits
-/// that ended in it, as an offset from the cell's centre in units of
-/// 1/65536 of a cell, over the last [`SURFACE_WINDOW`] hits, and how many
-/// hits it has had in all.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-struct SurfaceCell {
-    hits: u16,
-    offset: [i16; 2],
-}
-
 /// The surface mean forgets with this window (hits): long enough that a
 /// mapped wall stays where it was first seen well (the map is the matcher's
 /// fixed reference), short enough to follow a correction.
@@ -169,9 +161,9 @@ const SURFACE_SCALE: f64 = 65536.0;
 pub struct OccupancyGrid {
     pub config: GridConfig,
     cells: Vec<i8>,
-    /// Per-cell surface means, same layout as `cells` (empty unless
+    /// Per-cell surface means where hits are, by blocks (empty unless
     /// [`GridConfig::surface_points`]).
-    surface: Vec<SurfaceCell>,
+    surface: SurfaceBlocks,
     width: usize,
     height: usize,
     /// Global index of local cell (0, 0).
@@ -191,7 +183,7 @@ impl OccupancyGrid {
         OccupancyGrid {
             config,
             cells: Vec::new(),
-            surface: Vec::new(),
+            surface: SurfaceBlocks::default(),
             width: 0,
             height: 0,
             origin_cell: [0, 0],
@@ -229,7 +221,7 @@ impl OccupancyGrid {
     }
     /// Bytes held by the cells.
     pub fn memory_bytes(&self) -> usize {
-        self.cells.capacity() + self.surface.capacity() * std::mem::size_of::<SurfaceCell>()
+        self.cells.capacity() + self.surface.memory_bytes()
     }
 
     /// Global cell index of a point of the odometry frame.
@@ -270,9 +262,8 @@ impl OccupancyGrid {
         if ix >= self.width || iy >= self.height {
             return None;
         }
-        let i = iy * self.width + ix;
-        let s = self.surface.get(i)?;
-        if s.hits == 0 || self.cells[i] <= 0 {
+        let s = self.surface.get(ix, iy)?;
+        if s.hits == 0 || self.cells[iy * self.width + ix] <= 0 {
             return None;
         }
         let offset = DVec2::new(s.offset[0] as f64, s.offset[1] as f64) / SURFACE_SCALE;
@@ -347,13 +338,7 @@ impl OccupancyGrid {
         }
         self.cells = cells;
         if self.config.surface_points {
-            let mut surface = vec![SurfaceCell::default(); nw * nh];
-            for row in 0..self.height {
-                let src = &self.surface[row * self.width..(row + 1) * self.width];
-                let start = (row + dy) * nw + dx;
-                surface[start..start + self.width].copy_from_slice(src);
-            }
-            self.surface = surface;
+            self.surface.regrid(nw, nh, dx, dy, self.height);
         }
         self.width = nw;
         self.height = nh;
@@ -374,7 +359,7 @@ impl OccupancyGrid {
                     as i8;
                 if *c <= 0 {
                     // Cleared: whatever surface was here is gone.
-                    if let Some(s) = self.surface.get_mut(y * self.width + x) {
+                    if let Some(s) = self.surface.get_mut(x, y) {
                         s.hits = 0;
                     }
                 }
@@ -385,7 +370,7 @@ impl OccupancyGrid {
 
     /// Moves the surface mean of the cell holding `p` towards `p`.
     fn add_surface_hit(&mut self, p: DVec2) {
-        if self.surface.is_empty() {
+        if !self.config.surface_points {
             return;
         }
         let Some((x, y)) = self.local(self.global_cell(p)) else {
@@ -393,8 +378,7 @@ impl OccupancyGrid {
         };
         let r = self.config.resolution_m;
         let centre = self.cell_centre(x, y);
-        let i = y * self.width + x;
-        let s = &mut self.surface[i];
+        let s = self.surface.entry(x, y);
         s.hits = s.hits.saturating_add(1);
         let target = (p - centre) / r * SURFACE_SCALE;
         let w = 1.0 / s.hits.min(SURFACE_WINDOW) as f64;
@@ -453,7 +437,7 @@ impl OccupancyGrid {
         let mut index = start.1 * self.width + start.0;
         let (sx, sy) = (walk.step[0] as isize, walk.step[1] as isize * w);
         let (min, max) = (self.config.min as i16, self.config.max);
-        let (cells, surface) = (&mut self.cells, &mut self.surface);
+        let (cells, surface, width) = (&mut self.cells, &mut self.surface, self.width);
         let mut lower = |index: usize| {
             let Some(v) = cells.get_mut(index) else {
                 return;
@@ -465,7 +449,7 @@ impl OccupancyGrid {
             }
             *v = (was as i16 + miss as i16).max(min) as i8;
             if was > 0 && *v <= 0 {
-                if let Some(s) = surface.get_mut(index) {
+                if let Some(s) = surface.get_mut(index % width, index / width) {
                     s.hits = 0;
                 }
             }
@@ -637,7 +621,7 @@ impl OccupancyGrid {
         // Does any wall cell of the run turn free (and so lose its surface)?
         // Rarely: then cell by cell; else one branch-free pass the compiler
         // vectorises.
-        let clears_surface = !self.surface.is_empty()
+        let clears_surface = self.config.surface_points
             && run
                 .iter()
                 .fold(false, |any, &was| any | ((was > 0) & (lowered(was) <= 0)));
@@ -646,7 +630,9 @@ impl OccupancyGrid {
                 let was = *v;
                 *v = lowered(was);
                 if was > 0 && *v <= 0 {
-                    self.surface[start + k].hits = 0;
+                    if let Some(s) = self.surface.get_mut(x0 + k, y) {
+                        s.hits = 0;
+                    }
                 }
             }
         } else {

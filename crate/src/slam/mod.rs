@@ -12,6 +12,7 @@
 //! | multi-resolution correlative search | [`correlative`] | Olson, ICRA 2009 |
 //! | Gauss–Newton on the smoothed map (map merging) | [`gauss_newton`] | Kohlbrecher et al., SSRR 2011 |
 //! | Gauss–Newton of scan points onto mapped surfaces | [`surface`] | Chen & Medioni 1992 (point-to-plane) |
+//! | the surface layer, kept by blocks where hits are | [`surface_blocks`] | Museth 2013 (OpenVDB leaf blocks) |
 //! | corridor degeneracy guard | [`degeneracy`] | Zhang, Kaess, Singh, ICRA 2016 |
 //! | pose filter with odometry self-calibration | [`filter`] | Thrun et al. §7.4; Martinelli 2007 |
 //! | the two mappers, online | [`mapper`] | thesis §4.3 (online SLAM) |
@@ -46,6 +47,7 @@ pub mod relations;
 pub mod robot_graph;
 pub mod scoring;
 pub mod surface;
+pub mod surface_blocks;
 
 pub use grid::{CellState, GridConfig, OccupancyGrid};
 pub use mapper::{MapperKind, MatchStatus, RobotMapping, SlamConfig};
