@@ -35,6 +35,8 @@ pub struct SlamFigures {
     pub matched_steps: usize,
     pub degenerate_steps: usize,
     pub odometry_only_steps: usize,
+    /// Steps the motion filter left to odometry's prediction (no match).
+    pub predicted_steps: usize,
     /// Cells of the SLAM grid and their bytes.
     pub map_width: usize,
     pub map_height: usize,
@@ -74,6 +76,7 @@ pub fn figures(sim: &Simulation, robot: &RobotSim) -> SlamFigures {
         matched_steps: m.counts.matched,
         degenerate_steps: m.counts.degenerate,
         odometry_only_steps: m.counts.odometry_only,
+        predicted_steps: m.counts.predicted,
         map_width: m.slam_map.width(),
         map_height: m.slam_map.height(),
         map_bytes: m.slam_map.memory_bytes(),

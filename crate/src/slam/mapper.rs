@@ -59,7 +59,8 @@ use super::gauss_newton;
 use super::grid::{beam_directions, GridConfig, OccupancyGrid};
 use super::likelihood::LikelihoodField;
 use super::surface::{information_at, refine_to_surface, RefineConfig, Refinement};
-use crate::geom::Pose2;
+use crate::geom::{wrap_angle, Pose2};
+use crate::kinematics::CONTROL_DT_S;
 use crate::sensors::LaserScan;
 use glam::DVec2;
 
@@ -84,6 +85,8 @@ pub struct SlamConfig {
     /// match's information is `JᵀJ / σ²`.
     pub match_noise_m: f64,
     pub odometry_noise: OdometryNoise,
+    /// When a scan is worth matching and mapping ([`MotionFilter`]).
+    pub motion: MotionFilter,
 }
 
 impl Default for SlamConfig {
@@ -98,7 +101,47 @@ impl Default for SlamConfig {
             search_below: 0.5,
             match_noise_m: 0.01,
             odometry_noise: OdometryNoise::default(),
+            motion: MotionFilter::default(),
         }
+    }
+}
+
+/// GMapping's `linearUpdate` / `angularUpdate` and Cartographer's
+/// `motion_filter`: a scan is matched and mapped only once odometry has
+/// moved `min_distance_m` or turned `min_angle_rad` since the last scan
+/// that was, or after `max_interval_s` whatever the motion (see the
+/// module's "Motion filter" section for how the values were chosen).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MotionFilter {
+    pub min_distance_m: f64,
+    pub min_angle_rad: f64,
+    pub max_interval_s: f64,
+}
+
+impl Default for MotionFilter {
+    fn default() -> Self {
+        MotionFilter {
+            min_distance_m: 0.1,
+            min_angle_rad: 3f64.to_radians(),
+            max_interval_s: 2.0,
+        }
+    }
+}
+
+impl MotionFilter {
+    /// Every scan processed: the mapper as it was before the filter.
+    pub const EVERY_SCAN: MotionFilter = MotionFilter {
+        min_distance_m: 0.0,
+        min_angle_rad: 0.0,
+        max_interval_s: 0.0,
+    };
+
+    /// Whether a scan taken `moved` (odometry, since the last processed
+    /// scan) and `steps` control steps after that scan is processed.
+    pub fn passes(&self, moved: &Pose2, steps: usize) -> bool {
+        moved.position().length() >= self.min_distance_m
+            || wrap_angle(moved.theta).abs() >= self.min_angle_rad
+            || steps as f64 * CONTROL_DT_S >= self.max_interval_s - 1e-9
     }
 }
 
@@ -267,6 +310,9 @@ pub struct MatchCounts {
     pub matched: usize,
     pub degenerate: usize,
     pub odometry_only: usize,
+    /// Steps the motion filter left to the prediction alone (no match,
+    /// nothing mapped).
+    pub predicted: usize,
 }
 
 /// One robot's two mappers, run online inside the simulation.
@@ -282,6 +328,9 @@ pub struct RobotMapping {
     /// The current pose and odometry's calibration (odometry frame).
     filter: PoseFilter,
     last_odometry: Pose2,
+    /// Odometry pose and step of the last processed scan (`None` before
+    /// the first).
+    last_processed: Option<(Pose2, usize)>,
     pub counts: MatchCounts,
     pub last_outcome: Option<MatchOutcome>,
 }
@@ -309,6 +358,7 @@ impl RobotMapping {
             // The start pose is the frame's origin: known exactly.
             filter: PoseFilter::new(Pose2::IDENTITY, &noise),
             last_odometry: Pose2::IDENTITY,
+            last_processed: None,
             counts: MatchCounts::default(),
             last_outcome: None,
         }
@@ -342,11 +392,33 @@ impl RobotMapping {
         self.filter.bias
     }
 
-    /// One step: the new odometry pose and the scan taken there.
+    /// Whether the motion filter lets the scan taken at `odometry` (the
+    /// next step's) be matched and mapped.
+    pub fn will_process(&self, odometry: &Pose2) -> bool {
+        match self.last_processed {
+            None => true,
+            Some((at, step)) => self
+                .config
+                .motion
+                .passes(&at.between(odometry), self.estimates.len() - step),
+        }
+    }
+
+    /// One step: the new odometry pose and the scan taken there. The
+    /// filter always predicts; the scan is matched and integrated into
+    /// both maps only when the motion filter passes it.
     pub fn observe(&mut self, odometry: &Pose2, scan: &LaserScan) {
-        self.odometry_map.integrate_scan(odometry, scan);
+        let process = self.will_process(odometry);
         let step = self.last_odometry.between(odometry);
         self.filter.predict(&step, &self.config.odometry_noise);
+        self.last_odometry = *odometry;
+        if !process {
+            self.counts.predicted += 1;
+            self.estimates.push(self.filter.pose);
+            return;
+        }
+        self.last_processed = Some((*odometry, self.estimates.len()));
+        self.odometry_map.integrate_scan(odometry, scan);
         let prior = self.filter.pose;
         let mut outcome = match_scan(&self.slam_map, scan, &prior, &self.config);
         if outcome.status != MatchStatus::OdometryOnly {
@@ -360,7 +432,6 @@ impl RobotMapping {
         }
         self.slam_map.integrate_scan(&outcome.pose, scan);
         self.estimates.push(outcome.pose);
-        self.last_odometry = *odometry;
         self.last_outcome = Some(outcome);
     }
 
