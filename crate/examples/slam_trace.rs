@@ -80,15 +80,9 @@ struct Summary {
     sum_ate_m: f64,
 }
 
-fn run_one(
-    run: &str,
-    opts: &Options,
-    summary: &mut Summary,
-) -> Result<(), Box<dyn std::error::Error>> {
-    let scenario = Scenario::parse(&scenario_text(run)?).map_err(|e| format!("{e:?}"))?;
-    let mut sim = Simulation::new(&scenario).map_err(|e| format!("{e:?}"))?;
-    sim.set_capture(false);
-    sim.set_mapping(false);
+/// The default settings with a few overridden from the environment
+/// (experiments and the motion filter's sweep).
+fn config_from_env() -> SlamConfig {
     let mut cfg = SlamConfig::default();
     // Experiments: override a few settings from the environment.
     let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
@@ -118,6 +112,19 @@ fn run_one(
     if let Some(v) = env("SLAM_MOTION_S") {
         cfg.motion.max_interval_s = v;
     }
+    cfg
+}
+
+fn run_one(
+    run: &str,
+    opts: &Options,
+    summary: &mut Summary,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let scenario = Scenario::parse(&scenario_text(run)?).map_err(|e| format!("{e:?}"))?;
+    let mut sim = Simulation::new(&scenario).map_err(|e| format!("{e:?}"))?;
+    sim.set_capture(false);
+    sim.set_mapping(false);
+    let cfg = config_from_env();
     let n = sim.robots.len();
     let mut mappers: Vec<RobotMapping> = (0..n).map(|_| RobotMapping::new(cfg.clone())).collect();
     let mut odometry_only: Vec<OccupancyGrid> = (0..n)
