@@ -11,7 +11,9 @@ use slamlab::sensors::{Laser, RangeScene};
 use slamlab::slam::degeneracy::scan_normals;
 use slamlab::slam::filter::{OdometryNoise, PoseFilter};
 use slamlab::slam::grid::{GridConfig, OccupancyGrid};
-use slamlab::slam::mapper::{match_scan, scan_points, MatchStatus, SlamConfig};
+use slamlab::slam::mapper::{
+    match_scan, scan_points, MatchStatus, MotionFilter, RobotMapping, SlamConfig,
+};
 use slamlab::slam::surface::{refine_to_surface, surface_residual, RefineConfig};
 use slamlab::world::World;
 use wasm_bindgen_test::wasm_bindgen_test;
@@ -241,4 +243,69 @@ fn the_filter_learns_a_wheelbase_error_from_matched_turns() {
     let turned = f.pose.theta - before;
     let error_deg = (turned - std::f64::consts::FRAC_PI_2).abs().to_degrees();
     assert!(error_deg < 0.4, "predicted turn off by {error_deg:.3}°");
+}
+
+/// Feeds `mapping` the room's scans along `odometry` (perfect odometry, the
+/// start at (1.5, 2) in the room) and returns the steps it processed.
+fn processed_steps(mapping: &mut RobotMapping, odometry: &[Pose2]) -> Vec<usize> {
+    let world = room();
+    let start = Pose2::new(1.5, 2.0, 0.0);
+    let mut steps = Vec::new();
+    for (k, o) in odometry.iter().enumerate() {
+        let before = mapping.counts.predicted;
+        mapping.observe(o, &scan_at(&world, &start.compose(o), k as u64, 0.0));
+        if mapping.counts.predicted == before {
+            steps.push(k + 1);
+        }
+    }
+    steps
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn the_motion_filter_processes_a_scan_after_a_distance_a_turn_or_a_time() {
+    let cfg = SlamConfig {
+        motion: MotionFilter {
+            min_distance_m: 0.1,
+            min_angle_rad: 3f64.to_radians(),
+            max_interval_s: 2.0,
+        },
+        ..SlamConfig::default()
+    };
+    // 3 cm a step: the first scan, then each one 12 cm on (0.09 m < 0.1).
+    let straight: Vec<Pose2> = (1..=12)
+        .map(|k| Pose2::new(0.03 * k as f64, 0.0, 0.0))
+        .collect();
+    let mut m = RobotMapping::new(cfg.clone());
+    assert_eq!(processed_steps(&mut m, &straight), vec![1, 5, 9]);
+    assert_eq!(m.counts.predicted, 9);
+    assert_eq!(m.estimates().len(), 13, "one estimate per step");
+    // The skipped steps' estimates are the prediction: with odometry exact
+    // and the scans matching it, each follows odometry's step.
+    let est = m.estimates();
+    for k in [2usize, 3, 4, 6, 7, 8] {
+        let step = est[k - 1].between(&est[k]);
+        assert!(
+            (step.x - 0.03).abs() < 1e-3 && step.y.abs() < 1e-3,
+            "step {k}: {step:?}"
+        );
+    }
+    // Turning in place 1.25° a step: every third scan (2.5° < 3° ≤ 3.75°).
+    let turning: Vec<Pose2> = (1..=9)
+        .map(|k| Pose2::new(0.0, 0.0, (1.25 * k as f64).to_radians()))
+        .collect();
+    let mut m = RobotMapping::new(cfg.clone());
+    assert_eq!(processed_steps(&mut m, &turning), vec![1, 4, 7]);
+    // Standing still: one scan every 2 s (20 steps of 0.1 s).
+    let still = vec![Pose2::IDENTITY; 45];
+    let mut m = RobotMapping::new(cfg);
+    assert_eq!(processed_steps(&mut m, &still), vec![1, 21, 41]);
+    // Without the filter every scan is processed.
+    let mut m = RobotMapping::new(SlamConfig {
+        motion: MotionFilter::EVERY_SCAN,
+        ..SlamConfig::default()
+    });
+    assert_eq!(
+        processed_steps(&mut m, &straight),
+        (1..=12).collect::<Vec<_>>()
+    );
 }

@@ -189,6 +189,7 @@ fn print_row(sim: &Simulation, t: &mut Traced, truth: &Pose2, odometry: &Pose2, 
         matched: c.matched - t.last_counts.matched,
         degenerate: c.degenerate - t.last_counts.degenerate,
         odometry_only: c.odometry_only - t.last_counts.odometry_only,
+        predicted: c.predicted - t.last_counts.predicted,
     };
     t.last_counts = c;
     let out = t.mapping.last_outcome;

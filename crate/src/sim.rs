@@ -22,8 +22,11 @@
 //! 6. **map** — each robot's two mappers ([`crate::slam::RobotMapping`])
 //!    take the odometry pose and the laser scan (never the truth): SLAM
 //!    matches the scan to its map and integrates it at the matched pose; the
-//!    odometry-only map, the thesis's baseline, at the odometry pose.
-//!    Off with [`Simulation::set_mapping`].
+//!    odometry-only map, the thesis's baseline, at the odometry pose. Both
+//!    skip the scans their motion filter drops (under 0.1 m, 3° and 2 s
+//!    since the last one used; [`crate::slam::mapper::MotionFilter`]).
+//!    The laser is still cast every step: the follower steers by it and
+//!    the log and the page show it. Off with [`Simulation::set_mapping`].
 //! 7. **capture** — once per camera period, each robot stores a camera frame
 //!    ([`crate::camera::capture`]): the instant's odometry and true poses,
 //!    sensor row, the other robots' bodies and a noise seed, from which the
