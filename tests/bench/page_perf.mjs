@@ -11,25 +11,16 @@
 // simulated seconds per wall second. `--shot` saves a screenshot of the page
 // at the end of the run. Needs ./build.sh build and Chromium.
 import path from 'node:path';
-import { readFile } from 'node:fs/promises';
 import { chromium } from 'playwright-core';
 import { CHROMIUM_FLAGS, serveRoot, waitReady } from '../support/browser.mjs';
+import { scenarioArgs } from './args.mjs';
 
-const args = process.argv.slice(2);
-const opt = (name, dflt) => {
-  const i = args.indexOf(`--${name}`);
-  return i >= 0 ? Number(args[i + 1]) : dflt;
-};
-const file = args[0];
-if (!file) {
-  console.error('usage: node tests/bench/page_perf.mjs SCENARIO.json [--speed 50] [--seconds 10]');
-  process.exit(2);
-}
+const { args, file, body, scenario, opt } = await scenarioArgs(
+  'node tests/bench/page_perf.mjs SCENARIO.json [--speed 50] [--seconds 10]',
+);
 const speed = opt('speed', 50);
 const seconds = opt('seconds', 10);
 const viewport = { width: opt('width', 1366), height: opt('height', 768) };
-const body = await readFile(file);
-const scenario = JSON.parse(body);
 
 const { server, url } = await serveRoot();
 const browser = await chromium.launch({ executablePath: '/usr/bin/chromium', args: CHROMIUM_FLAGS });

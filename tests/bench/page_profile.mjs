@@ -8,22 +8,13 @@
 // Prints the total sampled time, the simulated clock, and the functions with
 // the most self time (JavaScript and wasm, `name file:line`), then the same
 // for inclusive time of the page's own functions. Needs ./build.sh build.
-import { readFile } from 'node:fs/promises';
 import { chromium } from 'playwright-core';
 import { CHROMIUM_FLAGS, serveRoot, waitReady } from '../support/browser.mjs';
+import { scenarioArgs } from './args.mjs';
 
-const args = process.argv.slice(2);
-const opt = (name, dflt) => {
-  const i = args.indexOf(`--${name}`);
-  return i >= 0 ? Number(args[i + 1]) : dflt;
-};
-const file = args[0];
-if (!file) {
-  console.error('usage: node tests/bench/page_profile.mjs SCENARIO.json [--speed 20] [--seconds 8]');
-  process.exit(2);
-}
-const body = await readFile(file);
-const scenario = JSON.parse(body);
+const { file, body, scenario, opt } = await scenarioArgs(
+  'node tests/bench/page_profile.mjs SCENARIO.json [--speed 20] [--seconds 8]',
+);
 const { server, url } = await serveRoot();
 const browser = await chromium.launch({ executablePath: '/usr/bin/chromium', args: CHROMIUM_FLAGS });
 
