@@ -13,7 +13,7 @@
 import path from 'node:path';
 import { chromium } from 'playwright-core';
 import { CHROMIUM_FLAGS, serveRoot, waitReady } from '../support/browser.mjs';
-import { scenarioArgs } from './args.mjs';
+import { importAtSpeed, scenarioArgs } from './page_bench.mjs';
 
 const { args, file, body, scenario, opt } = await scenarioArgs(
   'node tests/bench/page_perf.mjs SCENARIO.json [--speed 50] [--seconds 10]',
@@ -29,15 +29,7 @@ try {
   page.on('pageerror', (e) => console.error(`page error: ${e.message}`));
   await page.goto(url);
   await waitReady(page);
-  await page.setInputFiles('#import-file', { name: path.basename(file), mimeType: 'application/json', buffer: body });
-  await page.waitForFunction((n) => window.slamlab.scenario().walls.length === n, scenario.walls.length, {
-    timeout: 60000,
-  });
-  await page.evaluate((v) => {
-    const s = document.getElementById('speed');
-    s.value = String(v);
-    s.dispatchEvent(new Event('input', { bubbles: true }));
-  }, speed);
+  await importAtSpeed(page, { name: path.basename(file), body, scenario }, speed);
   await page.evaluate(() => {
     window.__perf = { frames: 0, long: [] };
     new PerformanceObserver((list) => {

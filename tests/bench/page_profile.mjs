@@ -10,7 +10,7 @@
 // for inclusive time of the page's own functions. Needs ./build.sh build.
 import { chromium } from 'playwright-core';
 import { CHROMIUM_FLAGS, serveRoot, waitReady } from '../support/browser.mjs';
-import { scenarioArgs } from './args.mjs';
+import { importAtSpeed, scenarioArgs } from './page_bench.mjs';
 
 const { file, body, scenario, opt } = await scenarioArgs(
   'node tests/bench/page_profile.mjs SCENARIO.json [--speed 20] [--seconds 8]',
@@ -48,15 +48,7 @@ try {
   const page = await ctx.newPage();
   await page.goto(url);
   await waitReady(page);
-  await page.setInputFiles('#import-file', { name: 'scenario.json', mimeType: 'application/json', buffer: body });
-  await page.waitForFunction((n) => window.slamlab.scenario().walls.length === n, scenario.walls.length, {
-    timeout: 60000,
-  });
-  await page.evaluate((v) => {
-    const s = document.getElementById('speed');
-    s.value = String(v);
-    s.dispatchEvent(new Event('input', { bubbles: true }));
-  }, opt('speed', 20));
+  await importAtSpeed(page, { name: 'scenario.json', body, scenario }, opt('speed', 20));
   const cdp = await ctx.newCDPSession(page);
   await cdp.send('Profiler.enable');
   await cdp.send('Profiler.setSamplingInterval', { interval: 1000 });
