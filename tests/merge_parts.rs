@@ -1086,3 +1086,31 @@ fn a_budgeted_merge_of_five_maps_searches_in_rank_order_and_skips_joined_robots(
     let reason = outcome.groups[1].reason.clone().unwrap_or_default();
     assert!(reason.contains("joined no other robot"), "{reason}");
 }
+
+// ----- frames taking part: thinned by place ---------------------------------
+
+#[wasm_bindgen_test(unsupported = test)]
+fn frames_are_thinned_by_place_not_only_against_the_last_one() {
+    use slamlab::merge::method::auto::thin_by_place;
+    let at =
+        |x: f64, y: f64, deg: f64| frame_with_ranges(Pose2::new(x, y, deg.to_radians()), |_| None);
+    // A first pass along a corridor, a frame every 0.35 m heading east;
+    // then a second pass over the same stretch, again heading east but
+    // 0.1 m to the side; then the corridor driven back, heading west.
+    let mut frames: Vec<FrameInfo> = (0..6).map(|k| at(0.35 * k as f64, 0.0, 0.0)).collect();
+    frames.extend((0..6).map(|k| at(0.35 * k as f64 + 0.05, 0.1, 3.0)));
+    frames.extend((0..6).map(|k| at(1.75 - 0.35 * k as f64, 0.0, 180.0)));
+    let kept = thin_by_place(&frames, 0.5, 15f64.to_radians());
+    // First pass: 0, 0.7, 1.4 m (0.35 m from a kept frame is too close),
+    // i.e. frames 0, 2, 4. The second pass is within 0.5 m and 3° of them
+    // everywhere: none kept. Driving back faces the other way: its own
+    // thinning, 1.75, 1.05, 0.35 m, i.e. frames 12, 14, 16.
+    assert_eq!(kept, vec![0, 2, 4, 12, 14, 16]);
+    // A turn of 15° or more at the same spot is a new view.
+    let turned = vec![at(0.0, 0.0, 0.0), at(0.0, 0.0, 10.0), at(0.0, 0.0, 16.0)];
+    assert_eq!(thin_by_place(&turned, 0.5, 15f64.to_radians()), vec![0, 2]);
+    // Frames across a cell border are still compared (the hash grid's
+    // neighbours): 0.49 m apart over x = 0.5 is too close.
+    let border = vec![at(0.26, 0.0, 0.0), at(0.75, 0.0, 0.0), at(1.2, 0.0, 0.0)];
+    assert_eq!(thin_by_place(&border, 0.5, 15f64.to_radians()), vec![0, 2]);
+}
