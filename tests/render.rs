@@ -30,6 +30,18 @@ fn view(w: u32, h: u32, lab: &mut Lab) {
     lab.set_view(v).unwrap();
 }
 
+/// A 400 × 300 view of the thesis maze's middle at 20 px/m with `layers`.
+fn view_400x300(layers: Layers) -> RenderOptions {
+    RenderOptions {
+        width: 400,
+        height: 300,
+        center: [10.0, 7.5],
+        scale: 20.0,
+        layers,
+        ..RenderOptions::default()
+    }
+}
+
 fn pixel(data: &[u8], w: u32, x: u32, y: u32) -> [u8; 4] {
     let i = ((y * w + x) * 4) as usize;
     [data[i], data[i + 1], data[i + 2], data[i + 3]]
@@ -79,17 +91,10 @@ fn running_view_matches_golden_image() {
 #[wasm_bindgen_test(unsupported = test)]
 fn robots_walls_and_background_land_where_the_view_says() {
     let mut lab = Lab::new(THESIS).unwrap();
-    let v = RenderOptions {
-        width: 400,
-        height: 300,
-        center: [10.0, 7.5],
-        scale: 20.0,
-        layers: Layers {
-            grid: false,
-            ..Layers::default()
-        },
-        ..RenderOptions::default()
-    };
+    let v = view_400x300(Layers {
+        grid: false,
+        ..Layers::default()
+    });
     lab.set_view(v.clone()).unwrap();
     let data = lab.render().unwrap().data().to_vec();
     // robot1 starts at (2, 7.5): pixel ((2-10)*20+200, 150-(0)*20) = (40, 150).
@@ -199,19 +204,12 @@ fn many_robots_draw_their_lasers_as_fans() {
     );
     let mut lab = Lab::new(&s.to_json_pretty()).unwrap();
     lab.step(30).unwrap();
-    let mut v = RenderOptions {
-        width: 400,
-        height: 300,
-        center: [10.0, 7.5],
-        scale: 20.0,
-        layers: Layers {
-            grid: false,
-            truth_path: false,
-            odometry_path: false,
-            ..Layers::default()
-        },
-        ..RenderOptions::default()
-    };
+    let mut v = view_400x300(Layers {
+        grid: false,
+        truth_path: false,
+        odometry_path: false,
+        ..Layers::default()
+    });
     lab.set_view(v.clone()).unwrap();
     let fans = lab.render().unwrap().data().to_vec();
     let r = &lab.simulation().unwrap().robots[1];

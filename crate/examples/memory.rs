@@ -74,6 +74,12 @@ fn line(stage: &str, lab: &Lab) {
     );
 }
 
+/// One row of the table: six sizes in MB, then the frames kept.
+fn print_row(name: &str, row: &[usize; 7]) {
+    let sizes: Vec<String> = row[..6].iter().map(|&b| mb(b)).collect();
+    println!("| {name} | {} ({}) |", sizes.join(" | "), row[6]);
+}
+
 fn table(m: &MemoryUse) {
     println!(
         "| robot | log poses | log sensors | estimates | odometry map | SLAM map | frames (kept) |"
@@ -93,28 +99,9 @@ fn table(m: &MemoryUse) {
         for (s, v) in sum.iter_mut().zip(row) {
             *s += v;
         }
-        println!(
-            "| {} | {} | {} | {} | {} | {} | {} ({}) |",
-            r.name,
-            mb(row[0]),
-            mb(row[1]),
-            mb(row[2]),
-            mb(row[3]),
-            mb(row[4]),
-            mb(row[5]),
-            row[6]
-        );
+        print_row(&r.name, &row);
     }
-    println!(
-        "| all | {} | {} | {} | {} | {} | {} ({}) |",
-        mb(sum[0]),
-        mb(sum[1]),
-        mb(sum[2]),
-        mb(sum[3]),
-        mb(sum[4]),
-        mb(sum[5]),
-        sum[6]
-    );
+    print_row("all", &sum);
     println!(
         "textures {} MB, described {} MB, merge: features {} MB ({} frames), infos {} MB, cells {} MB, merged map {} MB; total {} MB",
         mb(m.textures),
