@@ -50,6 +50,27 @@ test('parsed results are what the binding wrote', () => {
   lab.raw.free();
 });
 
+test('writeReport hands out the report text in chunks, byte for byte, and passes on a failed write', () => {
+  const lab = Lab.open(wasm, thesis);
+  lab.setDuration(600);
+  assert.equal(lab.step(6000), 6000); // 600 s of two robots: three trajectories each, well over one 1 MiB chunk
+  const timings = { simulate: 2, total: 3 };
+  const text = lab.reportText(timings);
+  const chunks = [];
+  lab.writeReport(timings, (chunk) => chunks.push(chunk));
+  assert.ok(chunks.length >= 2, `${chunks.length} chunks for ${text.length} bytes`);
+  assert.ok(chunks.every((c) => c instanceof Uint8Array && c.length > 0));
+  assert.ok(chunks.slice(0, -1).every((c) => c.length === 1 << 20), 'full chunks of 1 MiB but the last');
+  assert.equal(Buffer.concat(chunks).toString('utf8'), text);
+  assert.throws(
+    () => lab.writeReport(timings, () => { throw new Error('disk full'); }),
+    /writing the report: disk full/,
+  );
+  // The lab and its run are still there after the failed write.
+  assert.equal(lab.reportText(timings), text);
+  lab.raw.free();
+});
+
 test('framesToDescribe pairs up the binding\'s flat [robot, frame, ...] list', () => {
   const lab = Lab.open(wasm, thesis);
   lab.step(100);

@@ -34,7 +34,10 @@ async function run(argv, wasm) {
   const totalMs = performance.now() - t0;
   const timings = { simulate: simulateMs, features: waitMs, total: totalMs };
   if (options.json) {
-    process.stdout.write(wasmCall(() => lab.reportText(timings)) + '\n');
+    // In chunks as the binding makes them: the text of a long, crowded run
+    // (75 MB for sixteen robots over an hour) is never held whole.
+    wasmCall(() => lab.writeReport(timings, (chunk) => process.stdout.write(chunk)));
+    process.stdout.write('\n');
   } else {
     printSummary(wasmCall(() => lab.report(timings)), simulateMs);
   }

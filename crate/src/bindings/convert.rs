@@ -5,6 +5,7 @@
 
 use wasm_bindgen::prelude::*;
 use wasm_bindgen::Clamped;
+use wasm_bindgen::JsCast;
 
 /// Any error message as the `JsError` JavaScript receives (an exception
 /// with that message).
@@ -29,4 +30,70 @@ pub(crate) fn put_rgba(
         .map_err(|_| JsError::new("could not make ImageData"))?;
     ctx.put_image_data(&img, 0.0, 0.0)
         .map_err(|_| JsError::new("could not draw into the canvas"))
+}
+
+/// The message of a thrown JavaScript value (an `Error`'s message, a
+/// string as it is, anything else as JavaScript would print it).
+pub(crate) fn message_of(thrown: &JsValue) -> String {
+    if let Some(e) = thrown.dyn_ref::<js_sys::Error>() {
+        return String::from(e.message());
+    }
+    thrown.as_string().unwrap_or_else(|| format!("{thrown:?}"))
+}
+
+/// Bytes written to a JavaScript function in chunks of [`Self::CHUNK`]
+/// bytes (each a fresh `Uint8Array`), so that a large document (a run
+/// report of tens of megabytes) is never held whole in wasm memory, whose
+/// linear memory only ever grows.
+pub(crate) struct ChunkSink<'a> {
+    write: &'a js_sys::Function,
+    buf: Vec<u8>,
+    /// What the function threw, if it did.
+    pub(crate) thrown: Option<JsValue>,
+}
+
+impl<'a> ChunkSink<'a> {
+    const CHUNK: usize = 1 << 20;
+
+    pub(crate) fn new(write: &'a js_sys::Function) -> ChunkSink<'a> {
+        ChunkSink {
+            write,
+            buf: Vec::with_capacity(Self::CHUNK),
+            thrown: None,
+        }
+    }
+
+    fn send(&mut self) -> std::io::Result<()> {
+        if self.buf.is_empty() {
+            return Ok(());
+        }
+        let chunk = js_sys::Uint8Array::from(&self.buf[..]);
+        self.buf.clear();
+        self.write
+            .call1(&JsValue::NULL, &chunk)
+            .map(|_| ())
+            .map_err(|e| {
+                self.thrown = Some(e);
+                std::io::Error::other("the write function threw")
+            })
+    }
+}
+
+impl std::io::Write for ChunkSink<'_> {
+    fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+        let mut rest = bytes;
+        while !rest.is_empty() {
+            let take = rest.len().min(Self::CHUNK - self.buf.len());
+            self.buf.extend_from_slice(&rest[..take]);
+            rest = &rest[take..];
+            if self.buf.len() == Self::CHUNK {
+                self.send()?;
+            }
+        }
+        Ok(bytes.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.send()
+    }
 }

@@ -373,7 +373,7 @@ impl Lab {
     }
 
     /// The run report; the simulation must have been started.
-    pub fn report(&self, timings: Timings) -> Result<Report, String> {
+    pub fn report(&self, timings: Timings) -> Result<Report<'_>, String> {
         let sim = self
             .sim
             .as_ref()

@@ -19,12 +19,42 @@ fn r6(x: f64) -> f64 {
     (x * 1e6).round() / 1e6
 }
 
-fn rows(times: &[f64], poses: &[Pose2]) -> Vec<[f64; 4]> {
-    times
-        .iter()
-        .zip(poses)
-        .map(|(&t, p)| [r6(t), r6(p.x), r6(p.y), r6(p.theta)])
-        .collect()
+/// A trajectory as `[t, x, y, theta]` rows, written straight from the
+/// robot's log when the report is serialised: an hour's run of sixteen
+/// robots has 1.7 million such rows, and a copy of them (55 MB) is memory
+/// the report need not take.
+#[derive(Clone, Copy, Debug)]
+pub struct Rows<'a> {
+    times: &'a [f64],
+    poses: &'a [Pose2],
+}
+
+impl<'a> Rows<'a> {
+    pub fn new(times: &'a [f64], poses: &'a [Pose2]) -> Rows<'a> {
+        Rows { times, poses }
+    }
+
+    /// The rows, rounded as the report writes them.
+    pub fn iter(&self) -> impl Iterator<Item = [f64; 4]> + 'a {
+        self.times
+            .iter()
+            .zip(self.poses)
+            .map(|(&t, p)| [r6(t), r6(p.x), r6(p.y), r6(p.theta)])
+    }
+
+    pub fn len(&self) -> usize {
+        self.times.len().min(self.poses.len())
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+impl Serialize for Rows<'_> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_seq(self.iter())
+    }
 }
 
 /// Final error of dead reckoning against the truth.
@@ -35,13 +65,13 @@ pub struct PoseError {
 }
 
 #[derive(Clone, Debug, Serialize)]
-pub struct RobotReport {
+pub struct RobotReport<'a> {
     pub name: String,
     pub follow: String,
-    pub truth: Vec<[f64; 4]>,
-    pub odometry: Vec<[f64; 4]>,
+    pub truth: Rows<'a>,
+    pub odometry: Rows<'a>,
     /// SLAM pose per step, same frame and times as `odometry`.
-    pub estimate: Vec<[f64; 4]>,
+    pub estimate: Rows<'a>,
     /// ATE and map figures of the SLAM and odometry-only mappers.
     pub slam: super::maps::SlamFigures,
     pub bumps: u32,
@@ -79,14 +109,14 @@ pub struct Timings {
 }
 
 #[derive(Clone, Debug, Serialize)]
-pub struct Report {
+pub struct Report<'a> {
     pub scenario: String,
     pub seed: u64,
     pub duration_s: f64,
     pub steps: usize,
     /// The merge method (`auto`, `thesis`, `map-only`); null before any merge.
     pub method: Option<String>,
-    pub robots: Vec<RobotReport>,
+    pub robots: Vec<RobotReport<'a>>,
     /// One matched-pair table per pair of robots (empty before a merge).
     pub match_tables: Vec<crate::merge::job::MatchTable>,
     /// The merge verdict, transforms and their errors; null before a merge.
@@ -103,8 +133,8 @@ pub fn odometry_final_error(start: &Pose2, odom: &Pose2, truth: &Pose2) -> PoseE
     }
 }
 
-impl Report {
-    pub fn from_sim(sim: &Simulation, timings: Timings) -> Report {
+impl<'a> Report<'a> {
+    pub fn from_sim(sim: &'a Simulation, timings: Timings) -> Report<'a> {
         let robots = sim
             .robots
             .iter()
@@ -118,9 +148,9 @@ impl Report {
                         crate::scenario::FollowSide::Left => "left".into(),
                         crate::scenario::FollowSide::Right => "right".into(),
                     },
-                    truth: rows(&log.times_s, &log.truth),
-                    odometry: rows(&log.times_s, &log.odometry),
-                    estimate: rows(&log.times_s, r.mapping.estimates()),
+                    truth: Rows::new(&log.times_s, &log.truth),
+                    odometry: Rows::new(&log.times_s, &log.odometry),
+                    estimate: Rows::new(&log.times_s, r.mapping.estimates()),
                     slam: super::maps::figures(sim, r),
                     bumps: r.bumps,
                     frames: r.frames.next_index(),
@@ -149,5 +179,12 @@ impl Report {
 
     pub fn to_json(&self) -> String {
         serde_json::to_string(self).unwrap_or_else(|e| format!("{{\"error\":\"{e}\"}}"))
+    }
+
+    /// The same JSON as [`Report::to_json`], byte for byte, written to `out`
+    /// as it is made (an hour's run of sixteen robots makes 75 MB of it,
+    /// which need then never be held whole).
+    pub fn write_json<W: std::io::Write>(&self, out: W) -> Result<(), String> {
+        serde_json::to_writer(out, self).map_err(|e| format!("writing the report: {e}"))
     }
 }
