@@ -68,6 +68,15 @@ fn facing(d: f64) -> Vec<WallSpec> {
     vec![wall([d, 1.25], [d, -1.25], "image:target")]
 }
 
+/// The thesis scenario run headless for `duration_s` seconds.
+fn thesis_run(duration_s: f64) -> Simulation {
+    let mut s = Scenario::from_json(THESIS).unwrap();
+    s.duration_s = duration_s;
+    let mut sim = Simulation::new(&s).unwrap();
+    sim.run_to_end();
+    sim
+}
+
 fn px(img: &CameraImage, x: u32, y: u32) -> u8 {
     img.gray[(y * img.width + x) as usize]
 }
@@ -465,15 +474,8 @@ fn camera_noise_is_seeded_and_has_the_configured_strength() {
 
 #[wasm_bindgen_test(unsupported = test)]
 fn a_frame_is_captured_every_simulated_second_with_its_senses() {
-    let mut s = Scenario::from_json(THESIS).unwrap();
-    s.duration_s = 10.0;
-    let mut sim = Simulation::new(&s).unwrap();
-    sim.run_to_end();
-    let sim2 = {
-        let mut x = Simulation::new(&s).unwrap();
-        x.run_to_end();
-        x
-    };
+    let sim = thesis_run(10.0);
+    let sim2 = thesis_run(10.0);
     for (r, r2) in sim.robots.iter().zip(&sim2.robots) {
         let frames = &r.frames.frames;
         assert_eq!(frames.len(), 11, "t = 0, 1, ..., 10 s");
@@ -502,7 +504,7 @@ fn a_frame_is_captured_every_simulated_second_with_its_senses() {
         assert_eq!(frames, &r2.frames.frames);
     }
     // A different seed changes the noise (and so the pixels).
-    let mut s3 = s.clone();
+    let mut s3 = sim.scenario.clone();
     s3.seed += 1;
     let mut sim3 = Simulation::new(&s3).unwrap();
     sim3.step();
@@ -579,10 +581,7 @@ fn camera_settings_are_validated() {
 /// texture detail a 64-pixel image cannot hold.
 #[wasm_bindgen_test(unsupported = test)]
 fn a_scaled_camera_renders_a_frame_as_its_thumbnail() {
-    let mut s = Scenario::from_json(THESIS).unwrap();
-    s.duration_s = 5.0;
-    let mut sim = Simulation::new(&s).unwrap();
-    sim.run_to_end();
+    let sim = thesis_run(5.0);
     let full = sim.camera.clone();
     let small = full.scaled(64);
     assert_eq!((small.width, small.height), (64, 48));
