@@ -91,6 +91,19 @@ pub struct Lab {
     inner: lab::Lab,
 }
 
+impl Lab {
+    /// Captured frame `index` of robot `robot`, or the message saying why not.
+    fn frame_at(
+        &self,
+        robot: u32,
+        index: u32,
+    ) -> Result<&crate::camera::capture::CapturedFrame, JsError> {
+        self.inner
+            .frame(robot as usize, index as usize)
+            .map_err(js_err)
+    }
+}
+
 #[wasm_bindgen]
 impl Lab {
     /// A session on a scenario (JSON text). Throws if it cannot be parsed;
@@ -325,10 +338,7 @@ impl Lab {
         index: u32,
         ctx: &web_sys::CanvasRenderingContext2d,
     ) -> Result<(), JsError> {
-        let f = self
-            .inner
-            .frame(robot as usize, index as usize)
-            .map_err(js_err)?;
+        let f = self.frame_at(robot, index)?;
         let img = self.inner.frame_image(f).map_err(js_err)?;
         let rgba: Vec<u8> = img.gray.iter().flat_map(|&g| [g, g, g, 255]).collect();
         put_rgba(ctx, &rgba, img.width, img.height)
@@ -351,10 +361,7 @@ impl Lab {
             .inner
             .simulation()
             .ok_or_else(|| JsError::new("nothing has run yet"))?;
-        let f = self
-            .inner
-            .frame(robot as usize, index as usize)
-            .map_err(js_err)?;
+        let f = self.frame_at(robot, index)?;
         if width == 0 || width > sim.camera.width {
             return Err(JsError::new(&format!(
                 "thumbnail width {width} must be 1 to the camera's {} pixels",
@@ -379,20 +386,14 @@ impl Lab {
     /// Captured frame `index` of robot `robot` as grey bytes.
     #[wasm_bindgen(js_name = frameGray)]
     pub fn frame_gray(&self, robot: u32, index: u32) -> Result<Vec<u8>, JsError> {
-        let f = self
-            .inner
-            .frame(robot as usize, index as usize)
-            .map_err(js_err)?;
+        let f = self.frame_at(robot, index)?;
         Ok(self.inner.frame_image(f).map_err(js_err)?.gray)
     }
 
     /// Captured frame `index` of robot `robot` as a PNG file (8-bit grey).
     #[wasm_bindgen(js_name = framePng)]
     pub fn frame_png(&self, robot: u32, index: u32) -> Result<Vec<u8>, JsError> {
-        let f = self
-            .inner
-            .frame(robot as usize, index as usize)
-            .map_err(js_err)?;
+        let f = self.frame_at(robot, index)?;
         let img = self.inner.frame_image(f).map_err(js_err)?;
         let mut out = Vec::new();
         image::codecs::png::PngEncoder::new(&mut out)
