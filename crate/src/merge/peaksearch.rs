@@ -273,10 +273,13 @@ fn block_within(k: usize, b: [i64; 2], peak: [i64; 2], apart: f64) -> bool {
     (dx as f64).hypot(dy as f64) < apart
 }
 
+/// Whether `i` is refused for lying near a peak kept: written as the
+/// negation of [`super::correlation::Correlation::peaks`]'s own test, so
+/// that even a NaN `apart` is treated alike.
 fn near(i: [i64; 2], peaks: &[([i64; 2], i32)], apart: f64) -> bool {
-    peaks.iter().any(|(u, _)| {
+    !peaks.iter().all(|(u, _)| {
         let (dx, dy) = ((u[0] - i[0]) as f64, (u[1] - i[1]) as f64);
-        dx.hypot(dy) < apart
+        dx.hypot(dy) >= apart
     })
 }
 
