@@ -37,6 +37,12 @@ fn maze_maps(
         .collect()
 }
 
+/// The large maze's maps, simulated once for both tests.
+fn large_maze() -> &'static [OccupancyGrid] {
+    static MAPS: std::sync::OnceLock<Vec<OccupancyGrid>> = std::sync::OnceLock::new();
+    MAPS.get_or_init(|| maze_maps(14, 12, 2, 11, 600.0))
+}
+
 /// Both searches on every ordered pair of `maps`; returns how many peaks
 /// were compared.
 fn assert_same_peaks(maps: &[OccupancyGrid], cfg: &MapSearchConfig) -> usize {
@@ -70,9 +76,8 @@ fn branch_and_bound_finds_the_exhaustive_peaks_on_maze_maps_of_three_sizes() {
     // 12.5 × 10 m, 20 × 15 m and 35 × 30 m mazes (2.5 m cells).
     let small = maze_maps(5, 4, 2, 3, 120.0);
     let middle = maze_maps(8, 6, 3, 7, 300.0);
-    let large = maze_maps(14, 12, 2, 11, 600.0);
     let mut compared = 0;
-    for maps in [&small, &middle, &large] {
+    for maps in [&small[..], &middle[..], large_maze()] {
         compared += assert_same_peaks(maps, &cfg);
     }
     // 2 + 6 + 2 ordered pairs, up to 12 peaks each: most pairs fill them.
@@ -101,7 +106,7 @@ fn the_whole_search_is_unchanged_on_a_large_maze() {
     // search_maps uses the branch and bound; its hypotheses come from the
     // peaks above, so the same peaks give the same answer. Here the answer
     // itself: every hypothesis judged from the exhaustive peaks.
-    let maps = maze_maps(14, 12, 2, 11, 600.0);
+    let maps = large_maze();
     let (cfg, verdict) = (MapSearchConfig::default(), VerdictConfig::default());
     let found = search_maps(&maps[0], &maps[1], &cfg, &verdict);
     let (_, full) = coarse_peaks(&maps[0], &maps[1], &cfg, TranslationSearch::Exhaustive)
