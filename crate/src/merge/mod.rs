@@ -65,6 +65,7 @@ pub mod method;
 pub mod offline;
 pub mod offline_search;
 pub mod pairbudget;
+pub mod peaksearch;
 pub mod refine;
 pub mod rigid;
 pub mod selection;
