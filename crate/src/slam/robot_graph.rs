@@ -66,7 +66,10 @@
 //! is `None`); `sim_drift --graph` runs it.
 
 use super::degeneracy::{constraint_of, scan_normals};
+use super::filter::OdometryNoise;
 use super::grid::{beam_directions, GridConfig, OccupancyGrid};
+use super::key_chain::KeyChain;
+pub use super::key_chain::StepMatch;
 use super::loop_closure::{closures_agree, find_closure, Closure, LoopConfig};
 use super::multires::Window;
 use super::posegraph::{Edge, PoseGraph};
@@ -79,10 +82,14 @@ use glam::DVec2;
 pub struct RobotGraphConfig {
     pub key_distance_m: f64,
     pub key_angle_rad: f64,
-    /// Standard deviations of a key-to-key edge where the filter matched.
-    pub key_sigma_m: f64,
-    pub key_sigma_rad: f64,
-    /// … and where it ran on odometry alone for a step or more.
+    /// Odometry's noise per step, as the front end's filter models it: the
+    /// key edges' covariance is compounded from it ([`super::key_chain`]).
+    pub odometry: OdometryNoise,
+    /// Standard deviations added to every key edge's compounded covariance
+    /// (a key's own match is not exact).
+    pub floor_m: f64,
+    pub floor_rad: f64,
+    /// A key edge whose compounded covariance cannot be inverted.
     pub loose_sigma_m: f64,
     pub loose_sigma_rad: f64,
     pub loops: LoopConfig,
@@ -119,8 +126,9 @@ impl Default for RobotGraphConfig {
         RobotGraphConfig {
             key_distance_m: 0.4,
             key_angle_rad: 20f64.to_radians(),
-            key_sigma_m: 0.02,
-            key_sigma_rad: 0.5f64.to_radians(),
+            odometry: OdometryNoise::default(),
+            floor_m: 0.001,
+            floor_rad: 0.05f64.to_radians(),
             loose_sigma_m: 0.1,
             loose_sigma_rad: 3f64.to_radians(),
             loops: LoopConfig {
@@ -264,8 +272,9 @@ pub struct RobotGraph {
     key_path_m: Vec<f64>,
     /// The key each step's estimate follows (the last key at or before it).
     step_key: Vec<u32>,
-    /// The filter ran on odometry alone since the last key.
-    loose: bool,
+    /// The pose since the last key and its covariance (`None` before the
+    /// first key).
+    chain: Option<KeyChain>,
     pending: Vec<Closure>,
     /// The key of the last accepted pair (for the cool-down).
     last_accepted: Option<usize>,
@@ -282,14 +291,20 @@ impl RobotGraph {
     }
 
     /// After the front end integrated `scan` at its newest estimate (the
-    /// last of `front.estimates`), `matched` unless it kept odometry's word: makes a key if the
-    /// robot moved far enough, looks for a loop closure, and applies an
-    /// accepted one to the front end.
-    pub fn add_scan(&mut self, scan: &LaserScan, matched: bool, front: FrontEnd<'_>) {
-        self.loose |= !matched;
+    /// last of `front.estimates`), with what its match said (`None` where
+    /// it kept odometry's word): makes a key if the robot moved far enough,
+    /// looks for a loop closure, and applies an accepted one to the front
+    /// end.
+    pub fn add_scan(&mut self, scan: &LaserScan, matched: Option<StepMatch>, front: FrontEnd<'_>) {
         let Some(&pose) = front.estimates.last() else {
             return;
         };
+        if let Some(chain) = &mut self.chain {
+            chain.step(&pose, &self.config.odometry);
+            if let Some(m) = &matched {
+                chain.observe(m);
+            }
+        }
         let is_key = match self.graph.nodes.last() {
             None => true,
             Some(last) => {
@@ -317,12 +332,15 @@ impl RobotGraph {
         if let Some(prev) = id.checked_sub(1) {
             let z = self.graph.nodes[prev].between(&pose);
             let c = &self.config;
-            let (sm, sr) = if self.loose {
-                (c.loose_sigma_m, c.loose_sigma_rad)
-            } else {
-                (c.key_sigma_m, c.key_sigma_rad)
-            };
-            self.graph.edges.push(Edge::new(prev, id, z, sm, sr));
+            let mut edge = Edge::new(prev, id, z, c.loose_sigma_m, c.loose_sigma_rad);
+            if let Some(info) = self
+                .chain
+                .as_ref()
+                .and_then(|ch| ch.edge_information(&z, c.floor_m, c.floor_rad))
+            {
+                edge.information = info;
+            }
+            self.graph.edges.push(edge);
         }
         let path = match (self.graph.nodes.last(), self.key_path_m.last()) {
             (Some(prev), Some(&p)) => p + prev.position().distance(pose.position()),
@@ -331,7 +349,7 @@ impl RobotGraph {
         self.key_path_m.push(path);
         self.graph.nodes.push(pose);
         self.keys.push(KeyScan::pack(scan));
-        self.loose = false;
+        self.chain = Some(KeyChain::start(pose));
         self.stats.keys += 1;
     }
 
@@ -450,17 +468,11 @@ impl RobotGraph {
             return;
         }
         let before = self.graph.nodes.clone();
-        let edges = self.graph.edges.len();
-        self.graph
-            .edges
-            .extend(closures.iter().map(|c| c.edge.clone()));
-        let ok = self.graph.optimise(10).is_ok()
-            && closures
-                .iter()
-                .all(|c| self.graph.chi2(&c.edge) <= self.config.max_closure_chi2);
-        if !ok {
-            self.graph.nodes = before;
-            self.graph.edges.truncate(edges);
+        let edges: Vec<Edge> = closures.iter().map(|c| c.edge.clone()).collect();
+        if !self
+            .graph
+            .try_closures(&edges, 10, None, self.config.max_closure_chi2)
+        {
             self.stats.closures_rejected += closures.len();
             return;
         }
@@ -490,6 +502,13 @@ impl RobotGraph {
         if let Some(m) = moves.last() {
             *front.pose = m.compose(front.pose);
         }
+        if let (Some(chain), Some(key), Some(last)) = (
+            &mut self.chain,
+            self.graph.nodes.last(),
+            front.estimates.last(),
+        ) {
+            chain.moved(*key, *last);
+        }
         let reach = self.keys.first().map_or(0.0, |k| k.range_max_m);
         let largest = before
             .iter()
@@ -506,11 +525,9 @@ impl RobotGraph {
 
     /// The SLAM map drawn from the key scans at their current poses.
     fn rebuild(&self, config: GridConfig) -> OccupancyGrid {
-        let mut map = OccupancyGrid::new(config);
-        for (pose, key) in self.graph.nodes.iter().zip(&self.keys) {
-            map.integrate_scan(pose, &key.unpack());
-        }
-        map
+        OccupancyGrid::drawn_at(config, self.graph.nodes.iter().copied(), |map, k, pose| {
+            map.integrate_scan(pose, &self.keys[k].unpack())
+        })
     }
 
     /// The step (index into the estimates) each key was taken at.
@@ -571,7 +588,7 @@ mod tests {
                 pose: &mut pose,
                 map: &mut map,
             };
-            g.add_scan(&s, true, front);
+            g.add_scan(&s, None, front);
         }
         assert_eq!(g.key_steps(), &[0, 4, 8]);
         assert_eq!(g.step_key, vec![0, 0, 0, 0, 1, 1, 1, 1, 2, 2]);
