@@ -71,6 +71,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 c.floor_rad = env("GRAPH_FLOOR_DEG").map_or(c.floor_rad, f64::to_radians);
                 c.loop_every = env("GRAPH_LOOP_EVERY").map_or(c.loop_every, |v| v as usize);
                 c.satisfied_m = env("GRAPH_SATISFIED_M").unwrap_or(c.satisfied_m);
+                c.refine_closures = env("GRAPH_REFINE").is_none_or(|v| v != 0.0);
+                c.loops.sigma_m = env("GRAPH_CLOSURE_SIGMA_M").unwrap_or(c.loops.sigma_m);
+                c.loops.sigma_rad =
+                    env("GRAPH_CLOSURE_SIGMA_DEG").map_or(c.loops.sigma_rad, f64::to_radians);
                 c.cooldown_keys = env("GRAPH_COOLDOWN").map_or(c.cooldown_keys, |v| v as usize);
                 c.loops.window.linear_m = env("GRAPH_WINDOW_M").unwrap_or(c.loops.window.linear_m);
                 if env("GRAPH_NO_LOOPS").is_some() {
