@@ -399,9 +399,9 @@ pub struct RobotMapping {
     last_processed: Option<(Pose2, usize)>,
     pub counts: MatchCounts,
     pub last_outcome: Option<MatchOutcome>,
-    /// The loop-closing back end ([`super::robot_graph`]); `None` (the
-    /// default, until it helps every robot: see its module doc) runs the
-    /// filter alone.
+    /// The loop-closing back end ([`super::robot_graph`]), made when
+    /// [`SlamConfig::back_end`] is set; `None` (the default, until it helps
+    /// every robot: see its module doc) runs the filter alone.
     pub graph: Option<RobotGraph>,
 }
 
