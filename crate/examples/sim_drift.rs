@@ -2,7 +2,7 @@
 //! against the truth over time, with what the matcher said.
 //!
 //! ```sh
-//! cargo run --release -p slamlab --example sim_drift -- SCENARIO.json robot5 [robot15 …] [--every 60] [--until 3600] [--graph]
+//! cargo run --release -p slamlab --example sim_drift -- SCENARIO.json robot5 [robot15 …] [--every 60] [--until 3600] [--graph|--no-graph]
 //! ```
 //!
 //! The simulation runs with its own mappers off and the named robots' mappers
@@ -12,14 +12,13 @@
 //! than drift), it prints the error of the estimate and of odometry, the
 //! match outcome counts in that stretch, the calibrated odometry bias, the
 //! loop closures accepted so far, and whether the map grid refused to grow.
-//! `--graph` runs the filter with the loop-closing back end
-//! ([`slamlab::slam::robot_graph`]), which is off by default.
+//! `--graph` / `--no-graph` run the filter with or without the loop-closing back end
+//! ([`slamlab::slam::robot_graph`]); without either, as `SlamConfig::back_end` says.
 
 use slamlab::geom::{wrap_angle, Pose2};
 use slamlab::scenario::Scenario;
 use slamlab::sim::Simulation;
-use slamlab::slam::mapper::{MatchCounts, RobotMapping};
-use slamlab::slam::robot_graph::{RobotGraph, RobotGraphConfig};
+use slamlab::slam::mapper::{MatchCounts, RobotMapping, SlamConfig};
 use slamlab::slam::scoring::{ate_m, position_errors_m};
 
 struct Traced {
@@ -31,18 +30,19 @@ struct Traced {
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let path = args
-        .first()
-        .ok_or("usage: sim_drift SCENARIO.json ROBOT… [--every S] [--until S] [--graph]")?;
+    let path = args.first().ok_or(
+        "usage: sim_drift SCENARIO.json ROBOT… [--every S] [--until S] [--graph|--no-graph]",
+    )?;
     let mut scenario =
         Scenario::parse(&std::fs::read_to_string(path)?).map_err(|e| format!("{e:?}"))?;
     let (mut every_s, mut names, mut back_end): (f64, Vec<String>, bool) =
-        (60.0, Vec::new(), false);
+        (60.0, Vec::new(), SlamConfig::default().back_end);
     let mut it = args[1..].iter();
     while let Some(a) = it.next() {
         match a.as_str() {
             "--every" => every_s = it.next().ok_or("--every S")?.parse()?,
             "--graph" => back_end = true,
+            "--no-graph" => back_end = false,
             "--until" => scenario.duration_s = it.next().ok_or("--until S")?.parse()?,
             name => names.push(name.to_string()),
         }
@@ -58,17 +58,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .iter()
                 .position(|r| &r.spec.name == n)
                 .ok_or(format!("no robot '{n}'"))?;
-            let mut mapping = RobotMapping::default();
-            if back_end {
-                mapping.graph = Some(RobotGraph::new(RobotGraphConfig::default()));
-            }
+            let mapping = RobotMapping::new(SlamConfig {
+                back_end,
+                ..SlamConfig::default()
+            });
+            let mut mapping = mapping;
             // Experiments: a few settings from the environment.
             let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
             if let Some(g) = &mut mapping.graph {
                 let c = &mut g.config;
-                c.key_sigma_m = env("GRAPH_KEY_SIGMA_M").unwrap_or(c.key_sigma_m);
-                c.key_sigma_rad =
-                    env("GRAPH_KEY_SIGMA_DEG").map_or(c.key_sigma_rad, f64::to_radians);
+                c.floor_m = env("GRAPH_FLOOR_M").unwrap_or(c.floor_m);
+                c.floor_rad = env("GRAPH_FLOOR_DEG").map_or(c.floor_rad, f64::to_radians);
+                c.loop_every = env("GRAPH_LOOP_EVERY").map_or(c.loop_every, |v| v as usize);
+                c.satisfied_m = env("GRAPH_SATISFIED_M").unwrap_or(c.satisfied_m);
+                c.refine_closures = env("GRAPH_REFINE").is_none_or(|v| v != 0.0);
+                c.loops.sigma_m = env("GRAPH_CLOSURE_SIGMA_M").unwrap_or(c.loops.sigma_m);
+                c.loops.sigma_rad =
+                    env("GRAPH_CLOSURE_SIGMA_DEG").map_or(c.loops.sigma_rad, f64::to_radians);
                 c.cooldown_keys = env("GRAPH_COOLDOWN").map_or(c.cooldown_keys, |v| v as usize);
                 c.loops.window.linear_m = env("GRAPH_WINDOW_M").unwrap_or(c.loops.window.linear_m);
                 if env("GRAPH_NO_LOOPS").is_some() {

@@ -112,6 +112,10 @@ fn config_from_env() -> SlamConfig {
     if let Some(v) = env("SLAM_MOTION_S") {
         cfg.motion.max_interval_s = v;
     }
+    // The loop-closing back end: 1 on, 0 off.
+    if let Some(v) = env("SLAM_BACK_END") {
+        cfg.back_end = v != 0.0;
+    }
     cfg
 }
 

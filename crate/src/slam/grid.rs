@@ -742,3 +742,20 @@ pub fn traverse(a: DVec2, b: DVec2, mut visit: impl FnMut([i64; 2])) {
         visit(cell);
     }
 }
+
+impl OccupancyGrid {
+    /// A new grid with scans drawn in order at `poses`: `draw(grid, k,
+    /// pose)` integrates the `k`-th. The map a pose graph's scans make at
+    /// their optimised poses (the log SLAM's and the robot back end's).
+    pub fn drawn_at(
+        config: GridConfig,
+        poses: impl IntoIterator<Item = Pose2>,
+        mut draw: impl FnMut(&mut OccupancyGrid, usize, &Pose2),
+    ) -> OccupancyGrid {
+        let mut grid = OccupancyGrid::new(config);
+        for (k, pose) in poses.into_iter().enumerate() {
+            draw(&mut grid, k, &pose);
+        }
+        grid
+    }
+}

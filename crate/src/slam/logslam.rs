@@ -481,19 +481,12 @@ impl LogSlam {
     /// Adds confirmed closures, optimises, and undoes it all if a closure
     /// stays badly unsatisfied.
     fn accept(&mut self, closures: Vec<Closure>) {
-        let saved_nodes = self.graph.nodes.clone();
-        let saved_edges = self.graph.edges.len();
-        for c in &closures {
-            self.graph.edges.push(c.edge.clone());
-        }
         let phi = self.dcs().filter(|_| self.config.dcs_incremental);
-        let ok = self.graph.optimise_robust(10, phi).is_ok()
-            && closures
-                .iter()
-                .all(|c| self.graph.chi2(&c.edge) <= self.config.max_closure_chi2);
-        if !ok {
-            self.graph.nodes = saved_nodes;
-            self.graph.edges.truncate(saved_edges);
+        let edges: Vec<Edge> = closures.iter().map(|c| c.edge.clone()).collect();
+        if !self
+            .graph
+            .try_closures(&edges, 10, phi, self.config.max_closure_chi2)
+        {
             self.stats.closures_rejected += closures.len();
             return;
         }
@@ -541,14 +534,15 @@ impl LogSlam {
     /// Draws the occupancy grid of `scans` (the same scans, in the same
     /// order, as were added) at the current estimates.
     pub fn build_map(&self, scans: &[LogScan]) -> OccupancyGrid {
-        let mut grid = OccupancyGrid::new(GridConfig {
+        let config = GridConfig {
             resolution_m: self.config.resolution_m,
             max_cells: 1 << 24,
             ..GridConfig::default()
-        });
+        };
         let reach = self.config.match_range_m.max(self.config.free_range_m);
-        for (k, scan) in scans.iter().enumerate().take(self.scans.len()) {
-            let pose = self.scan_pose(k);
+        let poses = (0..self.scans.len().min(scans.len())).map(|k| self.scan_pose(k));
+        OccupancyGrid::drawn_at(config, poses, |grid, k, pose| {
+            let scan = &scans[k];
             let c = pose.position();
             grid.ensure_contains(c - reach, c + reach);
             let laser = pose.compose(&scan.laser_offset);
@@ -561,7 +555,6 @@ impl LogSlam {
                     grid.integrate_beam(from, from + dir * r, true);
                 }
             }
-        }
-        grid
+        })
     }
 }

@@ -114,7 +114,7 @@ use super::filter::PoseFilter;
 use super::gauss_newton;
 use super::grid::{beam_directions, GridConfig, OccupancyGrid};
 use super::likelihood::LikelihoodField;
-use super::robot_graph::{FrontEnd, RobotGraph};
+use super::robot_graph::{FrontEnd, RobotGraph, RobotGraphConfig, StepMatch};
 use super::surface::{information_at, refine_to_surface, RefineConfig, Refinement};
 use crate::geom::{wrap_angle, Pose2};
 use crate::kinematics::CONTROL_DT_S;
@@ -144,6 +144,9 @@ pub struct SlamConfig {
     pub odometry_noise: OdometryNoise,
     /// When a scan is worth matching and mapping ([`MotionFilter`]).
     pub motion: MotionFilter,
+    /// Whether [`RobotMapping::new`] runs the loop-closing back end
+    /// ([`super::robot_graph`]) beside the filter.
+    pub back_end: bool,
 }
 
 impl Default for SlamConfig {
@@ -159,6 +162,7 @@ impl Default for SlamConfig {
             match_noise_m: 0.01,
             odometry_noise: OdometryNoise::default(),
             motion: MotionFilter::default(),
+            back_end: false,
         }
     }
 }
@@ -395,9 +399,9 @@ pub struct RobotMapping {
     last_processed: Option<(Pose2, usize)>,
     pub counts: MatchCounts,
     pub last_outcome: Option<MatchOutcome>,
-    /// The loop-closing back end ([`super::robot_graph`]); `None` (the
-    /// default, until it helps every robot: see its module doc) runs the
-    /// filter alone.
+    /// The loop-closing back end ([`super::robot_graph`]), made when
+    /// [`SlamConfig::back_end`] is set; `None` (the default, until it helps
+    /// every robot: see its module doc) runs the filter alone.
     pub graph: Option<RobotGraph>,
 }
 
@@ -410,6 +414,12 @@ impl Default for RobotMapping {
 impl RobotMapping {
     pub fn new(config: SlamConfig) -> RobotMapping {
         let noise = config.odometry_noise.clone();
+        let graph = config.back_end.then(|| {
+            RobotGraph::new(RobotGraphConfig {
+                odometry: config.odometry_noise.clone(),
+                ..RobotGraphConfig::default()
+            })
+        });
         RobotMapping {
             odometry_map: OccupancyGrid::new(GridConfig {
                 surface_points: false,
@@ -427,7 +437,7 @@ impl RobotMapping {
             last_processed: None,
             counts: MatchCounts::default(),
             last_outcome: None,
-            graph: None,
+            graph,
         }
     }
 
@@ -502,7 +512,7 @@ impl RobotMapping {
         if let Some(graph) = &mut self.graph {
             graph.add_scan(
                 scan,
-                outcome.status != MatchStatus::OdometryOnly,
+                step_match(&outcome),
                 FrontEnd {
                     estimates: &mut self.estimates,
                     pose: &mut self.filter.pose,
@@ -520,6 +530,23 @@ impl RobotMapping {
             MapperKind::Slam => &self.slam_map,
         }
     }
+}
+
+/// What the back end needs of a match (see [`super::key_chain`]): its
+/// information and, when degenerate, the weak direction in the world frame.
+fn step_match(outcome: &MatchOutcome) -> Option<StepMatch> {
+    let weak_direction = match outcome.status {
+        MatchStatus::OdometryOnly => return None,
+        MatchStatus::Matched => None,
+        MatchStatus::Degenerate => Some(
+            Pose2::new(0.0, 0.0, outcome.pose.theta)
+                .transform_point(outcome.constraint.weak_direction),
+        ),
+    };
+    Some(StepMatch {
+        information: outcome.information,
+        weak_direction,
+    })
 }
 
 /// Which of a robot's two maps.

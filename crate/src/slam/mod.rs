@@ -24,6 +24,7 @@
 //! | loop closure by correlative matching | [`loop_closure`] | Konolige et al. 2010; Hess et al. 2016 |
 //! | SLAM for real laser logs | [`logslam`] | Karto / slam_toolbox, Cartographer |
 //! | the simulated robots' loop-closing back end | [`robot_graph`] | Konolige et al. 2010; Hess et al. 2016 |
+//! | its key edges' compounded covariance | [`key_chain`] | Smith, Self, Cheeseman 1990; Konolige et al. 2010 |
 //! | relation errors against a reference | [`relations`] | Kümmerle et al., Auton. Robots 2009 |
 //!
 //! The simulation feeds every robot's [`RobotMapping`] once per step with
@@ -35,6 +36,7 @@ pub mod export;
 pub mod filter;
 pub mod gauss_newton;
 pub mod grid;
+pub mod key_chain;
 pub mod likelihood;
 pub mod log_replay;
 pub mod logslam;

@@ -158,6 +158,29 @@ impl PoseGraph {
         self.optimise_robust(iterations, None)
     }
 
+    /// Adds loop-closure `edges`, optimises (`iterations`, Dynamic
+    /// Covariance Scaling with `phi`), and keeps them only if every one is
+    /// then satisfied within `max_chi2`; otherwise puts the nodes and edges
+    /// back as they were. Returns whether they were kept.
+    pub fn try_closures(
+        &mut self,
+        edges: &[Edge],
+        iterations: usize,
+        phi: Option<f64>,
+        max_chi2: f64,
+    ) -> bool {
+        let saved_nodes = self.nodes.clone();
+        let saved_edges = self.edges.len();
+        self.edges.extend_from_slice(edges);
+        let ok = self.optimise_robust(iterations, phi).is_ok()
+            && edges.iter().all(|e| self.chi2(e) <= max_chi2);
+        if !ok {
+            self.nodes = saved_nodes;
+            self.edges.truncate(saved_edges);
+        }
+        ok
+    }
+
     /// [`PoseGraph::optimise`] with Dynamic Covariance Scaling of the loop
     /// closures when `phi` is given (see the module doc): each step weighs
     /// a closure's information by `s²`, `s = min(1, 2Φ / (Φ + χ²))` at the
