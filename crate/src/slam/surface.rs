@@ -114,20 +114,21 @@ pub fn surface_centroid(map: &OccupancyGrid, q: DVec2, n: DVec2, radius: f64) ->
     let [ox, oy] = map.origin_cell();
     let (w, h) = (map.width() as i64, map.height() as i64);
     let (mut sum_w, mut sum) = (0.0, DVec2::ZERO);
-    for y in (gy - reach - oy).max(0)..=(gy + reach - oy).min(h - 1) {
-        for x in (gx - reach - ox).max(0)..=(gx + reach - ox).min(w - 1) {
-            let Some(s) = map.surface_point(x as usize, y as usize) else {
-                continue;
-            };
-            let d = s.position - q;
-            if n.dot(d).abs() > radius || t.dot(d).abs() > band {
-                continue;
-            }
-            let wt = s.hits as f64;
-            sum_w += wt;
-            sum += wt * s.position;
-        }
+    let (x0, x1) = ((gx - reach - ox).max(0), (gx + reach - ox).min(w - 1));
+    let (y0, y1) = ((gy - reach - oy).max(0), (gy + reach - oy).min(h - 1));
+    if x0 > x1 || y0 > y1 {
+        return None;
     }
+    let window = |a: i64, b: i64| [a as usize, b as usize];
+    map.for_surface_points(window(x0, x1), window(y0, y1), |s| {
+        let d = s.position - q;
+        if n.dot(d).abs() > radius || t.dot(d).abs() > band {
+            return;
+        }
+        let wt = s.hits as f64;
+        sum_w += wt;
+        sum += wt * s.position;
+    });
     (sum_w > 0.0).then(|| sum / sum_w)
 }
 
