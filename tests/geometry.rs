@@ -243,7 +243,10 @@ fn the_sensors_grid_finds_the_same_ranges_as_the_worlds() {
     let mut rng = Rng::new(5);
     for _ in 0..40 {
         let a = DVec2::new(rng.range(0.0, 60.0), rng.range(0.0, 60.0));
-        walls.push(Segment::new(a, a + DVec2::from_angle(rng.range(0.0, 2.0 * PI)) * 4.0));
+        walls.push(Segment::new(
+            a,
+            a + DVec2::from_angle(rng.range(0.0, 2.0 * PI)) * 4.0,
+        ));
     }
     let world = World::new(walls);
     let (mut hits, mut corners) = (0, 0);

@@ -321,7 +321,10 @@ fn squared_bounds_answer_as_lengths_do() {
         let b = squared_bound(c);
         assert!(b.sqrt() <= c, "{c}: bound {b}");
         assert!(f64::from_bits(b.to_bits() + 1).sqrt() > c, "{c}: bound {b}");
-        assert!((b - c * c).abs() <= 4.0 * f64::EPSILON * c * c, "{c}: bound {b}");
+        assert!(
+            (b - c * c).abs() <= 4.0 * f64::EPSILON * c * c,
+            "{c}: bound {b}"
+        );
     }
     let mut rng = Rng::new(3);
     let (c, b) = (0.3, squared_bound(0.3));
@@ -331,5 +334,8 @@ fn squared_bounds_answer_as_lengths_do() {
         assert_eq!(v.length() <= c, v.length_squared() <= b, "{v}");
         both[(v.length() <= c) as usize] += 1;
     }
-    assert!(both[0] > 1000 && both[1] > 1000, "both sides tried: {both:?}");
+    assert!(
+        both[0] > 1000 && both[1] > 1000,
+        "both sides tried: {both:?}"
+    );
 }
