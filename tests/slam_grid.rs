@@ -361,3 +361,47 @@ fn the_window_walk_gives_the_surface_points_cell_by_cell() {
     }
     assert!(windows >= 10, "windows with surface points: {windows}");
 }
+
+/// The likelihood field of one saturated wall cell is the Gaussian kernel
+/// around it (σ = 1 cell, radius 2, unit sum: `w(d) = exp(−d²/2) / Σ`,
+/// the value at offset (dx, dy) being `w(dx)·w(dy)`), cut off at the
+/// window's edge, and each coarse entry is the largest fine value of its
+/// 4 × 4 block forward.
+#[wasm_bindgen_test(unsupported = test)]
+fn the_likelihood_field_of_one_wall_cell_is_the_kernel() {
+    use slamlab::slam::likelihood::LikelihoodField;
+    let mut g = grid();
+    let p = DVec2::new(0.525, 0.275); // global cell (10, 5)
+    for _ in 0..6 {
+        g.integrate_beam(p - DVec2::new(0.01, 0.0), p, true);
+    }
+    let norm = 1.0 + 2.0 * ((-0.5f64).exp() + (-2.0f64).exp());
+    let w = |d: i64| {
+        if d.abs() > 2 {
+            0.0
+        } else {
+            (-0.5 * (d * d) as f64).exp() / norm
+        }
+    };
+    // A window whose left edge cuts the kernel: cells 9..=20 × 0..=11.
+    let f = LikelihoodField::build(&g, [9, 0], [20, 11], 4);
+    assert_eq!((f.width, f.height), (12, 12));
+    for y in 0..12i64 {
+        for x in 0..12i64 {
+            let (dx, dy) = (x + 9 - 10, y - 5);
+            let want = w(dx) * w(dy);
+            let got = f.fine_at(x, y) as f64;
+            assert!(
+                (got - want).abs() < 1e-6,
+                "({x}, {y}): {got} against {want}"
+            );
+        }
+    }
+    // Coarse: the block [x, x + 4) × [y, y + 4) holding the wall cell
+    // (window x 1, y 5) has its value; a block two cells off, w(2)·w(0).
+    let top = w(0) * w(0);
+    assert!((f.coarse_at(0, 2) as f64 - top).abs() < 1e-6);
+    assert!((f.coarse_at(3, 5) as f64 - w(2) * w(0)).abs() < 1e-6);
+    assert_eq!(f.coarse_at(6, 5), 0.0);
+    assert_eq!(f.coarse_at(0, 8), 0.0);
+}

@@ -11,6 +11,13 @@
 //! stop as soon as the nearest hit so far lies before the exit of the current
 //! cell (nothing in a later cell can be nearer). Scenes with few walls skip
 //! the grid: testing 64 segments is cheaper than walking cells.
+//!
+//! The cells are sized to the walls (about two walls' length), which suits
+//! the camera's long rays; the laser and sonar cast through a second grid
+//! of 1 m cells ([`World::cast_range`]), since their rays are 2–4 m and a
+//! maze's long wall runs made the first grid's cells 10 m and more. The
+//! nearest hit does not depend on the cells, so the ranges are the same
+//! bit for bit.
 
 use crate::geom::{ConvexPolygon, Segment};
 use glam::DVec2;
