@@ -198,6 +198,9 @@ pub fn refine_to_surface(
     };
     // The normal equations and cost at `pose` with association `surface`.
     let evaluate = |pose: &Pose2, surface: &[Option<DVec2>]| {
+        // The pose's sine and cosine once, not once a point (the same
+        // numbers `transform_point` works out).
+        let frame = pose.frame();
         let (s, c) = pose.theta.sin_cos();
         let mut h = [[0.0; 3]; 3];
         let mut g = [0.0; 3];
@@ -211,7 +214,7 @@ pub fn refine_to_surface(
             };
             count += 1;
             let nw = DVec2::new(c * n.x - s * n.y, s * n.x + c * n.y);
-            let r = nw.dot(pose.transform_point(p) - *m);
+            let r = nw.dot(frame.to_parent(p) - *m);
             let (rho, w) = huber(r, k);
             cost += rho;
             let dq = DVec2::new(-s * p.x - c * p.y, c * p.x - s * p.y);
