@@ -227,3 +227,45 @@ fn pose_frame_maps_points_as_the_pose_does() {
         assert!(close(frame.to_local(frame.to_parent(p)), p));
     }
 }
+
+/// The sensors' finer grid ([`World::cast_range`]) finds the same range as
+/// the world's own grid, bit for bit, in a world of long walls (a maze's
+/// runs, where the own grid's cells are several metres wide), including
+/// rays through the points where walls meet.
+#[wasm_bindgen_test(unsupported = test)]
+fn the_sensors_grid_finds_the_same_ranges_as_the_worlds() {
+    let mut walls = Vec::new();
+    for k in 0..=20 {
+        let v = 3.0 * k as f64;
+        walls.push(seg(0.0, v, 60.0, v));
+        walls.push(seg(v, 0.0, v, 60.0));
+    }
+    let mut rng = Rng::new(5);
+    for _ in 0..40 {
+        let a = DVec2::new(rng.range(0.0, 60.0), rng.range(0.0, 60.0));
+        walls.push(Segment::new(
+            a,
+            a + DVec2::from_angle(rng.range(0.0, 2.0 * PI)) * 4.0,
+        ));
+    }
+    let world = World::new(walls);
+    let (mut hits, mut corners) = (0, 0);
+    for i in 0..400 {
+        // Every fourth ray from a lattice point: through wall junctions.
+        let o = if i % 4 == 0 {
+            DVec2::new(3.0 * (i % 19) as f64 + 1.5, 3.0 * (i % 17) as f64 + 1.5)
+        } else {
+            DVec2::new(rng.range(0.0, 60.0), rng.range(0.0, 60.0))
+        };
+        for k in 0..181 {
+            let dir = DVec2::from_angle(k as f64 * PI / 90.0);
+            let range = |h: Option<slamlab::world::RayHit>| h.map(|h| h.range_m.to_bits());
+            let own = world.cast(o, dir, 4.0);
+            assert_eq!(range(world.cast_range(o, dir, 4.0)), range(own), "{o} {k}");
+            hits += own.is_some() as usize;
+            corners += (i % 4 == 0 && k % 45 == 0 && own.is_some()) as usize;
+        }
+    }
+    assert!(hits > 400 * 181 / 2, "rays hit walls: {hits}");
+    assert!(corners > 100, "rays through junctions: {corners}");
+}

@@ -316,3 +316,92 @@ fn a_scan_of_hits_clears_to_the_margin_and_marks_the_ends() {
     assert_eq!(g.log_odds_global([19, 0]), 2.0 * hit);
     assert_eq!(g.log_odds_global([21, 0]), 0.0);
 }
+
+/// The matcher's window walk ([`OccupancyGrid::for_surface_points`]) gives
+/// the points `surface_point` gives cell by cell, in the same order, for
+/// windows across block borders and the grid's edges.
+#[wasm_bindgen_test(unsupported = test)]
+fn the_window_walk_gives_the_surface_points_cell_by_cell() {
+    let mut g = OccupancyGrid::new(GridConfig {
+        surface_points: true,
+        ..GridConfig::default()
+    });
+    for (k, range) in [1.3, 2.1, 0.7, 3.4].into_iter().enumerate() {
+        let pose = Pose2::new(0.1 * k as f64, -0.05 * k as f64, 0.4 * k as f64);
+        g.integrate_scan(&pose, &ring_scan(range, true));
+    }
+    let (w, h) = (g.width(), g.height());
+    let mut corners = vec![(0, 0), (w - 3, h - 2)];
+    let mut surface_cells = 0;
+    for y in 0..h {
+        for x in 0..w {
+            if g.surface_point(x, y).is_some() {
+                surface_cells += 1;
+                if surface_cells % 97 == 0 {
+                    corners.push((x.saturating_sub(2), y.saturating_sub(3)));
+                }
+            }
+        }
+    }
+    let mut windows = 0;
+    for (x0, y0) in corners {
+        for (dx, dy) in [(4, 4), (1, 7), (60, 60)] {
+            let (x1, y1) = ((x0 + dx).min(w - 1), (y0 + dy).min(h - 1));
+            let mut walked = Vec::new();
+            g.for_surface_points([x0, x1], [y0, y1], |s| walked.push(s));
+            let mut asked = Vec::new();
+            for y in y0..=y1 {
+                for x in x0..=x1 {
+                    asked.extend(g.surface_point(x, y));
+                }
+            }
+            assert_eq!(walked, asked, "window {x0}..={x1} × {y0}..={y1}");
+            windows += (!asked.is_empty()) as usize;
+        }
+    }
+    assert!(windows >= 10, "windows with surface points: {windows}");
+}
+
+/// The likelihood field of one saturated wall cell is the Gaussian kernel
+/// around it (σ = 1 cell, radius 2, unit sum: `w(d) = exp(−d²/2) / Σ`,
+/// the value at offset (dx, dy) being `w(dx)·w(dy)`), cut off at the
+/// window's edge, and each coarse entry is the largest fine value of its
+/// 4 × 4 block forward.
+#[wasm_bindgen_test(unsupported = test)]
+fn the_likelihood_field_of_one_wall_cell_is_the_kernel() {
+    use slamlab::slam::likelihood::LikelihoodField;
+    let mut g = grid();
+    let p = DVec2::new(0.525, 0.275); // global cell (10, 5)
+    for _ in 0..6 {
+        g.integrate_beam(p - DVec2::new(0.01, 0.0), p, true);
+    }
+    let norm = 1.0 + 2.0 * ((-0.5f64).exp() + (-2.0f64).exp());
+    let w = |d: i64| {
+        if d.abs() > 2 {
+            0.0
+        } else {
+            (-0.5 * (d * d) as f64).exp() / norm
+        }
+    };
+    // A window whose left edge cuts the kernel: cells 9..=20 × 0..=11.
+    let f = LikelihoodField::build(&g, [9, 0], [20, 11], 4);
+    assert_eq!((f.width, f.height), (12, 12));
+    for y in 0..12i64 {
+        for x in 0..12i64 {
+            let (dx, dy) = (x + 9 - 10, y - 5);
+            let want = w(dx) * w(dy);
+            let got = f.fine_at(x, y) as f64;
+            assert!(
+                (got - want).abs() < 1e-6,
+                "({x}, {y}): {got} against {want}"
+            );
+        }
+    }
+    // Coarse: the block [x, x + 4) × [y, y + 4) holding the wall cell
+    // (window x 1, y 5) has its value; a block two cells off, w(2)·w(0).
+    let top = w(0) * w(0);
+    assert!((f.coarse_at(0, 2) as f64 - top).abs() < 1e-6);
+    assert!((f.coarse_at(3, 5) as f64 - w(2) * w(0)).abs() < 1e-6);
+    assert_eq!(f.coarse_at(6, 5), 0.0);
+    assert_eq!(f.coarse_at(0, 8), 0.0);
+}

@@ -46,6 +46,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 stored,
                 described.len()
             );
+            println!("fingerprint: {:016x}", fingerprint(sim));
         }
         println!("simulate (ms): {simulate:.0}");
         return Ok(());
@@ -68,4 +69,30 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     println!("timings (ms): {:?}", report.timings_ms);
     Ok(())
+}
+
+/// A hash (FNV-1a) of every robot's true and SLAM poses, step by step, and
+/// of both its maps' cells: two builds that print the same fingerprint ran
+/// the same simulation and SLAM bit for bit (a check for changes meant to
+/// be faster only).
+fn fingerprint(sim: &slamlab::sim::Simulation) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut eat = |bytes: &[u8]| {
+        for &b in bytes {
+            h = (h ^ b as u64).wrapping_mul(0x0100_0000_01b3);
+        }
+    };
+    for r in &sim.robots {
+        for p in r.log.truth.iter().chain(r.mapping.estimates()) {
+            for v in [p.x, p.y, p.theta] {
+                eat(&v.to_bits().to_le_bytes());
+            }
+        }
+        for map in [&r.mapping.slam_map, &r.mapping.odometry_map] {
+            let [ox, oy] = map.origin_cell();
+            eat(&[ox, oy, map.width() as i64, map.height() as i64].map(|v| v as u8));
+            eat(&map.raw_units().iter().map(|&u| u as u8).collect::<Vec<_>>());
+        }
+    }
+    h
 }

@@ -47,7 +47,7 @@ impl RangeScene<'_> {
     ) -> Option<RayHit> {
         let mut hit = match near {
             Some(walls) => self.world.cast_among(walls, origin, dir, max_range_m),
-            None => self.world.cast(origin, dir, max_range_m),
+            None => self.world.cast_range(origin, dir, max_range_m),
         };
         for s in self.obstacles {
             if let Some(t) = s.ray_hit(origin, dir) {

@@ -90,10 +90,10 @@ pub fn search(
     let (wd, ht) = (field.width as i64, field.height as i64);
     for t in -nt..=nt {
         let theta = prior.theta + t as f64 * cfg.angular_step_rad;
-        let pose = Pose2::new(prior.x, prior.y, theta);
+        let frame = Pose2::new(prior.x, prior.y, theta).frame();
         let mut all = true;
         for &p in points {
-            let c = field.cell_of(pose.transform_point(p));
+            let c = field.cell_of(frame.to_parent(p));
             all &= c[0] - w >= 0 && c[1] - w >= 0 && c[0] + w + k < wd && c[1] + w + k < ht;
             cells.push(c);
             index.push(c[1] * wd + c[0]);

@@ -82,7 +82,7 @@
 //! dropped (and counted in [`OccupancyGrid::dropped_updates`]), and the
 //! matcher keeps working on what is mapped.
 
-use super::surface_blocks::SurfaceBlocks;
+use super::surface_blocks::{slot, SurfaceBlocks, BLOCK};
 use crate::geom::Pose2;
 use crate::sensors::laser::beam_bearing;
 use crate::sensors::LaserScan;
@@ -271,6 +271,49 @@ impl OccupancyGrid {
             position: self.cell_centre(ix, iy) + offset * self.config.resolution_m,
             hits: s.hits,
         })
+    }
+
+    /// Calls `visit` with [`Self::surface_point`] of every local cell in
+    /// columns `x0..=x1` of rows `y0..=y1` (inside the grid) that has one,
+    /// row by row, left to right: the same points in the same order as
+    /// asking cell by cell, with one block lookup per row of a block
+    /// instead of one per cell (the matcher asks for 5 × 5 windows, a
+    /// fifth of a SLAM run's time).
+    #[inline]
+    pub fn for_surface_points(
+        &self,
+        [x0, x1]: [usize; 2],
+        [y0, y1]: [usize; 2],
+        mut visit: impl FnMut(SurfacePoint),
+    ) {
+        if self.width == 0 || self.height == 0 {
+            return;
+        }
+        let r = self.config.resolution_m;
+        let (x1, y1) = (x1.min(self.width - 1), y1.min(self.height - 1));
+        for y in y0..=y1 {
+            let row = &self.cells[y * self.width..(y + 1) * self.width];
+            let mut x = x0;
+            while x <= x1 {
+                // The last column of this block in the window.
+                let end = (x | (BLOCK - 1)).min(x1);
+                if let Some(block) = self.surface.block_of(x, y) {
+                    for (xx, &units) in row.iter().enumerate().take(end + 1).skip(x) {
+                        let s = block[slot(xx, y)];
+                        if s.hits == 0 || units <= 0 {
+                            continue;
+                        }
+                        let offset =
+                            DVec2::new(s.offset[0] as f64, s.offset[1] as f64) / SURFACE_SCALE;
+                        visit(SurfacePoint {
+                            position: self.cell_centre(xx, y) + offset * r,
+                            hits: s.hits,
+                        });
+                    }
+                }
+                x = end + 1;
+            }
+        }
     }
 
     /// Whether this grid keeps surface means.
@@ -618,9 +661,31 @@ impl OccupancyGrid {
                 was.saturating_add(miss).max(min)
             }
         };
+        // One branch-free pass the compiler vectorises, noting whether any
+        // wall cell turned free (and so loses its surface). When the
+        // clamp lies at or below one miss, a lowered value in
+        // `miss + 1 ..= 0` came from a cell above zero and nothing else
+        // does (a cell at or below zero lands at or below `miss`), so the
+        // rare cells to reset are found again from what was written.
+        if self.config.surface_points && min <= miss && miss < 0 {
+            let turned = |v: i8| (v > miss) & (v <= 0);
+            let any = run.iter_mut().fold(false, |any, v| {
+                *v = lowered(*v);
+                any | turned(*v)
+            });
+            if any {
+                for (k, &v) in run.iter().enumerate() {
+                    if turned(v) {
+                        if let Some(s) = self.surface.get_mut(x0 + k, y) {
+                            s.hits = 0;
+                        }
+                    }
+                }
+            }
+            return;
+        }
         // Does any wall cell of the run turn free (and so lose its surface)?
-        // Rarely: then cell by cell; else one branch-free pass the compiler
-        // vectorises.
+        // Rarely: then cell by cell; else one branch-free pass.
         let clears_surface = self.config.surface_points
             && run
                 .iter()

@@ -92,55 +92,34 @@ impl LikelihoodField {
         let wgt = BLUR.map(|w| w / norm);
         let mut rows = vec![0f32; width * height];
         for y in 0..height {
-            let r = &raw[y * width..(y + 1) * width];
-            let o = &mut rows[y * width..(y + 1) * width];
-            for x in 0..width {
-                let mut m = r[x] * wgt[0];
-                for (d, &w) in wgt.iter().enumerate().skip(1) {
-                    if x >= d {
-                        m += r[x - d] * w;
-                    }
-                    if x + d < width {
-                        m += r[x + d] * w;
-                    }
-                }
-                o[x] = m;
-            }
+            blur_row(
+                &raw[y * width..(y + 1) * width],
+                &mut rows[y * width..(y + 1) * width],
+                wgt,
+            );
         }
-        let mut fine = vec![0f32; width * height];
-        for y in 0..height {
-            for x in 0..width {
-                let mut m = rows[y * width + x] * wgt[0];
-                for (d, &w) in wgt.iter().enumerate().skip(1) {
-                    if y >= d {
-                        m += rows[(y - d) * width + x] * w;
-                    }
-                    if y + d < height {
-                        m += rows[(y + d) * width + x] * w;
-                    }
-                }
-                fine[y * width + x] = m;
-            }
-        }
+        let fine = blur_columns(&rows, width, height, wgt);
         // Coarse: forward block maxima over [x, x + k) then [y, y + k).
+        // The values are never NaN, so a comparison is `f32::max` (which
+        // wasm calls as a function, `fmaxf`, for its NaN rule).
         let k = k.max(1);
+        let larger = |a: f32, b: f32| if b > a { b } else { a };
         let mut cx = vec![0f32; width * height];
         for y in 0..height {
             for x in 0..width {
                 let end = (x + k).min(width);
                 cx[y * width + x] = fine[y * width + x..y * width + end]
                     .iter()
-                    .fold(0f32, |a, &b| a.max(b));
+                    .fold(0f32, |a, &b| larger(a, b));
             }
         }
         let mut coarse = vec![0f32; width * height];
         for y in 0..height {
-            for x in 0..width {
-                let mut m = 0f32;
-                for yy in y..(y + k).min(height) {
-                    m = m.max(cx[yy * width + x]);
+            let out = &mut coarse[y * width..(y + 1) * width];
+            for yy in y..(y + k).min(height) {
+                for (o, &c) in out.iter_mut().zip(&cx[yy * width..(yy + 1) * width]) {
+                    *o = larger(*o, c);
                 }
-                coarse[y * width + x] = m;
             }
         }
         LikelihoodField {
@@ -201,4 +180,68 @@ impl LikelihoodField {
         let dy = (1.0 - fx) * (m01 - m00) + fx * (m11 - m10);
         (value, DVec2::new(dx, dy) / self.resolution_m)
     }
+}
+
+/// One row of the blur: `out[x] = Σ_d w(|d|) · row[x + d]`, the terms
+/// added centre, then ±1, then ±2, those outside the row left out. Cells
+/// two or more from either end have every term, added in that same order
+/// without a test (a loop the compiler vectorises); the ends test.
+fn blur_row(row: &[f32], out: &mut [f32], wgt: [f32; 3]) {
+    let width = row.len();
+    let edge = |x: usize| {
+        let mut m = row[x] * wgt[0];
+        for (d, &w) in wgt.iter().enumerate().skip(1) {
+            if x >= d {
+                m += row[x - d] * w;
+            }
+            if x + d < width {
+                m += row[x + d] * w;
+            }
+        }
+        m
+    };
+    if width < 5 {
+        for (x, o) in out.iter_mut().enumerate() {
+            *o = edge(x);
+        }
+        return;
+    }
+    for x in [0, 1, width - 2, width - 1] {
+        out[x] = edge(x);
+    }
+    for (x, o) in out.iter_mut().enumerate().take(width - 2).skip(2) {
+        let mut m = row[x] * wgt[0];
+        m += row[x - 1] * wgt[1];
+        m += row[x + 1] * wgt[1];
+        m += row[x - 2] * wgt[2];
+        m += row[x + 2] * wgt[2];
+        *o = m;
+    }
+}
+
+/// The column pass of the blur over `rows` (`width` × `height`, row by
+/// row): the same sums as [`blur_row`] down each column, in the same
+/// order, computed a whole row at a time.
+fn blur_columns(rows: &[f32], width: usize, height: usize, wgt: [f32; 3]) -> Vec<f32> {
+    let mut fine = vec![0f32; width * height];
+    let row = |y: usize| &rows[y * width..(y + 1) * width];
+    for y in 0..height {
+        let out = &mut fine[y * width..(y + 1) * width];
+        for (o, &c) in out.iter_mut().zip(row(y)) {
+            *o = c * wgt[0];
+        }
+        for (d, &w) in wgt.iter().enumerate().skip(1) {
+            if y >= d {
+                for (o, &c) in out.iter_mut().zip(row(y - d)) {
+                    *o += c * w;
+                }
+            }
+            if y + d < height {
+                for (o, &c) in out.iter_mut().zip(row(y + d)) {
+                    *o += c * w;
+                }
+            }
+        }
+    }
+    fine
 }

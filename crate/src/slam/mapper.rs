@@ -353,8 +353,9 @@ fn coarse_search(
     // the rotation's sweep, plus a blur margin.
     let mut lo = DVec2::splat(f64::INFINITY);
     let mut hi = DVec2::splat(f64::NEG_INFINITY);
+    let frame = prior.frame();
     for &p in points {
-        let q = prior.transform_point(p);
+        let q = frame.to_parent(p);
         lo = lo.min(q);
         hi = hi.max(q);
     }

@@ -114,20 +114,21 @@ pub fn surface_centroid(map: &OccupancyGrid, q: DVec2, n: DVec2, radius: f64) ->
     let [ox, oy] = map.origin_cell();
     let (w, h) = (map.width() as i64, map.height() as i64);
     let (mut sum_w, mut sum) = (0.0, DVec2::ZERO);
-    for y in (gy - reach - oy).max(0)..=(gy + reach - oy).min(h - 1) {
-        for x in (gx - reach - ox).max(0)..=(gx + reach - ox).min(w - 1) {
-            let Some(s) = map.surface_point(x as usize, y as usize) else {
-                continue;
-            };
-            let d = s.position - q;
-            if n.dot(d).abs() > radius || t.dot(d).abs() > band {
-                continue;
-            }
-            let wt = s.hits as f64;
-            sum_w += wt;
-            sum += wt * s.position;
-        }
+    let (x0, x1) = ((gx - reach - ox).max(0), (gx + reach - ox).min(w - 1));
+    let (y0, y1) = ((gy - reach - oy).max(0), (gy + reach - oy).min(h - 1));
+    if x0 > x1 || y0 > y1 {
+        return None;
     }
+    let window = |a: i64, b: i64| [a as usize, b as usize];
+    map.for_surface_points(window(x0, x1), window(y0, y1), |s| {
+        let d = s.position - q;
+        if n.dot(d).abs() > radius || t.dot(d).abs() > band {
+            return;
+        }
+        let wt = s.hits as f64;
+        sum_w += wt;
+        sum += wt * s.position;
+    });
     (sum_w > 0.0).then(|| sum / sum_w)
 }
 
@@ -197,6 +198,9 @@ pub fn refine_to_surface(
     };
     // The normal equations and cost at `pose` with association `surface`.
     let evaluate = |pose: &Pose2, surface: &[Option<DVec2>]| {
+        // The pose's sine and cosine once, not once a point (the same
+        // numbers `transform_point` works out).
+        let frame = pose.frame();
         let (s, c) = pose.theta.sin_cos();
         let mut h = [[0.0; 3]; 3];
         let mut g = [0.0; 3];
@@ -210,7 +214,7 @@ pub fn refine_to_surface(
             };
             count += 1;
             let nw = DVec2::new(c * n.x - s * n.y, s * n.x + c * n.y);
-            let r = nw.dot(pose.transform_point(p) - *m);
+            let r = nw.dot(frame.to_parent(p) - *m);
             let (rho, w) = huber(r, k);
             cost += rho;
             let dq = DVec2::new(-s * p.x - c * p.y, c * p.x - s * p.y);

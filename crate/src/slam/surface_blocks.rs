@@ -25,6 +25,11 @@
 /// Cells on a side of a block (the grid's growth step is a multiple).
 pub const BLOCK: usize = 4;
 const CELLS: usize = BLOCK * BLOCK;
+/// Where local cell `(x, y)` lies in its block ([`SurfaceBlocks::block_of`]).
+#[inline]
+pub const fn slot(x: usize, y: usize) -> usize {
+    (y % BLOCK) * BLOCK + x % BLOCK
+}
 /// The index's mark of a block without cells.
 const NONE: u32 = u32::MAX;
 
@@ -53,10 +58,7 @@ impl SurfaceBlocks {
     /// Block `(bx, by)` of the index and the cell's place in it.
     #[inline]
     fn locate(&self, x: usize, y: usize) -> (usize, usize) {
-        (
-            (y / BLOCK) * self.cols + x / BLOCK,
-            (y % BLOCK) * BLOCK + x % BLOCK,
-        )
+        ((y / BLOCK) * self.cols + x / BLOCK, slot(x, y))
     }
 
     /// The surface of local cell `(x, y)`, if its block has cells.
@@ -66,6 +68,18 @@ impl SurfaceBlocks {
         match *self.index.get(b)? {
             NONE => None,
             p => Some(&self.pool[p as usize][c]),
+        }
+    }
+
+    /// The block holding local cell `(x, y)`, if it has cells; the cell is
+    /// its entry [`slot`]`(x, y)`. A walk along a row looks a block up
+    /// once for its (up to) [`BLOCK`] cells.
+    #[inline]
+    pub fn block_of(&self, x: usize, y: usize) -> Option<&[SurfaceCell; CELLS]> {
+        let (b, _) = self.locate(x, y);
+        match *self.index.get(b)? {
+            NONE => None,
+            p => Some(&self.pool[p as usize]),
         }
     }
 
