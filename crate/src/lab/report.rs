@@ -41,14 +41,6 @@ impl<'a> Rows<'a> {
             .zip(self.poses)
             .map(|(&t, p)| [r6(t), r6(p.x), r6(p.y), r6(p.theta)])
     }
-
-    pub fn len(&self) -> usize {
-        self.times.len().min(self.poses.len())
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
 }
 
 impl Serialize for Rows<'_> {
