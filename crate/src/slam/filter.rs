@@ -226,18 +226,19 @@ fn identity() -> Mat {
     m
 }
 
-fn mul(a: &Mat, b: &Mat) -> Mat {
-    let mut m = [[0.0; N]; N];
+/// `A B` of two square matrices (the filter's 5 × 5, the back end's 3 × 3).
+pub(super) fn mul<const K: usize>(a: &[[f64; K]; K], b: &[[f64; K]; K]) -> [[f64; K]; K] {
+    let mut m = [[0.0; K]; K];
     for (r, row) in m.iter_mut().enumerate() {
         for (c, v) in row.iter_mut().enumerate() {
-            *v = (0..N).map(|k| a[r][k] * b[k][c]).sum();
+            *v = (0..K).map(|k| a[r][k] * b[k][c]).sum();
         }
     }
     m
 }
 
-fn transpose(a: &Mat) -> Mat {
-    let mut m = [[0.0; N]; N];
+pub(super) fn transpose<const K: usize>(a: &[[f64; K]; K]) -> [[f64; K]; K] {
+    let mut m = [[0.0; K]; K];
     for (r, row) in a.iter().enumerate() {
         for (c, v) in row.iter().enumerate() {
             m[c][r] = *v;
@@ -247,10 +248,10 @@ fn transpose(a: &Mat) -> Mat {
 }
 
 /// `(A + Aᵀ) / 2`: keeps rounding from making the covariance asymmetric.
-fn symmetric(a: &Mat) -> Mat {
+pub(super) fn symmetric<const K: usize>(a: &[[f64; K]; K]) -> [[f64; K]; K] {
     let mut m = *a;
-    for r in 0..N {
-        for c in r + 1..N {
+    for r in 0..K {
+        for c in r + 1..K {
             let v = 0.5 * (a[r][c] + a[c][r]);
             m[r][c] = v;
             m[c][r] = v;

@@ -55,7 +55,7 @@
 //! over the distance between the keys and stiff across it; a stretch on
 //! odometry alone is loose in every direction.
 
-use super::filter::{inverse3, OdometryNoise};
+use super::filter::{inverse3, mul, symmetric, transpose, OdometryNoise};
 use super::match_covariance::edge_information;
 use crate::geom::{wrap_angle, Pose2};
 use glam::DVec2;
@@ -164,16 +164,6 @@ fn diagonal(m2: f64, rad2: f64) -> Mat3 {
     [[m2, 0.0, 0.0], [0.0, m2, 0.0], [0.0, 0.0, rad2]]
 }
 
-fn mul(a: &Mat3, b: &Mat3) -> Mat3 {
-    let mut m = [[0.0; 3]; 3];
-    for (r, row) in m.iter_mut().enumerate() {
-        for (c, v) in row.iter_mut().enumerate() {
-            *v = (0..3).map(|k| a[r][k] * b[k][c]).sum();
-        }
-    }
-    m
-}
-
 fn add(a: &Mat3, b: &Mat3) -> Mat3 {
     let mut m = *a;
     for (r, row) in m.iter_mut().enumerate() {
@@ -186,24 +176,7 @@ fn add(a: &Mat3, b: &Mat3) -> Mat3 {
 
 /// `J M Jᵀ`.
 fn sandwich(j: &Mat3, m: &Mat3) -> Mat3 {
-    let jt = [
-        [j[0][0], j[1][0], j[2][0]],
-        [j[0][1], j[1][1], j[2][1]],
-        [j[0][2], j[1][2], j[2][2]],
-    ];
-    mul(&mul(j, m), &jt)
-}
-
-fn symmetric(a: &Mat3) -> Mat3 {
-    let mut m = *a;
-    for r in 0..3 {
-        for c in r + 1..3 {
-            let v = 0.5 * (a[r][c] + a[c][r]);
-            m[r][c] = v;
-            m[c][r] = v;
-        }
-    }
-    m
+    mul(&mul(j, m), &transpose(j))
 }
 
 #[cfg(test)]
