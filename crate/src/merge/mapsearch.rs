@@ -98,7 +98,7 @@ use super::peaksearch::{best_translations, pyramid_of, MaxPyramid, ScoreImage};
 use super::verdict::{contradiction_reason, map_agreement, Agreement, VerdictConfig};
 use super::MergeStatus;
 use crate::geom::{wrap_angle, Pose2};
-use crate::slam::grid::{CellState, OccupancyGrid};
+use crate::slam::grid::{state_of, CellState, OccupancyGrid};
 use glam::DVec2;
 use std::f64::consts::FRAC_PI_2;
 
@@ -310,20 +310,7 @@ impl Raster {
     fn draw(grid: &OccupancyGrid, theta: f64, cell_m: f64, free_penalty: i32) -> Option<Raster> {
         let (s, c) = theta.sin_cos();
         let turn = |p: DVec2| DVec2::new(c * p.x - s * p.y, s * p.x + c * p.y);
-        let mut lo = DVec2::splat(f64::INFINITY);
-        let mut hi = DVec2::splat(f64::NEG_INFINITY);
-        for iy in 0..grid.height() {
-            for ix in 0..grid.width() {
-                if grid.state(ix, iy) != CellState::Unknown {
-                    let q = turn(grid.cell_centre(ix, iy));
-                    lo = lo.min(q);
-                    hi = hi.max(q);
-                }
-            }
-        }
-        if !lo.is_finite() {
-            return None;
-        }
+        let (lo, hi) = turned_bounds(grid, &turn)?;
         // One empty cell of margin on each side, for the neighbourhoods.
         let origin = [
             (lo.x / cell_m).floor() as i64 - 1,
@@ -333,19 +320,13 @@ impl Raster {
         let height = ((hi.y / cell_m).floor() as i64 - origin[1] + 2) as usize;
         // 0 unknown, 1 free, 2 wall (a wall anywhere in the cell wins).
         let mut state = vec![0u8; width * height];
+        let at = |q: DVec2| {
+            let x = ((q.x / cell_m).floor() as i64 - origin[0]) as usize;
+            let y = ((q.y / cell_m).floor() as i64 - origin[1]) as usize;
+            y * width + x
+        };
         for iy in 0..grid.height() {
-            for ix in 0..grid.width() {
-                let v = match grid.state(ix, iy) {
-                    CellState::Unknown => continue,
-                    CellState::Free => 1,
-                    CellState::Occupied => 2,
-                };
-                let q = turn(grid.cell_centre(ix, iy));
-                let x = ((q.x / cell_m).floor() as i64 - origin[0]) as usize;
-                let y = ((q.y / cell_m).floor() as i64 - origin[1]) as usize;
-                let k = y * width + x;
-                state[k] = state[k].max(v);
-            }
+            mark_row(grid, iy, &turn, &at, &mut state);
         }
         let mut score = vec![0i32; width * height];
         let mut walls = Vec::new();
@@ -381,12 +362,69 @@ impl Raster {
         })
     }
 
+    /// The raster as the branch and bound reads it.
+    fn image(&self) -> ScoreImage<'_> {
+        ScoreImage {
+            width: self.width,
+            height: self.height,
+            score: &self.score,
+            walls: &self.walls,
+        }
+    }
+
     /// The scores with both axes reversed (for the second half of the
     /// correlation).
     fn reversed_scores(&self) -> Vec<i32> {
         let mut out = self.score.clone();
         out.reverse();
         out
+    }
+}
+
+/// The box of `grid`'s known cell centres turned by `turn`, or `None`
+/// when no cell is known. Along a row each turned coordinate is monotonic
+/// in the column (every floating-point step from the column index to it —
+/// add, multiply by a constant, add a constant — is), so a row's extremes
+/// lie at its first and last known cells: two cells a row are turned
+/// instead of all of them, and the box is the same to the bit.
+fn turned_bounds(grid: &OccupancyGrid, turn: &impl Fn(DVec2) -> DVec2) -> Option<(DVec2, DVec2)> {
+    let known = |u: &i8| state_of(*u) != CellState::Unknown;
+    let w = grid.width();
+    let mut lo = DVec2::splat(f64::INFINITY);
+    let mut hi = DVec2::splat(f64::NEG_INFINITY);
+    for (iy, row) in grid.raw_units().chunks_exact(w.max(1)).enumerate() {
+        let (Some(first), Some(last)) = (row.iter().position(known), row.iter().rposition(known))
+        else {
+            continue;
+        };
+        for ix in [first, last] {
+            let q = turn(grid.cell_centre(ix, iy));
+            lo = lo.min(q);
+            hi = hi.max(q);
+        }
+    }
+    lo.is_finite().then_some((lo, hi))
+}
+
+/// Marks row `iy`'s known cells in the raster's states (`at` gives a
+/// turned centre's raster index); a wall wins over free. (A function per
+/// row: a wasm engine optimises a function after a few calls.)
+fn mark_row(
+    grid: &OccupancyGrid,
+    iy: usize,
+    turn: &impl Fn(DVec2) -> DVec2,
+    at: &impl Fn(DVec2) -> usize,
+    state: &mut [u8],
+) {
+    let w = grid.width();
+    for (ix, &u) in grid.raw_units()[iy * w..][..w].iter().enumerate() {
+        let v = match state_of(u) {
+            CellState::Unknown => continue,
+            CellState::Free => 1,
+            CellState::Occupied => 2,
+        };
+        let k = at(turn(grid.cell_centre(ix, iy)));
+        state[k] = state[k].max(v);
     }
 }
 
@@ -426,38 +464,56 @@ fn correlate(a: &Raster, b: &Raster) -> Correlation {
     Correlation { t0, nx, ny, acc }
 }
 
+/// A map prepared once for the coarse comparisons of many pairs
+/// ([`super::pairbudget`]): its wall spectrum and its raster at the
+/// coarse cell in its own axes (the part of [`coarse_overlap`] that does
+/// not depend on the other map).
+pub struct CoarseMap<'g> {
+    grid: &'g OccupancyGrid,
+    spectrum: WallSpectrum,
+    cell_m: f64,
+    raster: Option<Raster>,
+}
+
+impl<'g> CoarseMap<'g> {
+    /// `grid` drawn at `cell_m` (at least its own cell).
+    pub fn new(grid: &'g OccupancyGrid, cell_m: f64, free_penalty: i32) -> CoarseMap<'g> {
+        let cell_m = cell_m.max(grid.resolution_m());
+        CoarseMap {
+            grid,
+            spectrum: WallSpectrum::of(grid),
+            cell_m,
+            raster: Raster::draw(grid, 0.0, cell_m, free_penalty),
+        }
+    }
+}
+
 /// How well map B can lie on map A at all, from a coarse search: the
 /// rotation from the spectra, then the best translation of each of the
-/// four rotations at `cell_m` (steps 1 and 2 of the module doc, without
-/// refinement or verdict). Returns the best correlation score over the
-/// coarse wall cells of the smaller map, counted both ways (about 1 when
-/// one map's walls all lie on the other's, lower where they fall on
+/// four rotations at A's coarse cell (steps 1 and 2 of the module doc,
+/// without refinement or verdict). Returns the best correlation score over
+/// the coarse wall cells of the smaller map, counted both ways (about 1
+/// when one map's walls all lie on the other's, lower where they fall on
 /// unknown ground or in free space, 0 when nothing fits). A ranking figure
 /// for [`super::pairbudget`], never a reason to merge: a maze's lattice
-/// lays unrelated maps partly on each other too.
-pub fn coarse_overlap(
-    a: &OccupancyGrid,
-    b: &OccupancyGrid,
-    spectra: (&WallSpectrum, &WallSpectrum),
-    cell_m: f64,
-    free_penalty: i32,
-) -> f64 {
-    let Some(delta) = rotation_between(spectra.0, spectra.1) else {
+/// lays unrelated maps partly on each other too. (At this coarse cell the
+/// exhaustive correlation is cheaper than the branch and bound's bounds.)
+pub fn coarse_overlap(a: &CoarseMap, b: &CoarseMap, free_penalty: i32) -> f64 {
+    let Some(delta) = rotation_between(&a.spectrum, &b.spectrum) else {
         return 0.0;
     };
-    let cell = cell_m.max(a.resolution_m());
-    let Some(ra) = Raster::draw(a, 0.0, cell, free_penalty) else {
+    let Some(ra) = a.raster.as_ref() else {
         return 0.0;
     };
     let mut best = 0i64;
     let mut walls_b = 0;
     for k in 0..4 {
         let theta = wrap_angle(delta + k as f64 * FRAC_PI_2);
-        let Some(rb) = Raster::draw(b, theta, cell, free_penalty) else {
+        let Some(rb) = Raster::draw(b.grid, theta, a.cell_m, free_penalty) else {
             return 0.0;
         };
         walls_b = rb.walls.len();
-        let corr = correlate(&ra, &rb);
+        let corr = correlate(ra, &rb);
         best = best.max(corr.acc.iter().copied().max().unwrap_or(0) as i64);
     }
     let smaller = ra.walls.len().min(walls_b);
@@ -548,19 +604,11 @@ fn branch_and_bound(
     count: usize,
     apart: f64,
 ) -> Vec<([i64; 2], i32)> {
-    fn image(r: &Raster) -> ScoreImage<'_> {
-        ScoreImage {
-            width: r.width,
-            height: r.height,
-            score: &r.score,
-            walls: &r.walls,
-        }
-    }
     let t0 = translation_origin(a, b);
     let found = a_max
-        .get_or_insert_with(|| pyramid_of(&image(a)))
+        .get_or_insert_with(|| pyramid_of(&a.image()))
         .as_mut()
-        .and_then(|m| best_translations(image(a), m, image(b), count, apart));
+        .and_then(|m| best_translations(a.image(), m, b.image(), count, apart));
     match found {
         Some(peaks) => peaks
             .into_iter()

@@ -52,7 +52,7 @@
 //! Nothing here reads the truth; everything is deterministic (ties go to
 //! the lower robot index).
 
-use super::mapsearch::{coarse_overlap, WallSpectrum};
+use super::mapsearch::{coarse_overlap, CoarseMap};
 use super::vocabulary::{inverted_file, word_count, Bag};
 use crate::slam::OccupancyGrid;
 use serde::Serialize;
@@ -176,17 +176,14 @@ fn best_of_others(scores: &[f64], owner: &[usize], me: usize, k: usize) -> Vec<u
 /// doc): `out[a][b]`, symmetric (computed for `a < b`), 0 on the diagonal.
 pub fn map_overlaps(maps: &[&OccupancyGrid], cfg: &PairBudgetConfig) -> Vec<Vec<f64>> {
     let n = maps.len();
-    let spectra: Vec<WallSpectrum> = maps.iter().map(|m| WallSpectrum::of(m)).collect();
+    let coarse: Vec<CoarseMap> = maps
+        .iter()
+        .map(|m| CoarseMap::new(m, cfg.coarse_cell_m, cfg.free_penalty))
+        .collect();
     let mut out = vec![vec![0.0; n]; n];
     for a in 0..n {
         for b in a + 1..n {
-            let s = coarse_overlap(
-                maps[a],
-                maps[b],
-                (&spectra[a], &spectra[b]),
-                cfg.coarse_cell_m,
-                cfg.free_penalty,
-            );
+            let s = coarse_overlap(&coarse[a], &coarse[b], cfg.free_penalty);
             out[a][b] = s;
             out[b][a] = s;
         }
