@@ -44,9 +44,11 @@ fn check(name: &str, o: &Outcome, max_m: f64, max_deg: f64, share: f64) {
 #[test]
 fn mit_csail_raw_log_against_gmapping() {
     let (o, recorded) = support::csail_raw();
-    // Measured: 0.432 m / 1.00 deg against odometry's 6.628 m / 18.80 deg
-    // (the 0.10 m / 1 deg is not met on this log: see BENCHMARKS.md).
-    check("mit-csail.clf.gz", &o, 0.45, 1.05, 0.25);
+    // Measured: 0.222 m / 1.03 deg against odometry's 6.628 m / 18.80 deg
+    // (0.432 m / 1.00 deg before session 17 refused closures on the search
+    // window's edge; the 0.10 m / 1 deg is not met on
+    // this log: see BENCHMARKS.md).
+    check("mit-csail.clf.gz", &o, 0.24, 1.08, 0.25);
     assert!(o.closures > 0, "the CSAIL tour revisits corridors");
     println!("recorded {recorded:.0} s, replayed in {:.1} s", o.seconds);
 }

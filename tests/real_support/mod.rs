@@ -206,6 +206,15 @@ pub fn config_from_env() -> LogSlamConfig {
             "response_half_m" => cfg.response.half_m = v,
             "response_half_deg" => cfg.response.half_rad = v.to_radians(),
             "response_drop" => cfg.response.drop = v,
+            "chain_keys" => cfg.chain_keys = v as usize,
+            "chain_min_score" => cfg.chain_min_score = v,
+            "loop_visits" => cfg.loop_visits = v as usize,
+            "loop_edge_reject" => cfg.loop_edge_reject = v != 0.0,
+            "loop_radius_m" => cfg.loops.search_radius_m = v,
+            "loop_submap_half" => cfg.loops.submap_half = v as usize,
+            "loop_window_m" => cfg.loops.window.linear_m = v,
+            "loop_window_deg" => cfg.loops.window.angular_rad = v.to_radians(),
+            "confirm_keys" => cfg.confirm_keys = v as usize,
             _ => panic!("SLAMLAB_LOG_SLAM: unknown setting {key}"),
         }
     }

@@ -31,8 +31,23 @@
 //!    off by default). Other scans are stored relative
 //!    to their key, so they follow it when the graph moves.
 //! 4. **Loop closures** ([`super::loop_closure`]): every `loop_every` keys
-//!    the new key is matched against older keys near its estimate.
-//! 5. **Consistency**: a single match can be wrong (two alike corridors).
+//!    the new key is matched against older keys near its estimate (with
+//!    `loop_visits` > 1, against the nearest key of each of that many
+//!    earlier passes through the place, the best match kept). A closure
+//!    whose match lies on the edge of its search window is refused
+//!    (`loop_edge_reject`), as the local match widens its window in that
+//!    case: the best pose inside a window is only a peak of the response if
+//!    it lies inside, and a match pressed against the window's border is
+//!    often a wrong place that merely fits better than the right one within
+//!    reach (on the raw MIT CSAIL log the four closures so refused include
+//!    the two that slid 1.8–1.9 m along a corridor; its relation error went
+//!    from 0.43 to 0.22 m, BENCHMARKS.md).
+//! 5. **Chain of recent keys** (Karto's scan-to-scan links, off unless
+//!    `chain_keys` > 0): the new key's scan is also matched against each of
+//!    the `chain_keys` keys before the previous one, alone, and every match
+//!    scoring `chain_min_score` becomes a key edge. Those redundant
+//!    stretches stiffen the front end where a closure pulls on it.
+//! 6. **Consistency**: a single match can be wrong (two alike corridors).
 //!    Following Olson's pairwise consistency idea ("Recognizing places using
 //!    spectrally clustered local matches", RAS 2009), a closure is only
 //!    accepted once a second closure found within `confirm_keys` keys
@@ -41,14 +56,17 @@
 //!    stretches (each locally accurate), must compose to nearly the
 //!    identity. Accepted closures go into the graph, which is optimised; an
 //!    optimisation that leaves a closure badly unsatisfied (χ² over
-//!    `max_closure_chi2`) is undone.
+//!    `max_closure_chi2`) is undone. (Re-checking every accepted closure's
+//!    χ² after later optimisations was tried and finds nothing to drop:
+//!    with key edges of σ 0.1 m the graph absorbs each closure, wrong ones
+//!    included, to χ² < 1.)
 //!
 //! The poses are in the log's odometry frame: the first scan's pose is its
 //! odometry pose, and the graph's first node stays fixed there.
 
 use super::grid::{GridConfig, OccupancyGrid};
 use super::likelihood::LikelihoodField;
-use super::loop_closure::{closures_agree, find_closure, Closure, LoopConfig};
+use super::loop_closure::{closures_agree, find_closure_among, Closure, LoopConfig};
 use super::match_covariance::{edge_information, response_covariance, ResponseWindow};
 use super::multires::{field_from_points, match_scan, ScanMatch, Window};
 use super::posegraph::{Edge, PoseGraph};
@@ -114,6 +132,18 @@ pub struct LogSlamConfig {
     pub key_covariance_position_only: bool,
     /// Where the response is sampled for those covariances.
     pub response: ResponseWindow,
+    /// Scan-to-scan edges from each new key to this many keys before the
+    /// previous one (Karto's chain of recent scans; 0: off).
+    pub chain_keys: usize,
+    /// Least score of such a scan-to-scan match.
+    pub chain_min_score: f64,
+    /// Closure candidates: the nearest key of up to this many earlier
+    /// visits to the place ([`super::loop_closure::find_closure_among`]).
+    pub loop_visits: usize,
+    /// Refuse a closure whose match lies on the edge of the closure search
+    /// window (the best pose inside the window is then not a peak of the
+    /// response: the true one may lie outside, as for the local match).
+    pub loop_edge_reject: bool,
 }
 
 impl Default for LogSlamConfig {
@@ -156,6 +186,10 @@ impl Default for LogSlamConfig {
                 half_rad: 3f64.to_radians(),
                 drop: 0.1,
             },
+            chain_keys: 0,
+            chain_min_score: 0.5,
+            loop_visits: 1,
+            loop_edge_reject: true,
         }
     }
 }
@@ -195,6 +229,10 @@ pub struct LogSlamStats {
     pub closures_tried: usize,
     pub closures_found: usize,
     pub closures_rejected: usize,
+    /// Scan-to-scan edges to earlier keys (`chain_keys`).
+    pub chain_edges: usize,
+    /// Closures refused for lying on the search window's edge.
+    pub closures_on_edge: usize,
 }
 
 /// The SLAM state of one log replay.
@@ -407,6 +445,9 @@ impl LogSlam {
                 edge.information = info;
             }
             self.graph.edges.push(edge);
+            if !self.unmatched_since_key {
+                self.chain_edges(id, &points);
+            }
         }
         self.unmatched_since_key = false;
         self.key_points.push(points);
@@ -423,6 +464,31 @@ impl LogSlam {
             self.try_close(id);
         }
         self.rebuild_local();
+    }
+
+    /// Scan-to-scan edges from key `id` (its scan `points`) to the
+    /// `chain_keys` keys before the previous one: the new scan matched
+    /// against each old key's scan alone, in the narrow window around the
+    /// new key's estimate.
+    fn chain_edges(&mut self, id: usize, points: &[DVec2]) {
+        let cfg = &self.config;
+        let from = id.saturating_sub(cfg.chain_keys + 1);
+        let pose = self.graph.nodes[id];
+        for j in from..id.saturating_sub(1) {
+            let f = self.graph.nodes[j].frame();
+            let world: Vec<DVec2> = self.key_points[j].iter().map(|&p| f.to_parent(p)).collect();
+            let field = field_from_points(&world, cfg.resolution_m, 4, cfg.narrow.linear_m + 1.0);
+            let Some(m) = match_scan(&field, points, &pose, &cfg.narrow) else {
+                continue;
+            };
+            if m.score < cfg.chain_min_score {
+                continue;
+            }
+            let z = self.graph.nodes[j].between(&m.pose);
+            let edge = Edge::new(j, id, z, cfg.key_sigma_m, cfg.key_sigma_rad);
+            self.graph.edges.push(edge);
+            self.stats.chain_edges += 1;
+        }
     }
 
     /// Rasterises the last `local_keys` key scans into the local map.
@@ -446,17 +512,22 @@ impl LogSlam {
     /// two agree.
     fn try_close(&mut self, id: usize) {
         self.stats.closures_tried += 1;
-        let Some(found) = find_closure(
+        let Some(found) = find_closure_among(
             &self.graph.nodes,
             &self.key_points,
             id,
             self.config.resolution_m,
             &self.config.loops,
             Some(&self.config.response).filter(|_| self.config.loop_covariance),
+            self.config.loop_visits,
         ) else {
             return;
         };
         self.stats.closures_found += 1;
+        if self.config.loop_edge_reject && self.on_window_edge(&found) {
+            self.stats.closures_on_edge += 1;
+            return;
+        }
         let cfg = &self.config;
         self.pending
             .retain(|c| c.edge.to + cfg.confirm_keys >= id && c.edge.to != id);
@@ -476,6 +547,19 @@ impl LogSlam {
             }
             None => self.pending.push(found),
         }
+    }
+
+    /// Whether closure `c`'s match lies on the edge of the search window
+    /// (a world-frame box and heading range around the new key's estimate).
+    fn on_window_edge(&self, c: &Closure) -> bool {
+        let (w, res) = (&self.config.loops.window, self.config.resolution_m);
+        let nodes = &self.graph.nodes;
+        let found = nodes[c.edge.from].compose(&c.edge.measurement);
+        let here = &nodes[c.edge.to];
+        let d = found.position() - here.position();
+        d.x.abs() > w.linear_m - 2.0 * res
+            || d.y.abs() > w.linear_m - 2.0 * res
+            || wrap_angle(found.theta - here.theta).abs() > w.angular_rad - 0.5f64.to_radians()
     }
 
     /// Adds confirmed closures, optimises, and undoes it all if a closure

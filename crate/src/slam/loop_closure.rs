@@ -15,7 +15,12 @@
 //! 1. **Candidates**: key scans older than the local map (at least
 //!    `min_key_gap` keys back) whose estimated position lies within
 //!    `search_radius_m` of the new key scan's. The nearest one is the centre
-//!    of the candidate region.
+//!    of the candidate region ([`find_closure`]). A place passed several
+//!    times offers one candidate region per pass: [`find_closure_among`]
+//!    splits the candidates into visits (runs of consecutive keys), takes
+//!    each visit's nearest key as a centre, and keeps the best-scoring match
+//!    of the nearest few — an older pass may see the walls the nearest one
+//!    missed.
 //! 2. **Match**: the key scans around that centre (`submap_half` either side,
 //!    consecutive, so they are consistent among themselves) are rasterised
 //!    into Olson's tables ([`super::multires`]), and the new scan is searched
@@ -81,14 +86,70 @@ pub fn find_closure(
     cfg: &LoopConfig,
     response: Option<&ResponseWindow>,
 ) -> Option<Closure> {
+    let centre = *visit_centres(nodes, i, cfg).first()?;
+    match_closure(nodes, key_points, i, centre, resolution_m, cfg, response)
+}
+
+/// [`find_closure`] against up to `visits` earlier passes through the
+/// place, not only the nearest: the candidate keys within the radius are
+/// split into visits (runs of keys, a new one after a gap of more than
+/// `2 · submap_half` keys), each visit's nearest key is a centre, and the
+/// best-scoring match of the `visits` nearest centres is returned.
+pub fn find_closure_among(
+    nodes: &[Pose2],
+    key_points: &[Vec<DVec2>],
+    i: usize,
+    resolution_m: f64,
+    cfg: &LoopConfig,
+    response: Option<&ResponseWindow>,
+    visits: usize,
+) -> Option<Closure> {
+    visit_centres(nodes, i, cfg)
+        .into_iter()
+        .take(visits.max(1))
+        .filter_map(|c| match_closure(nodes, key_points, i, c, resolution_m, cfg, response))
+        .max_by(|a, b| a.score.total_cmp(&b.score))
+}
+
+/// The nearest key of each visit to key `i`'s place (see
+/// [`find_closure_among`]), nearest first.
+fn visit_centres(nodes: &[Pose2], i: usize, cfg: &LoopConfig) -> Vec<usize> {
     if i < cfg.min_key_gap {
-        return None;
+        return Vec::new();
     }
     let here = nodes[i].position();
-    let (centre, _) = (0..=i - cfg.min_key_gap)
+    let near: Vec<(usize, f64)> = (0..=i - cfg.min_key_gap)
         .map(|j| (j, nodes[j].position().distance(here)))
         .filter(|&(_, d)| d <= cfg.search_radius_m)
-        .min_by(|a, b| a.1.total_cmp(&b.1))?;
+        .collect();
+    let mut centres: Vec<(usize, f64)> = Vec::new();
+    let mut last: Option<usize> = None;
+    for &(j, d) in &near {
+        let new_visit = last.is_none_or(|l| j - l > 2 * cfg.submap_half);
+        match centres.last_mut() {
+            Some(c) if !new_visit => {
+                if d < c.1 {
+                    *c = (j, d);
+                }
+            }
+            _ => centres.push((j, d)),
+        }
+        last = Some(j);
+    }
+    centres.sort_by(|a, b| a.1.total_cmp(&b.1));
+    centres.into_iter().map(|c| c.0).collect()
+}
+
+/// Matches key `i` against the key scans around `centre`.
+fn match_closure(
+    nodes: &[Pose2],
+    key_points: &[Vec<DVec2>],
+    i: usize,
+    centre: usize,
+    resolution_m: f64,
+    cfg: &LoopConfig,
+    response: Option<&ResponseWindow>,
+) -> Option<Closure> {
     let lo = centre.saturating_sub(cfg.submap_half);
     let hi = (centre + cfg.submap_half).min(i - cfg.min_key_gap);
     let mut world = Vec::new();
