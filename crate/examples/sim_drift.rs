@@ -2,7 +2,7 @@
 //! against the truth over time, with what the matcher said.
 //!
 //! ```sh
-//! cargo run --release -p slamlab --example sim_drift -- SCENARIO.json robot5 [robot15 …] [--every 60] [--until 3600] [--graph|--no-graph]
+//! cargo run --release -p slamlab --example sim_drift -- SCENARIO.json robot5 [robot15 …] [--every 60] [--until 3600] [--graph|--no-graph] [--probe]
 //! ```
 //!
 //! The simulation runs with its own mappers off and the named robots' mappers
@@ -14,6 +14,14 @@
 //! loop closures accepted so far, and whether the map grid refused to grow.
 //! `--graph` / `--no-graph` run the filter with or without the loop-closing back end
 //! ([`slamlab::slam::robot_graph`]); without either, as `SlamConfig::back_end` says.
+//!
+//! `--probe` (with `--graph`, and `GRAPH_NO_LOOPS=1` to keep the key poses
+//! the front end's own) measures, at the end, how good a key edge could be:
+//! the front end's relative pose between keys 1 to 600 apart against the
+//! truth's (signed mean and rms: does it drift, or jitter?), and for keys
+//! 1 to 10 apart that still overlap, a direct scan-to-scan match of the
+//! two key scans ([`slamlab::slam::robot_graph::RobotGraph::match_keys`])
+//! beside the front end's answer.
 
 use slamlab::geom::{wrap_angle, Pose2};
 use slamlab::scenario::Scenario;
@@ -31,18 +39,20 @@ struct Traced {
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let path = args.first().ok_or(
-        "usage: sim_drift SCENARIO.json ROBOT… [--every S] [--until S] [--graph|--no-graph]",
+        "usage: sim_drift SCENARIO.json ROBOT… [--every S] [--until S] [--graph|--no-graph] [--probe]",
     )?;
     let mut scenario =
         Scenario::parse(&std::fs::read_to_string(path)?).map_err(|e| format!("{e:?}"))?;
     let (mut every_s, mut names, mut back_end): (f64, Vec<String>, bool) =
         (60.0, Vec::new(), SlamConfig::default().back_end);
+    let mut probe = false;
     let mut it = args[1..].iter();
     while let Some(a) = it.next() {
         match a.as_str() {
             "--every" => every_s = it.next().ok_or("--every S")?.parse()?,
             "--graph" => back_end = true,
             "--no-graph" => back_end = false,
+            "--probe" => probe = true,
             "--until" => scenario.duration_s = it.next().ok_or("--until S")?.parse()?,
             name => names.push(name.to_string()),
         }
@@ -124,6 +134,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             profile.join(" ")
         );
         print_edge_errors(r, &t.mapping);
+        if probe {
+            print_front_spans(r, &t.mapping);
+            print_key_matches(r, &t.mapping);
+        }
         println!(
             "{}: ATE slam {:.3} m, odometry {:.3} m, path {:.0} m, counts {:?}, back end {:?}",
             r.spec.name,
@@ -185,6 +199,97 @@ fn print_edge_errors(r: &slamlab::sim::RobotSim, mapping: &RobotMapping) {
         (sums[1] / n).sqrt(),
         (sums[2] / n).sqrt().to_degrees()
     );
+}
+
+/// For keys `m` apart: the rms heading and position error against the
+/// truth of the front end's relative pose and of a scan-to-scan match of
+/// the two keys ([`slamlab::slam::robot_graph::RobotGraph::match_keys`]),
+/// over the pairs that overlap.
+fn print_key_matches(r: &slamlab::sim::RobotSim, mapping: &RobotMapping) {
+    let Some(g) = &mapping.graph else {
+        return;
+    };
+    let (est, truth, steps) = (mapping.estimates(), &r.log.truth, g.key_steps());
+    let res = mapping.slam_map.resolution_m();
+    for (m, half) in [
+        (1, 0),
+        (2, 0),
+        (3, 0),
+        (5, 0),
+        (10, 0),
+        (3, 2),
+        (5, 2),
+        (10, 3),
+    ] {
+        let (mut n, mut front, mut scan, mut front_m, mut scan_m) = (0usize, 0.0, 0.0, 0.0, 0.0);
+        let mut tried = 0usize;
+        let mut mean_s = [0.0f64; 3];
+        for i in m..steps.len() {
+            tried += 1;
+            let Some(k) = g.match_keys(i - m, half, i, res) else {
+                continue;
+            };
+            let t = truth[steps[i - m]].between(&truth[steps[i]]);
+            let z = est[steps[i - m]].between(&est[steps[i]]);
+            let (ef, es) = (t.between(&z), t.between(&k.relative));
+            front += wrap_angle(ef.theta).powi(2);
+            scan += wrap_angle(es.theta).powi(2);
+            front_m += ef.position().length_squared();
+            scan_m += es.position().length_squared();
+            mean_s[0] += es.x;
+            mean_s[1] += es.y;
+            mean_s[2] += wrap_angle(es.theta).to_degrees();
+            n += 1;
+        }
+        let d = n.max(1) as f64;
+        println!(
+            "{} keys {m} apart (onto {} keys): {n}/{tried} overlap; heading rms front end {:.4}°, scan-to-scan {:.4}°; position rms {:.4} m, {:.4} m",
+            r.spec.name,
+            2 * half + 1,
+            (front / d).sqrt().to_degrees(),
+            (scan / d).sqrt().to_degrees(),
+            (front_m / d).sqrt(),
+            (scan_m / d).sqrt()
+        );
+        println!(
+            "   scan-to-scan mean error {:+.4} {:+.4} m {:+.4}°",
+            mean_s[0] / d,
+            mean_s[1] / d,
+            mean_s[2] / d
+        );
+    }
+}
+
+/// The front end's relative pose error against the truth between keys
+/// `m` apart, for spans up to a lap: signed mean and rms, in the older
+/// key's frame (along, across, heading).
+fn print_front_spans(r: &slamlab::sim::RobotSim, mapping: &RobotMapping) {
+    let Some(g) = &mapping.graph else {
+        return;
+    };
+    let (est, truth, steps) = (mapping.estimates(), &r.log.truth, g.key_steps());
+    for m in [1, 10, 50, 150, 300, 600] {
+        let (mut mean, mut sq, mut n) = ([0.0; 3], [0.0; 3], 0f64);
+        for i in m..steps.len() {
+            let t = truth[steps[i - m]].between(&truth[steps[i]]);
+            let z = est[steps[i - m]].between(&est[steps[i]]);
+            let e = t.between(&z);
+            for (k, v) in [e.x, e.y, wrap_angle(e.theta).to_degrees()]
+                .into_iter()
+                .enumerate()
+            {
+                mean[k] += v;
+                sq[k] += v * v;
+            }
+            n += 1.0;
+        }
+        let rms = sq.map(|v| (v / n.max(1.0)).sqrt());
+        let mean = mean.map(|v| v / n.max(1.0));
+        println!(
+            "{} front end {m} keys: mean x {:+.4} y {:+.4} m θ {:+.4}°; rms {:.4} {:.4} m {:.4}°",
+            r.spec.name, mean[0], mean[1], mean[2], rms[0], rms[1], rms[2]
+        );
+    }
 }
 
 fn print_row(sim: &Simulation, t: &mut Traced, truth: &Pose2, odometry: &Pose2, err: f64) {

@@ -74,22 +74,53 @@
 //! these by a few centimetres either way. The refined closures are right to
 //! 0.1° (the search's alone were off by up to 0.44°), each lap's first
 //! closure snaps the pose back to within 2 cm, and yet the middle of the
-//! lap stays 0.2–0.8 m off. Why: measured against the truth, the front
-//! end's relative pose between consecutive keys is off by 2 mm along, 2 mm
-//! across and **0.08° in heading** (rms, every robot). That is a random
-//! walk in heading, √600 keys × 0.08° ≈ 2° per lap, the drift observed, and
-//! it bends the lap's map as a whole. One closure per lap measures the
-//! walk's end, not its path: the best any weighting can do is the mean of
-//! the paths that end there (a Brownian bridge), which leaves about half the
-//! walk's spread mid-lap — a weighting cannot recover what no edge
-//! measured. The single-robot runs of the same maze confirm it: robot 16
-//! alone drifts with a steady heading (0.898 → 0.051 m, the test
-//! `tests/slam_back_end.rs`), robot 7 alone meanders (0.62 → 0.54 m).
-//! Presets and exercises (`SLAM_BACK_END=1 … slam_trace -- all`) are
-//! unchanged to the millimetre. Helping every robot needs more than the
-//! back end has: a front end whose heading wanders less per key, or
-//! constraints from other robots' maps. Until then `SlamConfig::back_end`
-//! is `false`; `sim_drift --graph` runs it.
+//! lap stays 0.2–0.8 m off.
+//!
+//! Why, measured against the truth (`sim_drift --graph --probe` with
+//! `GRAPH_NO_LOOPS=1`, the front end's own key poses, rms over the five
+//! robots' hour): the front end's relative pose between keys `m` apart is
+//! off in heading by
+//!
+//! | keys apart | 1 | 10 | 50 | 150 | 300 | 600 |
+//! |---|---|---|---|---|---|---|
+//! | heading error rms | 0.09–0.10° | 0.19–0.28° | 0.23–0.43° | 0.25–0.45° | 0.23–0.66° | 0.26–0.90° |
+//! | position error rms | 3–4 mm | 0.9–1.4 cm | 3–5 cm | 7–17 cm | 11–28 cm | 18–65 cm |
+//!
+//! with a signed mean near zero: not a bias, and not a random walk of
+//! independent key steps either (that would give √600 × 0.09° ≈ 2.2° over
+//! 600 keys). Much of a key's heading error is jitter that later keys
+//! take back; what accumulates is a slow meander of a few tenths of a
+//! degree over a lap. One closure per lap measures where it ended, not its
+//! path; least squares then bends the lap as the chain's covariance says
+//! (a Brownian bridge), which leaves the meander's spread mid-lap — and for
+//! robot 7, whose error rose early and then stayed, bends the middle of
+//! the lap further off than the filter alone had it (0.75 m at 900 s against
+//! 0.48 m). Later laps are matched against the map of the first, so the
+//! corrected trajectory repeats the first lap's error every lap (robot 5 at
+//! 300 s intervals: 0.03 0.19 0.26 0.16 0.01 | 0.04 0.19 0.27 0.16 0.02).
+//!
+//! ## Scan-to-scan key edges: measured, not added
+//! Karto's "chain of recent scans" links each key to the previous keys its
+//! laser still overlaps by matching the scans directly. [`RobotGraph::match_keys`]
+//! refines a key's scan onto the surfaces of an older key's scan alone (or
+//! of a few keys around it) from the front end's relative pose; against the
+//! truth (same run, rms heading error; the front end's in brackets):
+//!
+//! | keys apart (matched onto) | 1 (1) | 2 (1) | 3 (1) | 5 (1) | 10 (1) | 3 (5) | 5 (5) | 10 (7) |
+//! |---|---|---|---|---|---|---|---|---|
+//! | all five robots, hour | 0.11–0.12° (0.08–0.10°) | 0.12–0.13° (0.10–0.13°) | 0.13–0.15° (0.10–0.15°) | 0.15–0.17° (0.11–0.13°) | 0.21–0.22° (0.10–0.15°) | — | — | — |
+//! | robots 7, 15, first 900 s | 0.10° (0.07–0.08°) | 0.11–0.12° (0.07–0.08°) | 0.12–0.13° (0.07–0.08°) | 0.15° (0.08–0.09°) | 0.21–0.22° (0.08–0.11°) | 0.10° (0.08°) | 0.11–0.12° (0.08–0.09°) | 0.14° (0.08–0.09°) |
+//!
+//! and 1–1.4 cm in position against the front end's 2–7 mm. A single scan's
+//! surfaces carry its laser noise (1 cm, a hit or two a cell) where the
+//! front end's map averages hundreds of scans, so the direct match is
+//! *worse* than the chain it would constrain, at every span where the scans
+//! still overlap (beyond 5 keys, 0.4 m apart, fewer than half the pairs
+//! do): such edges cannot straighten the meander, and are not added.
+//! Helping every robot needs information the robot's own scans do not
+//! hold about the first lap's shape (other robots' maps), or a front end
+//! whose later laps are not locked to the first lap's map. Until then
+//! `SlamConfig::back_end` is `false`; `sim_drift --graph` runs it.
 
 use super::degeneracy::{constraint_of, scan_normals};
 use super::filter::OdometryNoise;
@@ -280,6 +311,16 @@ pub struct ClosureRecord {
     pub to_step: usize,
     pub measurement: Pose2,
     pub score: f64,
+}
+
+/// A scan-to-scan match of two keys ([`RobotGraph::match_keys`]): the
+/// newer key's pose in the older key's frame, the refinement's information
+/// `Σ w JᵀJ` (unit residual variance) and how many points found a surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KeyMatch {
+    pub relative: Pose2,
+    pub information: [[f64; 3]; 3],
+    pub count: usize,
 }
 
 /// What the front end hands the back end after each integrated scan, and
@@ -591,6 +632,43 @@ impl RobotGraph {
     fn rebuild(&self, config: GridConfig) -> OccupancyGrid {
         OccupancyGrid::drawn_at(config, self.graph.nodes.iter().copied(), |map, k, pose| {
             map.integrate_scan(pose, &self.keys[k].unpack())
+        })
+    }
+
+    /// Refines key `newer`'s scan onto the surfaces of the scans of keys
+    /// `older − half ..= older + half` (those before `newer`), drawn at
+    /// their poses relative to key `older`, starting from the graph's
+    /// relative pose: with `half = 0` a scan-to-scan match, no map in
+    /// between; wider, a small submap whose surfaces average several scans'
+    /// noise. `None` when fewer than half of the newer scan's points find a
+    /// surface (the scans hardly overlap).
+    pub fn match_keys(
+        &self,
+        older: usize,
+        half: usize,
+        newer: usize,
+        resolution_m: f64,
+    ) -> Option<KeyMatch> {
+        let config = GridConfig {
+            resolution_m,
+            surface_points: true,
+            ..GridConfig::default()
+        };
+        let anchor = self.graph.nodes[older];
+        let (lo, hi) = (older.saturating_sub(half), (older + half).min(newer - 1));
+        let poses = self.graph.nodes[lo..=hi].iter().map(|p| anchor.between(p));
+        let map = OccupancyGrid::drawn_at(config, poses, |m, k, pose| {
+            m.integrate_scan(pose, &self.keys[lo + k].unpack())
+        });
+        let start = anchor.between(&self.graph.nodes[newer]);
+        let points = self.keys[newer].points();
+        let normals = scan_normals(&points);
+        let r = refine_to_surface(&map, &points, &normals, &start, &RefineConfig::default());
+        let with_normal = normals.iter().filter(|n| n.is_some()).count();
+        (r.count * 2 >= with_normal && r.count >= 10 && r.pose.is_finite()).then_some(KeyMatch {
+            relative: r.pose,
+            information: r.information,
+            count: r.count,
         })
     }
 
