@@ -16,7 +16,8 @@
 // every block is brought up to date when the run pauses, steps or ends.
 //
 // A thumbnail is drawn only once it is on screen (scrolled into its strip's
-// view), a few a frame: rendering one costs 0.1 ms where the wall textures
+// view; the newest, which a strip at its end scrolls on to show, at once),
+// the others a few a frame: rendering one costs 0.1 ms where the wall textures
 // it shows are cached and up to tens of milliseconds where they are not
 // (crate/src/camera/texture.rs paints them on first use), and at 20× with
 // 16 robots the strips on screen gained 80 frames a second, drawn at once
@@ -287,15 +288,18 @@ export class CameraPanel {
     const tw = Math.min(THUMB_W, this.camera.width);
     const th = Math.max(1, Math.round((tw * this.camera.height) / this.camera.width));
     const atEnd = b.strip.scrollLeft + b.strip.clientWidth >= b.strip.scrollWidth - 4;
-    for (const m of metas) {
-      if (shown.has(m.index)) continue;
+    // A strip at its end scrolls on to show its newest frames: those it
+    // shows are drawn now (no blank flashes), the others once scrolled to.
+    const fresh = metas.filter((m) => !shown.has(m.index));
+    const drawNow = atEnd ? Math.ceil(b.strip.clientWidth / tw) + 1 : 0;
+    fresh.forEach((m, k) => {
       const t = document.createElement('canvas');
       t.className = 'cam-thumb';
       t.width = tw;
       t.height = th;
       t.dataset.robot = String(b.robot);
       t.dataset.index = String(m.index);
-      if (this.thumbSeen) this.thumbSeen.observe(t);
+      if (this.thumbSeen && k < fresh.length - drawNow) this.thumbSeen.observe(t);
       else lab.drawFrameThumb(b.robot, m.index, tw, t.getContext('2d'));
       t.tabIndex = -1;
       t.setAttribute('role', 'option');
@@ -313,7 +317,7 @@ export class CameraPanel {
       });
       b.strip.append(t);
       b.shown.push(m.index);
-    }
+    });
     b.empty.hidden = b.shown.length > 0;
     b.strip.dataset.frames = String(b.shown.length);
     b.goto.hidden = b.shown.length === 0;
