@@ -167,8 +167,10 @@ export class RunController {
     const dt = clamp((nowMs - this.lastFrameMs) / 1000, 0, 0.25);
     this.lastFrameMs = nowMs;
     const wanted = (this.speed * dt) / CONTROL_DT_S + this.stepCarry;
+    // At least one step, unless the views took half the frame already.
     const budget = Math.min(this.budgetMs, FRAME_TASK_MS - spentMs);
-    const fit = this.stepMs > 0 ? Math.max(1, Math.floor(budget / this.stepMs)) : 1;
+    const least = spentMs < FRAME_TASK_MS / 2 ? 1 : 0;
+    const fit = this.stepMs > 0 ? Math.max(least, Math.floor(budget / this.stepMs)) : least;
     const n = Math.max(0, Math.min(Math.floor(wanted), fit, this.maxStepsPerFrame));
     this.stepCarry = Math.min(wanted - n, (this.speed * CATCH_UP_S) / CONTROL_DT_S);
     this.budgetMs = this.stepCarry >= 1
