@@ -209,6 +209,7 @@ function onChange(kind) {
 const WORLD_FRAME_MS = 33; // the world view's redraw interval while running (about 30 per second)
 const WORLD_SHARE = [3, 8]; // ... and at most every 3 times its drawing time (8 when the run strains)
 let [lastWorldMs, worldDrawMs] = [0, 0];
+let camerasNext = false; // the world was drawn last frame: this one is the cameras'
 const frameTimes = new FrameTimes(); // where each frame's time goes, for the benchmarks
 
 /** One animation frame: redraw what is due, advance the run in the time
@@ -229,7 +230,7 @@ function frame(now) {
     const strain = runner.running ? runner.strain() : 0;
     const share = WORLD_SHARE[0] + strain * (WORLD_SHARE[1] - WORLD_SHARE[0]);
     const gap = Math.max(WORLD_FRAME_MS, share * worldDrawMs);
-    const changed = view.dirty && (!runner.running || now - lastWorldMs >= gap);
+    const changed = view.dirty && (!runner.running || (now - lastWorldMs >= gap && !camerasNext));
     if (changed) {
       const t0 = performance.now();
       t.time('world', () => view.draw());
@@ -238,9 +239,10 @@ function frame(now) {
     }
     // While running, a frame that drew the world leaves the cameras (a live
     // view costs as much as the world, more where its wall textures are not
-    // cached yet) to the next one, so that the two do not add up in one task.
-    const cameras = runner.running ? !changed : changed;
-    t.time('cameras', () => cameraPanel.update(now, cameras, strain));
+    // cached yet) to the next one, which draws no world, so that the two do
+    // not add up in one task.
+    camerasNext = runner.running && changed;
+    if (!camerasNext) t.time('cameras', () => cameraPanel.update(now, changed || runner.running, strain));
     t.time('maps', () => mapsPanel.update(now, changed || runner.running));
     t.time('merge', () => mergePanel.update(now));
     t.time('guide', () => guide.update(now));

@@ -25,7 +25,7 @@ import { setStatus } from './status.js';
 const CONTROL_DT_S = 0.1; // one Lab step
 const CATCH_UP_S = 0.5; // owed steps kept: at most this much wall time's worth at the speed
 const STEP_COST_WEIGHT = 0.3; // weight of the newest frame in the step-cost estimate
-const FRAME_TASK_MS = 50; // a frame's work (views and steps) at most, when steps are owed
+const FRAME_TASK_MS = 40; // a frame's work (views and steps) at most, when steps are owed
 const BUDGET_MIN_MS = 12; // the steps' time per frame when the run keeps up
 const BUDGET_UP_MS = 2; // ... grows by this each frame that ends with steps owed
 const BUDGET_DOWN_MS = 1; // ... and shrinks by this each frame that does not
