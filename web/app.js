@@ -240,10 +240,10 @@ function frame(now) {
     // While running, a frame that drew the world leaves the cameras (a live
     // view costs as much as the world, more where its wall textures are not
     // cached yet) to the next one, which draws no world, so that the two do
-    // not add up in one task.
+    // not add up in one task; the maps wait for a frame in which neither drew.
     camerasNext = runner.running && changed;
-    if (!camerasNext) t.time('cameras', () => cameraPanel.update(now, changed || runner.running, strain));
-    t.time('maps', () => mapsPanel.update(now, changed || runner.running));
+    const cameras = !camerasNext && t.time('cameras', () => cameraPanel.update(now, changed || runner.running, strain));
+    if (!runner.running || !(changed || cameras)) t.time('maps', () => mapsPanel.update(now, changed || runner.running));
     t.time('merge', () => mergePanel.update(now));
     t.time('guide', () => guide.update(now));
     if (runner.running) t.time('readouts', () => toolbar.readouts(false));

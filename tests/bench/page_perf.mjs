@@ -2,7 +2,7 @@
 // tasks and simulated-time rate while running in headless Chromium.
 //
 // Usage: node tests/bench/page_perf.mjs SCENARIO.json [--speed 50] [--seconds 10]
-//        [--width 1366 --height 768] [--shot FILE.png] [--parts]
+//        [--width 1366 --height 768] [--shot FILE.png] [--parts] [--scroll SELECTOR]
 // Imports the scenario through the page's Import button, sets the speed
 // slider, presses Run, and for `--seconds` of wall time counts animation
 // frames, records every long task (PerformanceObserver 'longtask') and reads
@@ -12,7 +12,8 @@
 // saves a screenshot of the page at the end of the run. `--parts` adds where
 // the page's frames spent their time (web/page/frame-times.js: totals in ms
 // by part, and the slowest frames with their parts). Needs ./build.sh build
-// and Chromium.
+// and Chromium. `--scroll` scrolls an element into view before the run (e.g.
+// `--scroll '#maps'`: the Maps panel on screen instead of the robot cards).
 import path from 'node:path';
 import { chromium } from 'playwright-core';
 import { CHROMIUM_FLAGS, serveRoot, waitReady } from '../support/browser.mjs';
@@ -45,6 +46,8 @@ try {
     requestAnimationFrame(tick);
   });
   const t0 = await page.evaluate(() => window.slamlab.state().time_s ?? window.slamlab.lab.timeS());
+  const scroll = args.indexOf('--scroll');
+  if (scroll >= 0) await page.evaluate((sel) => document.querySelector(sel).scrollIntoView({ block: 'start' }), args[scroll + 1]);
   await page.click('#run');
   const w0 = Date.now();
   await page.evaluate(() => {

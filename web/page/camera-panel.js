@@ -213,10 +213,10 @@ export class CameraPanel {
 
   /** Called every animation frame; `changed` when the world moved or was
    *  edited, `strain` (0 to 1) how hard the run strains to keep its speed
-   *  (web/page/run.js). */
+   *  (web/page/run.js). Returns whether it drew anything. */
   update(nowMs, changed, strain = 0) {
-    this.drawPending();
-    if (!this.blocks.length || !changed) return;
+    const drew = this.drawPending();
+    if (!this.blocks.length || !changed) return drew;
     // One on-screen block per turn, so that each refreshes about every
     // LIVE_INTERVAL_MS and no single frame renders them all.
     // And at most every LIVE_SHARE times what the last refresh took, so that
@@ -226,12 +226,13 @@ export class CameraPanel {
     const shown = this.blocks.filter((b) => b.visible);
     const share = LIVE_SHARE[0] + strain * (LIVE_SHARE[1] - LIVE_SHARE[0]);
     const gap = Math.max(LIVE_INTERVAL_MS / Math.max(1, shown.length), share * this.liveMs);
-    if (!shown.length || nowMs - this.lastLiveMs < gap) return;
+    if (!shown.length || nowMs - this.lastLiveMs < gap) return drew;
     this.lastLiveMs = nowMs;
     this.turn = (this.turn + 1) % shown.length;
     const t0 = performance.now();
     this.refreshBlock(shown[this.turn], false);
     this.liveMs = performance.now() - t0;
+    return true;
   }
 
   /** Redraws the live views and grows the strips: every block when
@@ -329,9 +330,9 @@ export class CameraPanel {
   /** Draws thumbnails that came on screen, newest first, for up to
    *  THUMB_SLICE_MS (at least one); the rest wait for the next frame. */
   drawPending() {
-    if (!this.pending.size) return;
+    if (!this.pending.size) return false;
     const lab = this.hooks.lab();
-    if (!lab) return;
+    if (!lab) return false;
     const t0 = performance.now();
     const order = [...this.pending].sort((a, b) => b[1][1] - a[1][1]);
     for (const [t, [robot, index]] of order) {
@@ -344,5 +345,6 @@ export class CameraPanel {
       }
       if (performance.now() - t0 >= THUMB_SLICE_MS) break;
     }
+    return true;
   }
 }
