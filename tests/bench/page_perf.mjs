@@ -2,14 +2,18 @@
 // tasks and simulated-time rate while running in headless Chromium.
 //
 // Usage: node tests/bench/page_perf.mjs SCENARIO.json [--speed 50] [--seconds 10]
-//        [--width 1366 --height 768] [--shot FILE.png]
+//        [--width 1366 --height 768] [--shot FILE.png] [--parts] [--scroll SELECTOR]
 // Imports the scenario through the page's Import button, sets the speed
 // slider, presses Run, and for `--seconds` of wall time counts animation
 // frames, records every long task (PerformanceObserver 'longtask') and reads
 // the simulated clock. Prints one JSON line:
 // {walls, robots, fps, frames, longtasks, longest_ms, sim_rate}, sim_rate =
-// simulated seconds per wall second. `--shot` saves a screenshot of the page
-// at the end of the run. Needs ./build.sh build and Chromium.
+// simulated seconds per wall second, over100 = long tasks over 100 ms. `--shot`
+// saves a screenshot of the page at the end of the run. `--parts` adds where
+// the page's frames spent their time (web/page/frame-times.js: totals in ms
+// by part, and the slowest frames with their parts). Needs ./build.sh build
+// and Chromium. `--scroll` scrolls an element into view before the run (e.g.
+// `--scroll '#maps'`: the Maps panel on screen instead of the robot cards).
 import path from 'node:path';
 import { chromium } from 'playwright-core';
 import { CHROMIUM_FLAGS, serveRoot, waitReady } from '../support/browser.mjs';
@@ -42,14 +46,20 @@ try {
     requestAnimationFrame(tick);
   });
   const t0 = await page.evaluate(() => window.slamlab.state().time_s ?? window.slamlab.lab.timeS());
+  const scroll = args.indexOf('--scroll');
+  if (scroll >= 0) await page.evaluate((sel) => document.querySelector(sel).scrollIntoView({ block: 'start' }), args[scroll + 1]);
   await page.click('#run');
   const w0 = Date.now();
-  await page.evaluate(() => (window.__perf.frames = 0));
+  await page.evaluate(() => {
+    window.__perf.frames = 0;
+    window.slamlab.frameTimes?.(true);
+  });
   await page.waitForTimeout(seconds * 1000);
   const out = await page.evaluate(() => ({
     frames: window.__perf.frames,
     long: window.__perf.long,
     t: window.slamlab.lab.timeS(),
+    parts: window.slamlab.frameTimes?.(),
   }));
   const wall = (Date.now() - w0) / 1000;
   const shot = args.indexOf('--shot');
@@ -63,7 +73,9 @@ try {
       frames: out.frames,
       longtasks: out.long.length,
       longest_ms: Math.round(Math.max(0, ...out.long)),
+      over100: out.long.filter((d) => d > 100).length,
       sim_rate: +((out.t - t0) / wall).toFixed(1),
+      ...(args.includes('--parts') ? { parts: out.parts } : {}),
     }),
   );
 } finally {

@@ -15,15 +15,25 @@
 // grow their strip; the others catch up when they scroll into view, and
 // every block is brought up to date when the run pauses, steps or ends.
 //
+// A thumbnail is drawn only once it is on screen (scrolled into its strip's
+// view; the newest, which a strip at its end scrolls on to show, at once),
+// the others a few a frame: rendering one costs 0.1 ms where the wall textures
+// it shows are cached and up to tens of milliseconds where they are not
+// (crate/src/camera/texture.rs paints them on first use), and at 20× with
+// 16 robots the strips on screen gained 80 frames a second, drawn at once
+// when a strip grew (issue 22: 120-280 ms tasks). The strip's elements
+// (its count, tab stops, clicks) are all there at once as before.
+//
 // By keyboard a strip is one tab stop (a roving tabindex): the arrow keys
 // move from frame to frame and show each, Home and End go to the ends.
 
 import { robotColour } from './palette.js';
 
 const LIVE_INTERVAL_MS = 120; // live views refresh at about 8 per second
-const LIVE_SHARE = 4; // ... and at most every 4 times what one took
+const LIVE_SHARE = [4, 12]; // ... and at most every 4 times what one took (12 when the run strains)
 const STRIP_INTERVAL_MS = 500; // strips grow at most twice a second while running
 const THUMB_W = 64;
+const THUMB_SLICE_MS = 6; // thumbnails drawn a frame: until this much time is spent (at least one)
 
 export class CameraPanel {
   /**
@@ -42,6 +52,15 @@ export class CameraPanel {
     this.camera = { width: 320, height: 240, hfov_deg: 60 };
     /** Live renders per robot (for the page tests: hidden blocks render none while running). */
     this.liveDraws = [];
+    /** Thumbnails on screen not drawn yet (canvas → [robot, index]). */
+    this.pending = new Map();
+    this.thumbSeen = typeof IntersectionObserver === 'undefined' ? null : new IntersectionObserver((entries) => {
+      for (const e of entries) {
+        if (!e.isIntersecting) continue;
+        this.thumbSeen.unobserve(e.target);
+        this.pending.set(e.target, [Number(e.target.dataset.robot), Number(e.target.dataset.index)]);
+      }
+    });
     this.seen = typeof IntersectionObserver === 'undefined' ? null : new IntersectionObserver((entries) => {
       for (const e of entries) {
         const b = this.blocks.find((x) => x.el === e.target);
@@ -62,6 +81,8 @@ export class CameraPanel {
     this.key = key;
     this.host.replaceChildren();
     this.seen?.disconnect();
+    this.thumbSeen?.disconnect();
+    this.pending.clear();
     this.blocks = scenario.robots.map((r, i) => this.makeBlock(r.name, i));
     this.liveDraws = this.blocks.map(() => 0);
     this.picked();
@@ -190,22 +211,28 @@ export class CameraPanel {
     b.strip.scrollLeft = t.offsetLeft - b.strip.offsetLeft - b.strip.clientWidth / 2;
   }
 
-  /** Called every animation frame; `changed` when the world moved or was edited. */
-  update(nowMs, changed) {
-    if (!this.blocks.length || !changed) return;
+  /** Called every animation frame; `changed` when the world moved or was
+   *  edited, `strain` (0 to 1) how hard the run strains to keep its speed
+   *  (web/page/run.js). Returns whether it drew anything. */
+  update(nowMs, changed, strain = 0) {
+    const drew = this.drawPending();
+    if (!this.blocks.length || !changed) return drew;
     // One on-screen block per turn, so that each refreshes about every
     // LIVE_INTERVAL_MS and no single frame renders them all.
     // And at most every LIVE_SHARE times what the last refresh took, so that
     // live views take at most a quarter of the time however many are on
-    // screen (issue 22: four 16-robot views in turn took a render a frame).
+    // screen (issue 22: four 16-robot views in turn took a render a frame),
+    // and a twelfth when the simulation needs the time to keep its speed.
     const shown = this.blocks.filter((b) => b.visible);
-    const gap = Math.max(LIVE_INTERVAL_MS / Math.max(1, shown.length), LIVE_SHARE * this.liveMs);
-    if (!shown.length || nowMs - this.lastLiveMs < gap) return;
+    const share = LIVE_SHARE[0] + strain * (LIVE_SHARE[1] - LIVE_SHARE[0]);
+    const gap = Math.max(LIVE_INTERVAL_MS / Math.max(1, shown.length), share * this.liveMs);
+    if (!shown.length || nowMs - this.lastLiveMs < gap) return drew;
     this.lastLiveMs = nowMs;
     this.turn = (this.turn + 1) % shown.length;
     const t0 = performance.now();
     this.refreshBlock(shown[this.turn], false);
     this.liveMs = performance.now() - t0;
+    return true;
   }
 
   /** Redraws the live views and grows the strips: every block when
@@ -262,14 +289,19 @@ export class CameraPanel {
     const tw = Math.min(THUMB_W, this.camera.width);
     const th = Math.max(1, Math.round((tw * this.camera.height) / this.camera.width));
     const atEnd = b.strip.scrollLeft + b.strip.clientWidth >= b.strip.scrollWidth - 4;
-    for (const m of metas) {
-      if (shown.has(m.index)) continue;
+    // A strip at its end scrolls on to show its newest frames: those it
+    // shows are drawn now (no blank flashes), the others once scrolled to.
+    const fresh = metas.filter((m) => !shown.has(m.index));
+    const drawNow = atEnd ? Math.ceil(b.strip.clientWidth / tw) + 1 : 0;
+    fresh.forEach((m, k) => {
       const t = document.createElement('canvas');
       t.className = 'cam-thumb';
       t.width = tw;
       t.height = th;
-      lab.drawFrameThumb(b.robot, m.index, tw, t.getContext('2d'));
+      t.dataset.robot = String(b.robot);
       t.dataset.index = String(m.index);
+      if (this.thumbSeen && k < fresh.length - drawNow) this.thumbSeen.observe(t);
+      else lab.drawFrameThumb(b.robot, m.index, tw, t.getContext('2d'));
       t.tabIndex = -1;
       t.setAttribute('role', 'option');
       t.setAttribute('aria-selected', 'false');
@@ -286,12 +318,33 @@ export class CameraPanel {
       });
       b.strip.append(t);
       b.shown.push(m.index);
-    }
+    });
     b.empty.hidden = b.shown.length > 0;
     b.strip.dataset.frames = String(b.shown.length);
     b.goto.hidden = b.shown.length === 0;
     b.goto.max = String(Math.max(0, ...b.shown));
     this.rove(b);
     if (atEnd) b.strip.scrollLeft = b.strip.scrollWidth;
+  }
+
+  /** Draws thumbnails that came on screen, newest first, for up to
+   *  THUMB_SLICE_MS (at least one); the rest wait for the next frame. */
+  drawPending() {
+    if (!this.pending.size) return false;
+    const lab = this.hooks.lab();
+    if (!lab) return false;
+    const t0 = performance.now();
+    const order = [...this.pending].sort((a, b) => b[1][1] - a[1][1]);
+    for (const [t, [robot, index]] of order) {
+      this.pending.delete(t);
+      if (!t.isConnected) continue;
+      try {
+        lab.drawFrameThumb(robot, index, t.width, t.getContext('2d'));
+      } catch {
+        // The frame was thinned away since: the next strip update removes it.
+      }
+      if (performance.now() - t0 >= THUMB_SLICE_MS) break;
+    }
+    return true;
   }
 }

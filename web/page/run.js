@@ -1,15 +1,34 @@
 // The run controller: Run, Pause, Step and Reset, and the simulation's
 // pace. The simulation lives in wasm; while running, the page's animation
-// frame (web/app.js) calls `advance(now)`, which runs as many 0.1 s control
-// steps as the speed asks for the time since the last frame, capped so a
-// frame stays short (if the machine cannot keep up, the run slows down
-// rather than piling up steps).
+// frame (web/app.js) first redraws what is due, then calls
+// `advance(now, spentMs)`, which runs as many 0.1 s control steps as the
+// speed asks for the time since the last frame, within what is left of the
+// frame's time.
+//
+// The pace (issue 22: 16 robots at 20× ask 200 steps a second, 2-4 ms
+// each). A fixed 12 ms of steps a frame gave 13-16 simulated s per s at
+// 20×, the views (world, cameras) taking twice the simulation's time. Now
+// steps the frame could not fit are owed, up to CATCH_UP_S of wall time's
+// worth (a machine that cannot keep up runs slower rather than piling up
+// steps), and the steps' time per frame (`budgetMs`) adapts: it grows by
+// BUDGET_UP_MS each frame that ends with steps owed, up to what is left of
+// FRAME_TASK_MS after the views, and shrinks by BUDGET_DOWN_MS, down to
+// BUDGET_MIN_MS, each frame that does not. `strain()` says how far it has
+// grown; the page redraws its views less often the more it is (web/app.js),
+// so the simulation gets the time. Each step's cost is measured as it goes;
+// the first frame of a run takes one step and the cap on a frame's steps
+// doubles a frame, so that no unmeasured batch starts a long task.
 import { clamp } from './geometry.js';
 import { fmt } from './dom.js';
 import { setStatus } from './status.js';
 
 const CONTROL_DT_S = 0.1; // one Lab step
-const FRAME_BUDGET_MS = 12; // time per frame we allow for simulation steps
+const CATCH_UP_S = 0.5; // owed steps kept: at most this much wall time's worth at the speed
+const STEP_COST_WEIGHT = 0.3; // weight of the newest frame in the step-cost estimate
+const FRAME_TASK_MS = 40; // a frame's work (views and steps) at most, when steps are owed
+const BUDGET_MIN_MS = 12; // the steps' time per frame when the run keeps up
+const BUDGET_UP_MS = 2; // ... grows by this each frame that ends with steps owed
+const BUDGET_DOWN_MS = 1; // ... and shrinks by this each frame that does not
 
 export class RunController {
   /**
@@ -24,11 +43,12 @@ export class RunController {
     this.running = false;
     this.speed = 10; // simulated seconds per real second
     this.lastFrameMs = 0;
-    this.stepCarry = 0;
-    // Steps a frame may take, from the measured cost of a step. It starts at
-    // one and at most doubles a frame, so that the first frame of a run (no
-    // measure yet) or one fast step cannot start a long task (issue 22: 20
-    // steps of 16 robots in the first frame took 300+ ms).
+    this.stepCarry = 0; // steps owed (wanted by the speed, not yet taken)
+    this.budgetMs = BUDGET_MIN_MS; // the steps' time per frame (see the top)
+    this.stepMs = 0; // measured cost of one step (0: not measured yet)
+    // Steps a frame may take at most: one on a run's first frame, and at
+    // most twice the last frame's, so that no unmeasured batch can start a
+    // long task (issue 22: 20 steps of 16 robots in one frame took 300+ ms).
     this.maxStepsPerFrame = 1;
     /** The run's state as last read (web/lab.js `state()`), or null. */
     this.state = null;
@@ -71,6 +91,8 @@ export class RunController {
     this.running = true;
     this.lastFrameMs = performance.now();
     this.stepCarry = 0;
+    this.budgetMs = BUDGET_MIN_MS;
+    this.maxStepsPerFrame = 1;
     setStatus(`Running at ${this.speed}× real time.`, 'info');
     this.hooks.refreshPanels();
     this.hooks.refreshControls();
@@ -133,26 +155,37 @@ export class RunController {
     this.hooks.finished?.(st);
   }
 
-  /** Advances the simulation for one animation frame at `nowMs`. */
-  advance(nowMs) {
-    const dt = clamp((nowMs - this.lastFrameMs) / 1000, 0, 0.1);
+  /** How far the steps' budget has grown to keep up with the speed: 0 (it
+   *  keeps up within BUDGET_MIN_MS a frame) to 1 (it takes the frame). */
+  strain() {
+    return clamp((this.budgetMs - BUDGET_MIN_MS) / (FRAME_TASK_MS - BUDGET_MIN_MS), 0, 1);
+  }
+
+  /** Advances the simulation for one animation frame at `nowMs`, after the
+   *  frame's other work took `spentMs`; returns the steps taken. */
+  advance(nowMs, spentMs = 0) {
+    const dt = clamp((nowMs - this.lastFrameMs) / 1000, 0, 0.25);
     this.lastFrameMs = nowMs;
     const wanted = (this.speed * dt) / CONTROL_DT_S + this.stepCarry;
-    let n = Math.floor(wanted);
-    this.stepCarry = wanted - n;
-    if (n > this.maxStepsPerFrame) {
-      n = this.maxStepsPerFrame;
-      this.stepCarry = 0; // the machine cannot keep up: slow down rather than pile up
-    }
-    if (n <= 0) return;
+    // At least one step, unless the views took half the frame already.
+    const budget = Math.min(this.budgetMs, FRAME_TASK_MS - spentMs);
+    const least = spentMs < FRAME_TASK_MS / 2 ? 1 : 0;
+    const fit = this.stepMs > 0 ? Math.max(least, Math.floor(budget / this.stepMs)) : least;
+    const n = Math.max(0, Math.min(Math.floor(wanted), fit, this.maxStepsPerFrame));
+    this.stepCarry = Math.min(wanted - n, (this.speed * CATCH_UP_S) / CONTROL_DT_S);
+    this.budgetMs = this.stepCarry >= 1
+      ? Math.min(FRAME_TASK_MS, this.budgetMs + BUDGET_UP_MS)
+      : Math.max(BUDGET_MIN_MS, this.budgetMs - BUDGET_DOWN_MS);
+    if (n === 0) return 0;
     const t0 = performance.now();
     const taken = this.lab.step(n);
     const perStep = (performance.now() - t0) / Math.max(1, taken);
-    const fit = Math.floor(FRAME_BUDGET_MS / Math.max(perStep, 1e-3));
-    this.maxStepsPerFrame = clamp(fit, 1, Math.min(1000, 2 * this.maxStepsPerFrame));
+    this.stepMs = this.stepMs > 0 ? STEP_COST_WEIGHT * perStep + (1 - STEP_COST_WEIGHT) * this.stepMs : perStep;
+    this.maxStepsPerFrame = Math.min(1000, 2 * this.maxStepsPerFrame);
     this.hooks.invalidate();
     if (taken < n) this.afterSteps(taken, n);
     else if (this.lab.timeS() + 1e-9 >= this.store.scenario.duration_s) this.afterSteps(taken, taken + 1);
+    return taken;
   }
 
   /** What the guided mode needs to know about the run. */
