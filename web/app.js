@@ -16,7 +16,7 @@
 //   *-panel.js, guided.js  the side and bottom panels, the guided mode;
 //                   pair-view.js (+ pair-map.js) the merge's frame pair,
 //                   match-table.js, merge-words.js, hidpi.js (pixel ratio)
-//   frame-times.js  where each animation frame's time goes (for the benchmarks)
+//   frame.js        an animation frame's work and pacing (+ frame-times.js)
 //   real/           your own maps and logs, merged and replayed in workers
 // and web/lab.js, the facade over the wasm `Lab` the command line uses too.
 //
@@ -40,7 +40,7 @@ import { Toolbar, download } from './page/toolbar.js';
 import { Summary } from './page/summary.js';
 import { setRobotColours } from './page/palette.js';
 import { fitStats } from './page/hidpi.js';
-import { FrameTimes } from './page/frame-times.js';
+import { FramePacer } from './page/frame.js';
 import { makeGuard, message, reportUncaught, setStatus } from './page/status.js';
 import { RobotsPanel } from './page/robots-panel.js';
 import { CameraPanel } from './page/camera-panel.js';
@@ -206,53 +206,17 @@ function onChange(kind) {
   if (kind === 'load') view.fit();
 }
 
-const WORLD_FRAME_MS = 33; // the world view's redraw interval while running (about 30 per second)
-const WORLD_SHARE = [3, 8]; // ... and at most every 3 times its drawing time (8 when the run strains)
-let [lastWorldMs, worldDrawMs] = [0, 0];
-let camerasNext = false; // the world was drawn last frame: this one is the cameras'
-const frameTimes = new FrameTimes(); // where each frame's time goes, for the benchmarks
+const pacer = new FramePacer({ runner, view, cameraPanel, mapsPanel, mergePanel, guide, toolbar });
 
 /** One animation frame: redraw what is due, advance the run in the time
- *  left, and let the panels follow. */
+ *  left, and let the panels follow (page/frame.js). */
 function frame(now) {
   if (covers.holdsFrames(runner.running, () => requestAnimationFrame(frame))) return;
   requestAnimationFrame(frame);
   if (!store.lab) return;
-  const t = frameTimes;
-  const start = performance.now();
-  t.begin();
   try {
-    // While running, the world view is redrawn at most every WORLD_FRAME_MS
-    // and at most every WORLD_SHARE times what its last drawing took (issue 22:
-    // 16 robots' laser rays took 20-40 ms to draw, more than a frame's steps),
-    // so that drawing leaves most of the time to the simulation; the more
-    // the run strains to keep its speed (web/page/run.js), the less often.
-    const strain = runner.running ? runner.strain() : 0;
-    const share = WORLD_SHARE[0] + strain * (WORLD_SHARE[1] - WORLD_SHARE[0]);
-    const gap = Math.max(WORLD_FRAME_MS, share * worldDrawMs);
-    const changed = view.dirty && (!runner.running || (now - lastWorldMs >= gap && !camerasNext));
-    if (changed) {
-      const t0 = performance.now();
-      t.time('world', () => view.draw());
-      worldDrawMs = performance.now() - t0;
-      lastWorldMs = now;
-    }
-    // While running, a frame that drew the world leaves the cameras (a live
-    // view costs as much as the world, more where its wall textures are not
-    // cached yet) to the next one, which draws no world, so that the two do
-    // not add up in one task; the maps wait for a frame in which neither drew.
-    camerasNext = runner.running && changed;
-    const cameras = !camerasNext && t.time('cameras', () => cameraPanel.update(now, changed || runner.running, strain));
-    if (!runner.running || !(changed || cameras)) t.time('maps', () => mapsPanel.update(now, changed || runner.running));
-    t.time('merge', () => mergePanel.update(now));
-    t.time('guide', () => guide.update(now));
-    if (runner.running) t.time('readouts', () => toolbar.readouts(false));
-    // The simulation takes what is left of the frame (web/page/run.js).
-    const spent = performance.now() - start;
-    const steps = runner.running ? t.time('steps', () => runner.advance(now, spent)) : 0;
-    t.end({ steps, strain: Math.round(100 * strain) / 100 });
+    pacer.run(now);
   } catch (e) {
-    t.end();
     runner.halt();
     onError(e);
     toolbar.refresh();
@@ -313,11 +277,7 @@ async function main() {
     realMaps,
     logView,
     /** Where the frames' time went since the last `reset` (web/page/frame-times.js). */
-    frameTimes: (reset = false) => {
-      const r = frameTimes.report();
-      if (reset) frameTimes.reset();
-      return r;
-    },
+    frameTimes: (reset = false) => pacer.report(reset),
   };
   document.body.dataset.ready = 'true';
   requestAnimationFrame(frame);
