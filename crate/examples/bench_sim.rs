@@ -8,8 +8,17 @@
 //! capture (a frame per simulated second); plus both mappers (odometry-only
 //! and SLAM). Rendering: ms per 960 x 720 frame of the thesis preset mid-run
 //! with laser rays, paths and grid. Medians of 3 and 200 repetitions.
+//!
+//! `cargo run --release -p slamlab --example bench_sim -- --late S.json 10,600,1800`:
+//! the world view of scenario `S.json` (1366 × 560) late in a run, drawn
+//! every 2 simulated seconds as the page draws it while running; at each
+//! listed time, the median time of a redraw after 2 s more of the run with
+//! the robots' paths kept on their layer (`render/trails.rs`), and of the
+//! same picture with the paths drawn from nothing (every path stroked
+//! whole, as before session 18; the walls from their kept layer in both).
 
 use slamlab::lab::Lab;
+use slamlab::render::{render_world_cached, TrailLayer, ViewLayers};
 use std::time::Instant;
 
 const PRESETS: [(&str, &str); 4] = [
@@ -25,6 +34,12 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().collect();
+    if let Some(i) = args.iter().position(|a| a == "--late") {
+        let usage = "usage: bench_sim --late SCENARIO.json T1,T2,...";
+        let (path, marks) = (args.get(i + 1).ok_or(usage)?, args.get(i + 2).ok_or(usage)?);
+        return late(path, marks);
+    }
     for (name, text) in PRESETS {
         let mut line = format!("native simulate {name:7}");
         for (label, capture, mapping) in [
@@ -70,6 +85,43 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             times.push(t0.elapsed().as_secs_f64() * 1000.0);
         }
         println!("native camera {w}x{h} {:.2} ms/frame", median(times));
+    }
+    Ok(())
+}
+
+/// The world view late in a run (see the module doc).
+fn late(path: &str, marks: &str) -> Result<(), Box<dyn std::error::Error>> {
+    const CHUNK: usize = 20; // steps between two redraws: 2 simulated seconds
+    let mut lab = Lab::new(&std::fs::read_to_string(path)?)?;
+    let view = lab.fit_view(1366, 560)?.clone();
+    let mut pm = tiny_skia::Pixmap::new(view.width, view.height).ok_or("no image")?;
+    let mut layers = ViewLayers::default();
+    let mut steps = 0;
+    for mark in marks.split(',') {
+        let mark_s: usize = mark.trim().parse()?;
+        while steps + CHUNK <= mark_s * 10 {
+            steps += lab.step(CHUNK)?;
+            lab.render()?;
+        }
+        let (mut kept, mut whole) = (Vec::new(), Vec::new());
+        for _ in 0..5 {
+            steps += lab.step(CHUNK)?;
+            let t0 = Instant::now();
+            lab.render()?;
+            kept.push(t0.elapsed().as_secs_f64() * 1000.0);
+            // The walls from their kept layer, the paths from nothing.
+            layers.trails = TrailLayer::default();
+            let t0 = Instant::now();
+            let sim = lab.simulation();
+            render_world_cached(&mut pm, lab.scenario(), sim, &view, &mut layers);
+            whole.push(t0.elapsed().as_secs_f64() * 1000.0);
+        }
+        println!(
+            "t = {:.0} s: redraw {:.2} ms with the paths kept, {:.2} ms drawn whole",
+            steps as f64 / 10.0,
+            median(kept),
+            median(whole)
+        );
     }
     Ok(())
 }

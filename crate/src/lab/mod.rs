@@ -28,7 +28,7 @@
 use crate::camera::capture::CapturedFrame;
 use crate::camera::texture::{ImageTexture, TextureBank};
 use crate::camera::{render as render_camera, robot_boxes, CameraImage, PinholeCamera};
-use crate::render::{render_world_cached, RenderOptions, WallLayer};
+use crate::render::{render_world_cached, RenderOptions, TrailLayer, ViewLayers};
 use crate::scenario::{Scenario, ScenarioError, MAX_DURATION_S};
 use crate::sensors::laser::beam_bearing;
 use crate::sim::{Simulation, LASER_LOG_NO_RETURN};
@@ -53,7 +53,7 @@ pub struct Lab {
     view: RenderOptions,
     pixmap: Option<Pixmap>,
     /// The view's walls, drawn once while they and the view stay put.
-    walls: WallLayer,
+    layers: ViewLayers,
     /// Texture cache and loaded pictures while no simulation holds them.
     textures: Option<TextureBank>,
     /// The world of the scenario being edited (for camera previews).
@@ -115,7 +115,7 @@ impl Lab {
             sim: None,
             view,
             pixmap: None,
-            walls: WallLayer::default(),
+            layers: ViewLayers::default(),
             textures: None,
             preview_world: None,
             merge: None,
@@ -169,6 +169,7 @@ impl Lab {
     /// Drops the simulation, keeping its texture bank for the next run.
     fn stop(&mut self) {
         self.merge = None;
+        self.layers.trails = TrailLayer::default();
         self.described = Default::default();
         if let Some(sim) = self.sim.take() {
             self.textures = Some(sim.textures.into_inner());
@@ -367,7 +368,7 @@ impl Lab {
             &self.scenario,
             self.sim.as_ref(),
             &self.view,
-            &mut self.walls,
+            &mut self.layers,
         );
         Ok(pm)
     }

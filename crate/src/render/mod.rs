@@ -12,6 +12,11 @@
 //! [`Pixmap`]. World coordinates have y up; this is the one place y is
 //! flipped. The background is opaque, so tiny-skia's premultiplied pixels
 //! equal the straight RGBA a canvas `ImageData` expects.
+//!
+//! The page redraws its view many times a second, so what changes rarely
+//! is kept drawn on layers between redraws ([`ViewLayers`]): the walls
+//! ([`WallLayer`]) and the robots' paths ([`TrailLayer`], in `trails.rs`,
+//! which strokes only what the robots added since the last redraw).
 
 use crate::geom::Pose2;
 use crate::kinematics::P2dx;
@@ -23,6 +28,9 @@ use crate::sensors::Sonar;
 use crate::sim::{RobotSim, Simulation};
 use glam::DVec2;
 use serde::Deserialize;
+pub use trails::TrailLayer;
+
+mod trails;
 use tiny_skia::{
     Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Rect, Stroke, StrokeDash,
     Transform,
@@ -375,17 +383,24 @@ pub fn render_world(
     sim: Option<&Simulation>,
     opts: &RenderOptions,
 ) {
-    render_world_cached(pm, scenario, sim, opts, &mut WallLayer::default());
+    render_world_cached(pm, scenario, sim, opts, &mut ViewLayers::default());
 }
 
-/// [`render_world`] with the walls kept in `walls` between calls (the
-/// page's view redrawn every frame).
+/// What a view keeps drawn between redraws: the walls and the robots' paths.
+#[derive(Default)]
+pub struct ViewLayers {
+    pub walls: WallLayer,
+    pub trails: TrailLayer,
+}
+
+/// [`render_world`] with the walls and the robots' paths kept in `layers`
+/// between calls (the page's view redrawn every frame).
 pub fn render_world_cached(
     pm: &mut Pixmap,
     scenario: &Scenario,
     sim: Option<&Simulation>,
     opts: &RenderOptions,
-    walls: &mut WallLayer,
+    layers: &mut ViewLayers,
 ) {
     pm.fill(Color::from_rgba8(250, 250, 247, 255));
     let o = opts;
@@ -394,9 +409,9 @@ pub fn render_world_cached(
     }
     // Trajectories under everything else.
     if let Some(sim) = sim {
-        draw_paths(pm, o, sim);
+        layers.trails.draw(pm, o, sim);
     }
-    walls.draw(pm, o, scenario);
+    layers.walls.draw(pm, o, scenario);
     draw_preview_wall(pm, o);
     // Sensors, then robots on top.
     let poses: Vec<Pose2> = match sim {
@@ -460,43 +475,6 @@ fn draw_grid(pm: &mut Pixmap, o: &RenderOptions) {
             );
         }
         y += step;
-    }
-}
-
-/// Each robot's odometry path (dashed, from its true start) and true path.
-fn draw_paths(pm: &mut Pixmap, o: &RenderOptions, sim: &Simulation) {
-    for (i, r) in sim.robots.iter().enumerate() {
-        let c = robot_colour(i);
-        if o.layers.odometry_path && r.log.odometry.len() > 1 {
-            let start = r.spec.start_pose();
-            let mut s = stroke(1.0);
-            s.line_join = LineJoin::Bevel;
-            s.line_cap = LineCap::Butt;
-            s.dash = StrokeDash::new(vec![6.0, 4.0], 0.0);
-            let dark = [c[0] / 2, c[1] / 2, c[2] / 2];
-            polyline(
-                pm,
-                o,
-                r.log.odometry.iter().map(|p| start.compose(p).position()),
-                1.5,
-                &paint(dark, 0.8),
-                &s,
-            );
-        }
-        if o.layers.truth_path && r.log.truth.len() > 1 {
-            polyline(
-                pm,
-                o,
-                r.log.truth.iter().map(|p| p.position()),
-                1.5,
-                &paint(c, 0.75),
-                &Stroke {
-                    width: 2.0,
-                    line_join: LineJoin::Bevel,
-                    ..Stroke::default()
-                },
-            );
-        }
     }
 }
 
