@@ -75,7 +75,8 @@ pub struct Closure {
 }
 
 /// Looks for a closure of key `i` (pose `nodes[i]`, points `key_points[i]`
-/// in its robot frame) against the older keys. With `response`, the edge's
+/// in its robot frame) against the older keys of the nearest earlier pass
+/// through its place ([`find_closure_among`] with one visit). With `response`, the edge's
 /// information is the match's own ([`super::match_covariance`]) instead of
 /// `cfg.sigma_m` / `cfg.sigma_rad`.
 pub fn find_closure(
@@ -86,8 +87,7 @@ pub fn find_closure(
     cfg: &LoopConfig,
     response: Option<&ResponseWindow>,
 ) -> Option<Closure> {
-    let centre = *visit_centres(nodes, i, cfg).first()?;
-    match_closure(nodes, key_points, i, centre, resolution_m, cfg, response)
+    find_closure_among(nodes, key_points, i, resolution_m, cfg, response, 1)
 }
 
 /// [`find_closure`] against up to `visits` earlier passes through the
