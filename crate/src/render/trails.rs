@@ -29,7 +29,7 @@
 use super::{over, paint, robot_colour, stroke, RenderOptions};
 use crate::geom::Pose2;
 use crate::sim::Simulation;
-use glam::DVec2;
+use glam::{DVec2, Vec2};
 use tiny_skia::{LineCap, LineJoin, Paint, PathBuilder, Pixmap, Stroke, StrokeDash, Transform};
 
 /// Points closer than this to the last kept one are dropped (px).
@@ -49,6 +49,8 @@ struct Trail {
     tip: Option<(f32, f32)>,
     /// Length of the path drawn so far (px): where its dashes stand.
     length_px: f32,
+    /// The box of the points kept (px): lowest and highest corner.
+    bounds: Option<(Vec2, Vec2)>,
 }
 
 impl Trail {
@@ -70,20 +72,24 @@ impl Trail {
             self.next += 1;
             let (x, y) = o.to_px(w);
             match self.last {
-                None => {
-                    pb.move_to(x, y);
-                    self.last = Some((x, y));
-                    self.tip = None;
-                }
+                None => pb.move_to(x, y),
                 Some((lx, ly)) if (x - lx).powi(2) + (y - ly).powi(2) >= min2 => {
                     pb.line_to(x, y);
                     self.length_px += (x - lx).hypot(y - ly);
-                    self.last = Some((x, y));
-                    self.tip = None;
                     segments += 1;
                 }
-                Some(_) => self.tip = Some((x, y)),
+                Some(_) => {
+                    self.tip = Some((x, y));
+                    continue;
+                }
             }
+            self.last = Some((x, y));
+            self.tip = None;
+            let p = Vec2::new(x, y);
+            self.bounds = Some(
+                self.bounds
+                    .map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p))),
+            );
         }
         if segments == 0 {
             return;
@@ -154,6 +160,31 @@ impl PathStyle {
     }
 }
 
+/// Lays `layer` over `pm` within the box `lo`..`hi` (px), widened by a
+/// stroke's reach: the rest of the layer is empty.
+fn lay_over(pm: &mut Pixmap, layer: &Pixmap, lo: Vec2, hi: Vec2) {
+    let (w, h) = (pm.width() as f32, pm.height() as f32);
+    let reach = 4.0; // half the widest stroke, antialiasing and a bevel's corner
+    let (x0, x1) = (
+        (lo.x - reach).clamp(0.0, w),
+        (hi.x + reach + 1.0).clamp(0.0, w),
+    );
+    let (y0, y1) = (
+        (lo.y - reach).clamp(0.0, h),
+        (hi.y + reach + 1.0).clamp(0.0, h),
+    );
+    let (x0, x1, y0, y1) = (x0 as usize, x1 as usize, y0 as usize, y1 as usize);
+    if x0 >= x1 {
+        return;
+    }
+    let stride = 4 * pm.width() as usize;
+    let (dst, src) = (pm.data_mut(), layer.data());
+    for y in y0..y1 {
+        let row = y * stride + 4 * x0..y * stride + 4 * x1;
+        over(&mut dst[row.clone()], &src[row]);
+    }
+}
+
 /// The robots' paths kept drawn between redraws (see the module doc).
 #[derive(Default)]
 pub struct TrailLayer {
@@ -206,7 +237,11 @@ impl TrailLayer {
                 truth.extend(layer, o, points, &PathStyle::truth(i));
             }
         }
-        over(pm.data_mut(), layer.data());
+        let bounds = self.trails.iter().flatten().filter_map(|t| t.bounds);
+        let bounds = bounds.reduce(|(a, b), (c, d)| (a.min(c), b.max(d)));
+        if let Some((lo, hi)) = bounds {
+            lay_over(pm, layer, lo, hi);
+        }
         for (i, [odometry, truth]) in self.trails.iter().enumerate() {
             odometry.draw_tip(pm, &PathStyle::odometry(i));
             truth.draw_tip(pm, &PathStyle::truth(i));
