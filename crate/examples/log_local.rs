@@ -19,7 +19,8 @@
 //!
 //! All beams within the matching range take part (no thinning), in the
 //! robot frame through the laser's offset. `SLAMLAB_LOG_SLAM` as in
-//! `log_relations`.
+//! `log_relations`; with `LOG_LOCAL_LIST` set, every pair where ours and the
+//! reference differ by over 0.1 m or 1° is listed.
 
 use glam::DVec2;
 use slamlab::carmen::{CarmenLog, LogScan};
@@ -27,7 +28,7 @@ use slamlab::geom::{wrap_angle, Pose2};
 use slamlab::slam::degeneracy::{scan_normals, symmetric_eigen2};
 use slamlab::slam::gauss_newton::solve3;
 use slamlab::slam::logslam::{scan_points, LogSlamConfig};
-use slamlab::slam::relations::{drift_odometry, DriftModel};
+use slamlab::slam::relations::{drift_odometry, relation_errors, DriftModel, RelationErrors};
 use std::collections::HashMap;
 
 #[path = "../../tests/real_support/mod.rs"]
@@ -208,8 +209,27 @@ fn compare(target: &Target, points: &[DVec2], candidates: &[Pose2], out: &mut [M
     true
 }
 
+/// One pair where the reference and ours disagree: each one's misfit and
+/// its offset (m, deg) from the pairwise ICP's answer, the ICP's weak
+/// eigenvalue, and the difference ours − reference in scan `i`'s frame.
+fn print_pair(i: usize, target: &Target, points: &[DVec2], r: &Pose2, o: &Pose2) {
+    let (icp, weak) = target.icp(points, r);
+    let (rt, rr) = apart(r, &icp);
+    let (ot, or) = apart(o, &icp);
+    println!(
+        "    pair {i:5}: ours-ref ({:+.3}, {:+.3}) m {:+.2} deg; misfit ref {:5.1} ours {:5.1} icp {:5.1} mm; off ICP: ref {rt:.3} m {rr:.2} deg, ours {ot:.3} m {or:.2} deg; weak {weak:.0}",
+        o.x - r.x,
+        o.y - r.y,
+        wrap_angle(o.theta - r.theta).to_degrees(),
+        1000.0 * target.misfit(points, r),
+        1000.0 * target.misfit(points, o),
+        1000.0 * target.misfit(points, &icp),
+    );
+}
+
 fn report(name: &str, log_all: &CarmenLog, reference: &[Pose2], cfg: &LogSlamConfig) {
-    let odom = drift_odometry(reference, &DriftModel::default(), support::DRIFT_SEED);
+    let list = std::env::var_os("LOG_LOCAL_LIST").is_some();
+    let odom = drift_odometry(reference, &DriftModel::default(), support::drift_seed());
     let (est, slam, _) = support::replay(log_all, Some(&odom), cfg);
     let log: &[LogScan] = &log_all.scans;
     // Front-end relative pose of consecutive scans that are both keys.
@@ -231,15 +251,29 @@ fn report(name: &str, log_all: &CarmenLog, reference: &[Pose2], cfg: &LogSlamCon
     let mut all = vec![Mean::default(), Mean::default()];
     let mut keyed = vec![Mean::default(), Mean::default(), Mean::default()];
     let mut skipped = 0;
+    let mut bad_pairs = Vec::new();
+    let mut ours_bad = 0;
     for i in 0..log.len() - 1 {
         let target = Target::new(scan_points(&log[i], &dense));
         let points = scan_points(&log[i + 1], &dense);
         let r = reference[i].between(&reference[i + 1]);
         let o = est[i].between(&est[i + 1]);
+        let (dt, dr) = apart(&r, &o);
+        if dt > 0.1 || dr > 1.0 {
+            let gain = target.misfit(&points, &r) - target.misfit(&points, &o);
+            if gain > GLITCH_MM / 1000.0 {
+                bad_pairs.push(i);
+            } else if gain < -GLITCH_MM / 1000.0 {
+                ours_bad += 1;
+            }
+        }
         let f = match (key_of_scan.get(&i), key_of_scan.get(&(i + 1))) {
             (Some(&a), Some(&b)) => front.get(&(a * 1_000_000 + b)).copied(),
             _ => None,
         };
+        if list && (apart(&r, &o).0 > 0.1 || apart(&r, &o).1 > 1.0) {
+            print_pair(i, &target, &points, &r, &o);
+        }
         if !compare(&target, &points, &[r, o], &mut all) {
             skipped += 1;
             continue;
@@ -252,6 +286,21 @@ fn report(name: &str, log_all: &CarmenLog, reference: &[Pose2], cfg: &LogSlamCon
         "{name}: {} consecutive pairs compared, {skipped} poorly constrained left out",
         all[0].n
     );
+    let glitches = glitch_scans(&bad_pairs);
+    println!(
+        "  consecutive relations where ours fits the scans {GLITCH_MM} mm better (and differs by > 0.1 m or 1 deg): {}; the reverse: {ours_bad}; reference glitch scans: {glitches:?}",
+        bad_pairs.len()
+    );
+    print_errors(
+        "relation errors",
+        &relation_errors(&est, reference, support::RANDOM_PAIRS, 1),
+    );
+    print_errors(
+        "without the glitch scans",
+        &without(&est, reference, &glitches),
+    );
+    revisits(log, reference, &est, &dense);
+    far_split(&est, reference);
     for (title, means) in [("all pairs", &all), ("pairs of keys", &keyed)] {
         println!(
             "  {title} ({}): misfit mm | ICP moves it m / deg | off ICP(ref) m / deg | ICP end vs ICP(ref) m / deg | misfit after ICP mm",
@@ -271,6 +320,133 @@ fn report(name: &str, log_all: &CarmenLog, reference: &[Pose2], cfg: &LogSlamCon
                 1000.0 * m.get(7)
             );
         }
+    }
+}
+
+/// A consecutive relation is the reference's fault when ours lays the scans
+/// this much better (mean clamped misfit, mm) and the two differ by over
+/// 0.1 m or 1°.
+const GLITCH_MM: f64 = 5.0;
+/// Longest run of reference poses between two faulty relations that is
+/// taken for a glitch (the poses jumped away and back).
+const GLITCH_RUN: usize = 5;
+
+/// The scans inside runs of at most `GLITCH_RUN` between two faulty
+/// relations (pair `i` joins scans `i` and `i + 1`).
+fn glitch_scans(bad_pairs: &[usize]) -> Vec<usize> {
+    let mut out = Vec::new();
+    for w in bad_pairs.windows(2) {
+        if w[1] - w[0] <= GLITCH_RUN {
+            out.extend(w[0] + 1..=w[1]);
+        }
+    }
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
+/// The relation errors ("all" and random) with the scans in `drop` left
+/// out of both trajectories.
+fn without(est: &[Pose2], reference: &[Pose2], drop: &[usize]) -> Vec<RelationErrors> {
+    let keep = |v: &[Pose2]| -> Vec<Pose2> {
+        v.iter()
+            .enumerate()
+            .filter(|(i, _)| !drop.contains(i))
+            .map(|(_, p)| *p)
+            .collect()
+    };
+    relation_errors(&keep(est), &keep(reference), support::RANDOM_PAIRS, 1)
+}
+
+fn print_errors(title: &str, e: &[RelationErrors]) {
+    let row: Vec<String> = e
+        .iter()
+        .map(|r| format!("{} {:.3}/{:.2}", r.pairs_of, r.trans_m, r.rot_deg))
+        .collect();
+    println!("  {title}: {}", row.join("  "));
+}
+
+/// Revisits: for each scan, the earliest-found scan at least `REVISIT_GAP`
+/// scans before it whose reference pose lies within 0.5 m and 20°. The
+/// same comparison as for consecutive scans, on those far pairs.
+const REVISIT_GAP: usize = 50;
+
+fn revisits(log: &[LogScan], reference: &[Pose2], est: &[Pose2], dense: &LogSlamConfig) {
+    let mut means = vec![Mean::default(), Mean::default()];
+    let (mut better, mut worse, mut gaps) = (0, 0, 0usize);
+    for j in REVISIT_GAP..log.len() {
+        let near = (0..j - REVISIT_GAP)
+            .map(|i| (i, reference[i].between(&reference[j])))
+            .filter(|(_, d)| d.position().length() < 0.5 && d.theta.abs() < 20f64.to_radians())
+            .min_by(|a, b| a.1.position().length().total_cmp(&b.1.position().length()));
+        let Some((i, r)) = near else { continue };
+        let target = Target::new(scan_points(&log[i], dense));
+        let points = scan_points(&log[j], dense);
+        let o = est[i].between(&est[j]);
+        if !compare(&target, &points, &[r, o], &mut means) {
+            continue;
+        }
+        gaps += j - i;
+        let gain = target.misfit(&points, &r) - target.misfit(&points, &o);
+        better += (gain > GLITCH_MM / 1000.0) as usize;
+        worse += (gain < -GLITCH_MM / 1000.0) as usize;
+    }
+    println!(
+        "  revisits ({} pairs, mean gap {} scans; ours fits {GLITCH_MM} mm better in {better}, worse in {worse}):",
+        means[0].n,
+        gaps / means[0].n.max(1)
+    );
+    for (k, m) in means.iter().enumerate() {
+        println!(
+            "    {:17} {:6.2} | {:6.4} / {:5.3} | {:6.4} / {:5.3} | {:6.4} / {:5.3} | {:6.2}",
+            ["reference", "ours (final)"][k],
+            1000.0 * m.get(0),
+            m.get(1),
+            m.get(2),
+            m.get(3),
+            m.get(4),
+            m.get(5),
+            m.get(6),
+            1000.0 * m.get(7)
+        );
+    }
+}
+
+/// How the far relations err: the translational error of pairs `k` apart
+/// split along the reference's displacement (a path too long or short:
+/// sliding along corridors) and across it (a bend: heading), mean |·| each,
+/// and the share of the summed error from each tenth of the log (by the
+/// pair's first scan).
+fn far_split(est: &[Pose2], reference: &[Pose2]) {
+    for k in [50usize, 100] {
+        let n = est.len();
+        if k >= n {
+            continue;
+        }
+        let (mut along, mut across, mut total) = (0.0, 0.0, 0.0);
+        let mut tenth = [0.0; 10];
+        for i in 0..n - k {
+            let dr = reference[i].between(&reference[i + k]);
+            let de = est[i].between(&est[i + k]);
+            let e = de.position() - dr.position();
+            let dir = dr.position().normalize_or(DVec2::X);
+            along += dir.dot(e).abs();
+            across += dir.perp_dot(e).abs();
+            total += e.length();
+            tenth[10 * i / n] += e.length();
+        }
+        let m = (n - k) as f64;
+        let shares: Vec<String> = tenth
+            .iter()
+            .map(|t| format!("{:.0}", 100.0 * t / total))
+            .collect();
+        println!(
+            "  k={k}: |error| {:.3} m, along the path {:.3}, across {:.3}; % by tenth of the log: {}",
+            total / m,
+            along / m,
+            across / m,
+            shares.join(" ")
+        );
     }
 }
 
