@@ -17,8 +17,16 @@
 //! corridor: the smaller eigenvalue of the translational information below
 //! `MIN_WEAK`) are left out of the comparison.
 //!
+//! Then, per log: the reference's glitches (short runs of scans whose
+//! reference relations to both neighbours lay the scans worse than ours, by
+//! `GLITCH_MM`) and the relation errors without them; the same comparison
+//! on revisits (pairs far apart in the log, near in space), which tests the
+//! far relations where the scans can; and the far relations' translational
+//! error split along and across the reference's path.
+//!
 //! All beams within the matching range take part (no thinning), in the
-//! robot frame through the laser's offset. `SLAMLAB_LOG_SLAM` as in
+//! robot frame through the laser's offset. `SLAMLAB_DRIFT_SEED` changes the
+//! drifting odometry's seed (all the real-log examples). `SLAMLAB_LOG_SLAM` as in
 //! `log_relations`; with `LOG_LOCAL_LIST` set, every pair where ours and the
 //! reference differ by over 0.1 m or 1° is listed.
 
@@ -366,8 +374,9 @@ fn print_errors(title: &str, e: &[RelationErrors]) {
     println!("  {title}: {}", row.join("  "));
 }
 
-/// Revisits: for each scan, the earliest-found scan at least `REVISIT_GAP`
-/// scans before it whose reference pose lies within 0.5 m and 20°. The
+/// Revisits: for each scan, the scan at least `REVISIT_GAP`
+/// scans before it whose reference pose lies nearest, if within 0.5 m and
+/// 20° (found by the reference, judged by the scans alone). The
 /// same comparison as for consecutive scans, on those far pairs.
 const REVISIT_GAP: usize = 50;
 
