@@ -70,8 +70,10 @@ fn aces_with_drifting_odometry() {
 #[test]
 fn csail_corrected_with_drifting_odometry() {
     let o = support::corrected("csail-corrected.log.gz");
-    // Measured: 0.274 m / 1.16 deg against odometry's 10.786 m / 35.14 deg.
-    check("csail", &o, 0.29, 1.25, 0.25);
+    // Measured: 0.241 m / 1.12 deg against odometry's 10.786 m / 35.14 deg
+    // (0.274 m / 1.16 deg before session 18 narrowed the wide window's
+    // reach to 0.6 m).
+    check("csail", &o, 0.26, 1.2, 0.25);
 }
 
 #[test]

@@ -152,7 +152,7 @@ fn main() {
                 .iter()
                 .map(|s| s.logged_pose.expect("FLASER pose"))
                 .collect();
-            let odom = drift_odometry(&reference, &DriftModel::default(), support::DRIFT_SEED);
+            let odom = drift_odometry(&reference, &DriftModel::default(), support::drift_seed());
             let (_, slam, _) = support::replay(&log, Some(&odom), &cfg);
             report(name, &slam, &reference);
         }

@@ -67,6 +67,14 @@ pub fn replay(
 
 /// The seed of the drifting odometry in every figure.
 pub const DRIFT_SEED: u64 = 21;
+/// `$SLAMLAB_DRIFT_SEED` if set (to measure how much a figure moves with
+/// the odometry's noise), else [`DRIFT_SEED`].
+pub fn drift_seed() -> u64 {
+    std::env::var("SLAMLAB_DRIFT_SEED")
+        .map(|s| s.parse().expect("SLAMLAB_DRIFT_SEED: an integer"))
+        .unwrap_or(DRIFT_SEED)
+}
+
 /// Random far pairs per evaluation.
 pub const RANDOM_PAIRS: usize = 1000;
 
@@ -83,7 +91,7 @@ pub fn corrected_with(name: &str, cfg: &LogSlamConfig) -> Outcome {
         .iter()
         .map(|s| s.logged_pose.expect("FLASER pose"))
         .collect();
-    let odom = drift_odometry(&reference, &DriftModel::default(), DRIFT_SEED);
+    let odom = drift_odometry(&reference, &DriftModel::default(), drift_seed());
     let (est, slam, seconds) = replay(&log, Some(&odom), cfg);
     Outcome {
         ours: relation_errors(&est, &reference, RANDOM_PAIRS, 1),
@@ -215,6 +223,8 @@ pub fn config_from_env() -> LogSlamConfig {
             "loop_window_m" => cfg.loops.window.linear_m = v,
             "loop_window_deg" => cfg.loops.window.angular_rad = v.to_radians(),
             "confirm_keys" => cfg.confirm_keys = v as usize,
+            "wide_m" => cfg.wide.linear_m = v,
+            "wide_deg" => cfg.wide.angular_rad = v.to_radians(),
             _ => panic!("SLAMLAB_LOG_SLAM: unknown setting {key}"),
         }
     }
