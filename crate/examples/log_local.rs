@@ -185,6 +185,22 @@ impl Mean {
         }
     }
 
+    /// One table row: misfit (mm), three pose offsets (m / deg), misfit after ICP (mm).
+    fn print_row(&self, name: &str) {
+        println!(
+            "    {:17} {:6.2} | {:6.4} / {:5.3} | {:6.4} / {:5.3} | {:6.4} / {:5.3} | {:6.2}",
+            name,
+            1000.0 * self.get(0),
+            self.get(1),
+            self.get(2),
+            self.get(3),
+            self.get(4),
+            self.get(5),
+            self.get(6),
+            1000.0 * self.get(7)
+        );
+    }
+
     fn get(&self, k: usize) -> f64 {
         self.sums.get(k).copied().unwrap_or(0.0) / self.n.max(1) as f64
     }
@@ -315,18 +331,7 @@ fn report(name: &str, log_all: &CarmenLog, reference: &[Pose2], cfg: &LogSlamCon
             means[0].n
         );
         for (k, m) in means.iter().enumerate() {
-            println!(
-                "    {:17} {:6.2} | {:6.4} / {:5.3} | {:6.4} / {:5.3} | {:6.4} / {:5.3} | {:6.2}",
-                names[k],
-                1000.0 * m.get(0),
-                m.get(1),
-                m.get(2),
-                m.get(3),
-                m.get(4),
-                m.get(5),
-                m.get(6),
-                1000.0 * m.get(7)
-            );
+            m.print_row(names[k]);
         }
     }
 }
@@ -406,18 +411,7 @@ fn revisits(log: &[LogScan], reference: &[Pose2], est: &[Pose2], dense: &LogSlam
         gaps / means[0].n.max(1)
     );
     for (k, m) in means.iter().enumerate() {
-        println!(
-            "    {:17} {:6.2} | {:6.4} / {:5.3} | {:6.4} / {:5.3} | {:6.4} / {:5.3} | {:6.2}",
-            ["reference", "ours (final)"][k],
-            1000.0 * m.get(0),
-            m.get(1),
-            m.get(2),
-            m.get(3),
-            m.get(4),
-            m.get(5),
-            m.get(6),
-            1000.0 * m.get(7)
-        );
+        m.print_row(["reference", "ours (final)"][k]);
     }
 }
 
