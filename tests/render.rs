@@ -17,13 +17,19 @@ const GOLDEN_EDIT: &[u8] = include_bytes!("golden/thesis_edit_320x240.png");
 const GOLDEN_RUN: &[u8] = include_bytes!("golden/thesis_run20s_320x240.png");
 
 fn view(w: u32, h: u32, lab: &mut Lab) {
+    let layers = Layers {
+        sonar: true,
+        ..Layers::default()
+    };
+    view_with(w, h, layers, lab);
+}
+
+/// A `w` × `h` view fitted to the scenario, with `layers`.
+fn view_with(w: u32, h: u32, layers: Layers, lab: &mut Lab) {
     let mut v = RenderOptions {
         width: w,
         height: h,
-        layers: Layers {
-            sonar: true,
-            ..Layers::default()
-        },
+        layers,
         ..RenderOptions::default()
     };
     v.fit(lab.scenario());
@@ -259,17 +265,11 @@ fn many_robots_draw_their_lasers_as_fans() {
 fn paths_drawn_a_stretch_at_a_time_look_as_drawn_whole() {
     let paths_only = || {
         let mut lab = Lab::new(THESIS).unwrap();
-        let mut v = RenderOptions {
-            width: 640,
-            height: 480,
-            layers: Layers {
-                laser: false,
-                ..Layers::default()
-            },
-            ..RenderOptions::default()
+        let layers = Layers {
+            laser: false,
+            ..Layers::default()
         };
-        v.fit(lab.scenario());
-        lab.set_view(v).unwrap();
+        view_with(640, 480, layers, &mut lab);
         lab
     };
     let mut stepwise = paths_only();
