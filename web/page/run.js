@@ -49,7 +49,6 @@ export class RunController {
     this.stepCarry = 0; // steps owed (wanted by the speed, not yet taken)
     this.budgetMs = BUDGET_MIN_MS; // the steps' time per frame (see the top)
     this.stepMs = 0; // measured cost of one step (0: not measured yet)
-    this.lastTakeMs = 0; // what the last batch of steps took
     // Steps a frame may take at most: one on a run's first frame, and at
     // most twice the last frame's, so that no unmeasured batch can start a
     // long task (issue 22: 20 steps of 16 robots in one frame took 300+ ms).
@@ -181,10 +180,10 @@ export class RunController {
       ? Math.min(FRAME_TASK_MS, this.budgetMs + BUDGET_UP_MS)
       : Math.max(BUDGET_MIN_MS, this.budgetMs - BUDGET_DOWN_MS);
     if (n === 0) return 0;
-    const { taken, ended } = this.take(n, Math.max(budget, 0));
+    const { taken, ended, ms } = this.take(n, Math.max(budget, 0));
     // Steps a slow one left no time for are owed.
     this.stepCarry = Math.min(this.stepCarry + n - taken, (this.speed * CATCH_UP_S) / CONTROL_DT_S);
-    const perStep = this.lastTakeMs / Math.max(1, taken);
+    const perStep = ms / Math.max(1, taken);
     this.stepMs = this.stepMs > 0 ? STEP_COST_WEIGHT * perStep + (1 - STEP_COST_WEIGHT) * this.stepMs : perStep;
     this.maxStepsPerFrame = Math.min(1000, 2 * this.maxStepsPerFrame);
     this.hooks.invalidate();
@@ -195,7 +194,8 @@ export class RunController {
   /** Takes up to `n` steps one at a time, stopping once `budgetMs` is
    *  spent: a step can cost several times the average (a camera frame
    *  captured, a map grown), and the frame should not pay for the rest of
-   *  the batch on top of it. The first step is always taken. */
+   *  the batch on top of it. The first step is always taken. Returns the
+   *  steps taken, whether the run ended, and the time they took (ms). */
   take(n, budgetMs) {
     const t0 = performance.now();
     let taken = 0;
@@ -206,8 +206,7 @@ export class RunController {
       ended = k < 1;
       if (performance.now() - t0 >= budgetMs) break;
     }
-    this.lastTakeMs = performance.now() - t0;
-    return { taken, ended };
+    return { taken, ended, ms: performance.now() - t0 };
   }
 
   /** What the guided mode needs to know about the run. */
