@@ -136,3 +136,46 @@ fn each_group_map_is_fused_in_its_first_robots_frame(lab: &Lab) {
     let err = lab.group_merged_pgm(3).expect_err("no fourth group");
     assert_eq!(err, "there is no group 3: the merge found 3");
 }
+
+/// The decision stage, cut into single units as the page cuts it, comes
+/// out exactly as in one call (the command line's way), and it is cut:
+/// one unit per pair's verdict, then one per map search, with the stage's
+/// progress counting them.
+#[wasm_bindgen_test(unsupported = test)]
+fn the_decision_a_unit_at_a_time_equals_the_decision_at_once() {
+    let mut lab = Lab::new(SCENARIO).expect("the scenario parses");
+    lab.run_to_end().expect("runs");
+    let mut report_of = |units: usize| {
+        lab.merge_start(MergeMethod::Auto).expect("starts");
+        let mut decision_calls = 0;
+        let mut seen_total = 0;
+        loop {
+            let before = lab.merge_progress().expect("progress");
+            if before.finished {
+                break;
+            }
+            let after = lab.merge_advance(units).expect("advances");
+            if before.stage == "decision" {
+                decision_calls += 1;
+                if after.stage == "decision" {
+                    assert!(after.done <= after.total, "{after:?}");
+                    seen_total = seen_total.max(after.total);
+                }
+            }
+        }
+        let mut report = lab.merge_report().expect("a report");
+        report.timings_ms = Default::default();
+        let json = serde_json::to_string(&report).expect("serialises");
+        (json, decision_calls, seen_total)
+    };
+    let (whole, calls_whole, _) = report_of(usize::MAX);
+    let (cut, calls_cut, total) = report_of(1);
+    assert_eq!(calls_whole, 1, "one call decides every pair");
+    // Five robots: ten pairs under the budget, then at least one search.
+    assert!(total > 10, "the searches count as units: {total}");
+    assert!(calls_cut >= 10, "one call per unit: {calls_cut}");
+    assert_eq!(
+        whole, cut,
+        "the outcome does not depend on the units per call"
+    );
+}

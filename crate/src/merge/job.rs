@@ -37,12 +37,14 @@
 //! and their maps. It never looks at the truth; the session layer
 //! (`crate::lab`) scores it.
 
+mod decision;
+
 use super::described::{describe_image, DescribedFrames};
 use super::frames::MergeInput;
 use super::fuse::fuse;
 use super::graph::{groups, spanning_tree, Joined, PairEdge};
 use super::method::{pose3, stages_of, MethodStages, PairInput};
-use super::pairbudget::{BudgetSummary, Components, PairBudget, PairPlan};
+use super::pairbudget::{BudgetSummary, PairBudget, PairPlan};
 use super::verify::{verify_pair, PairCheck, VerifyConfig};
 use super::MergeStatus;
 use crate::camera::PinholeCamera;
@@ -163,6 +165,8 @@ pub struct MergeJob {
     /// Frames described ahead, elsewhere ([`super::described`]): taken
     /// instead of describing them again.
     described: DescribedFrames,
+    /// The decision stage between calls ([`decision`]).
+    deciding: Option<decision::Deciding>,
 }
 
 impl MergeJob {
@@ -220,6 +224,7 @@ impl MergeJob {
             merged: None,
             times_ms: Default::default(),
             described: DescribedFrames::default(),
+            deciding: None,
         })
     }
 
@@ -261,13 +266,20 @@ impl MergeJob {
                 let done: usize = self.pairs.iter().map(|p| p.cells.len()).sum();
                 (done, total)
             }
+            Stage::Decision => self
+                .deciding
+                .as_ref()
+                .map_or((0, self.pairs.len().max(1)), |d| {
+                    d.progress(self.pairs.len())
+                }),
             Stage::Done => (1, 1),
             _ => (0, 1),
         }
     }
 
-    /// Does up to `units` units of work (frames described, pairs checked;
-    /// the proposal, decision and fusion stages are one unit each) without
+    /// Does up to `units` units of work (frames described, pairs checked,
+    /// pairs decided or searched; the proposal and fusion stages are one
+    /// unit each) without
     /// leaving the current stage. `input` must be what the job was made
     /// from. Returns the units done (0 once finished).
     pub fn advance(&mut self, input: &impl MergeInput, units: usize) -> Result<usize, String> {
@@ -285,9 +297,12 @@ impl MergeJob {
             }
             Stage::Matching => Ok(self.advance_matching(units)),
             Stage::Decision => {
-                self.decide(input);
-                self.stage = Stage::Fusion;
-                Ok(1)
+                let done = self.advance_decision(input, units);
+                if self.decision_finished() {
+                    self.finish_decision();
+                    self.stage = Stage::Fusion;
+                }
+                Ok(done.max(1))
             }
             Stage::Fusion => {
                 self.fuse_maps(input);
@@ -432,105 +447,6 @@ impl MergeJob {
             config: &self.config,
             search_maps,
         }
-    }
-
-    /// The decision on every pair of robots, by the method's own rule,
-    /// then the join. With a pair budget ([`super::pairbudget`]) the
-    /// frame-based verdicts come first and the map searches after, in rank
-    /// order, skipping robots already joined.
-    fn decide(&mut self, input: &impl MergeInput) {
-        let (outcomes, budget) = if self.pairs.iter().any(|p| p.budget.is_some()) {
-            let (o, b) = self.decide_within_budget(input);
-            (o, Some(b))
-        } else {
-            let o = self
-                .pairs
-                .iter()
-                .map(|p| self.method.decide(&self.pair_input(input, p, true)))
-                .collect();
-            (o, None)
-        };
-        for (p, o) in self.pairs.iter_mut().zip(&outcomes) {
-            p.outcome = Some(o.clone());
-        }
-        let mut outcome = self.join(outcomes);
-        outcome.budget = budget;
-        self.outcome = Some(outcome);
-    }
-
-    /// [`MergeJob::decide`] with a pair budget (step 4 of
-    /// [`super::pairbudget`]'s doc).
-    fn decide_within_budget(&self, input: &impl MergeInput) -> (Vec<PairOutcome>, BudgetSummary) {
-        let mut summary = BudgetSummary {
-            pairs: self.pairs.len(),
-            ..Default::default()
-        };
-        let mut outcomes: Vec<PairOutcome> = Vec::with_capacity(self.pairs.len());
-        for p in &self.pairs {
-            let b = p.budget.unwrap_or_default();
-            summary.partners_per_robot = b.partners;
-            let o = match b.plan {
-                PairPlan::Full => {
-                    summary.matched += 1;
-                    let mut o = self.method.decide(&self.pair_input(input, p, false));
-                    o.check = Some("full");
-                    o
-                }
-                _ => self.unmatched(p, &b),
-            };
-            outcomes.push(o);
-        }
-        let mut joined = Components::new(self.robots.len());
-        for (p, o) in self.pairs.iter().zip(&outcomes) {
-            if o.status == MergeStatus::Merged {
-                joined.join(p.a, p.b);
-            }
-        }
-        // The map searches, likeliest pairs first.
-        let mut order: Vec<usize> = Vec::new();
-        for (k, o) in outcomes.iter_mut().enumerate() {
-            let b = self.pairs[k].budget.unwrap_or_default();
-            let ambiguous = o.verdict.as_ref().is_some_and(|d| d.ambiguous);
-            if o.status == MergeStatus::Merged || b.plan == PairPlan::NotChecked || ambiguous {
-                continue;
-            }
-            if b.search {
-                order.push(k);
-            } else {
-                o.reason = format!(
-                    "{}; maps not searched: neither robot ranks the other among its {} likeliest partners by coarse map overlap ({:.2})",
-                    o.reason, b.partners, b.overlap
-                );
-                o.check = Some("frames");
-            }
-        }
-        order.sort_by_key(|&k| (self.pairs[k].budget.map_or(usize::MAX, |b| b.rank), k));
-        for k in order {
-            let p = &self.pairs[k];
-            let o = &mut outcomes[k];
-            if joined.same(p.a, p.b) {
-                summary.searches_skipped += 1;
-                o.reason = format!(
-                    "{}; maps not searched: {} and {} are already joined through merged pairs",
-                    o.reason, o.a, o.b
-                );
-                o.check = Some(if o.check == Some("full") {
-                    "frames"
-                } else {
-                    "none"
-                });
-                continue;
-            }
-            summary.maps_searched += 1;
-            *o = self
-                .method
-                .search_after(&self.pair_input(input, p, true), o.clone());
-            if o.status == MergeStatus::Merged {
-                joined.join(p.a, p.b);
-            }
-        }
-        summary.not_checked = outcomes.iter().filter(|o| o.check == Some("none")).count();
-        (outcomes, summary)
     }
 
     /// The outcome of a pair whose frames the budget left unmatched: not
