@@ -92,6 +92,10 @@
 //! does not guess). And the maps alone cannot merge what they do not both
 //! show: a small overlap gives too little evidence by design.
 
+mod steps;
+
+pub use steps::MapSearchSteps;
+
 use super::align::refine_alignment;
 use super::correlation::{add_row, Correlation};
 use super::peaksearch::{best_translations, pyramid_of, MaxPyramid, ScoreImage};
@@ -640,6 +644,22 @@ pub fn coarse_peaks(
     cfg: &MapSearchConfig,
     how: TranslationSearch,
 ) -> Result<(f64, Vec<(Pose2, i64)>), String> {
+    let (delta, ra) = coarse_start(a, b, cfg)?;
+    let mut a_max = None;
+    let mut coarse: Vec<(Pose2, i64)> = Vec::new();
+    for k in 0..4 {
+        coarse.extend(coarse_rotation(a, &ra, &mut a_max, b, delta, k, cfg, how)?);
+    }
+    Ok((delta, coarse_ranked(coarse, cfg)))
+}
+
+/// Step 1 of [`coarse_peaks`]: the rotation from the wall directions, and
+/// A drawn unturned.
+fn coarse_start(
+    a: &OccupancyGrid,
+    b: &OccupancyGrid,
+    cfg: &MapSearchConfig,
+) -> Result<(f64, Raster), String> {
     let Some(delta) = dominant_rotation(a, b) else {
         return Err("maps alone: too few walls to find their directions".into());
     };
@@ -647,27 +667,47 @@ pub fn coarse_peaks(
     let Some(ra) = Raster::draw(a, 0.0, cell, cfg.free_penalty) else {
         return Err("maps alone: a map is empty".into());
     };
+    Ok((delta, ra))
+}
+
+/// Step 2 of [`coarse_peaks`] for rotation `k` of four: B turned by
+/// `delta + k·90°`, and its best translations over A's raster `ra`
+/// (`a_max`, A's pyramid, is built at the first rotation and kept).
+#[allow(clippy::too_many_arguments)]
+fn coarse_rotation(
+    a: &OccupancyGrid,
+    ra: &Raster,
+    a_max: &mut Option<Option<MaxPyramid>>,
+    b: &OccupancyGrid,
+    delta: f64,
+    k: usize,
+    cfg: &MapSearchConfig,
+    how: TranslationSearch,
+) -> Result<Vec<(Pose2, i64)>, String> {
+    let cell = cfg.cell_m.max(a.resolution_m());
     let apart = cfg.distinct_m / cell;
-    let mut a_max = None;
-    let mut coarse: Vec<(Pose2, i64)> = Vec::new();
-    for k in 0..4 {
-        let theta = wrap_angle(delta + k as f64 * FRAC_PI_2);
-        let Some(rb) = Raster::draw(b, theta, cell, cfg.free_penalty) else {
-            return Err("maps alone: a map is empty".into());
-        };
-        let peaks = match how {
-            TranslationSearch::Exhaustive => {
-                correlate(&ra, &rb).peaks(cfg.peaks_per_rotation, apart)
-            }
-            TranslationSearch::BranchAndBound => {
-                branch_and_bound(&ra, &mut a_max, &rb, cfg.peaks_per_rotation, apart)
-            }
-        };
-        for (t, score) in peaks {
-            let pose = Pose2::new(t[0] as f64 * cell, t[1] as f64 * cell, theta);
-            coarse.push((pose, score as i64));
+    let theta = wrap_angle(delta + k as f64 * FRAC_PI_2);
+    let Some(rb) = Raster::draw(b, theta, cell, cfg.free_penalty) else {
+        return Err("maps alone: a map is empty".into());
+    };
+    let peaks = match how {
+        TranslationSearch::Exhaustive => correlate(ra, &rb).peaks(cfg.peaks_per_rotation, apart),
+        TranslationSearch::BranchAndBound => {
+            branch_and_bound(ra, a_max, &rb, cfg.peaks_per_rotation, apart)
         }
-    }
+    };
+    Ok(peaks
+        .into_iter()
+        .map(|(t, score)| {
+            let pose = Pose2::new(t[0] as f64 * cell, t[1] as f64 * cell, theta);
+            (pose, score as i64)
+        })
+        .collect())
+}
+
+/// Step 3 of [`coarse_peaks`]: every rotation's peaks, strongest first
+/// (ties by angle, then position), at most `max_hypotheses`.
+fn coarse_ranked(mut coarse: Vec<(Pose2, i64)>, cfg: &MapSearchConfig) -> Vec<(Pose2, i64)> {
     coarse.sort_by(|p, q| {
         q.1.cmp(&p.1)
             .then(p.0.theta.total_cmp(&q.0.theta))
@@ -675,7 +715,7 @@ pub fn coarse_peaks(
             .then(p.0.y.total_cmp(&q.0.y))
     });
     coarse.truncate(cfg.max_hypotheses.max(1));
-    Ok((delta, coarse))
+    coarse
 }
 
 /// Searches map A for map B (see the module doc): B's frame in A's, from
@@ -687,15 +727,12 @@ pub fn search_maps(
     cfg: &MapSearchConfig,
     verdict: &VerdictConfig,
 ) -> MapSearch {
-    let (delta, coarse) = match coarse_peaks(a, b, cfg, TranslationSearch::BranchAndBound) {
-        Ok(found) => found,
-        Err(reason) => return MapSearch::refuse(reason),
-    };
-    let hypotheses: Vec<MapHypothesis> = coarse
-        .iter()
-        .map(|&(pose, score)| judge(a, b, pose, score, cfg, verdict))
-        .collect();
-    decide(hypotheses, wall_centroid(b), delta, cfg)
+    let mut steps = MapSearchSteps::default();
+    loop {
+        if let Some(found) = steps.step(a, b, cfg, verdict) {
+            return found;
+        }
+    }
 }
 
 /// Step 4 of the module doc: one passing transform, clearly ahead of

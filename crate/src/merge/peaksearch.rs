@@ -181,10 +181,18 @@ impl Points {
             }
             let row = &m[y as usize * lw..][..lw];
             let xs = &self.xs[range.clone()];
-            // Columns inside the level: 0 <= cx + px < lw.
-            let lo = xs.partition_point(|&px| cx + px < 0);
-            let hi = xs.partition_point(|&px| cx + px < lw as i64);
-            for &px in &xs[lo..hi.max(lo)] {
+            // Columns inside the level: 0 <= cx + px < lw. Most rows lie
+            // wholly inside (xs ascend: the first and last tell); only the
+            // others need the two binary searches.
+            let (first, last) = (xs[0], xs[xs.len() - 1]);
+            let xs = if cx + first >= 0 && cx + last < lw as i64 {
+                xs
+            } else {
+                let lo = xs.partition_point(|&px| cx + px < 0);
+                let hi = xs.partition_point(|&px| cx + px < lw as i64);
+                &xs[lo..hi.max(lo)]
+            };
+            for &px in xs {
                 sum += row[(cx + px) as usize] as i32;
             }
         }

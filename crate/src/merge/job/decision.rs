@@ -14,8 +14,9 @@
 //! 2. **Searches** (budget only). The pairs that are not merged, not torn
 //!    between two transforms and ranked for it by coarse map overlap are
 //!    searched by the maps alone, likeliest first; a pair whose robots
-//!    merged pairs have already joined is skipped. One unit per pair in
-//!    that order.
+//!    merged pairs have already joined is skipped. One unit per step of a
+//!    search ([`MapSearchSteps`]: its start, each of four rotations, each
+//!    hypothesis judged), so that no call holds a whole search.
 //!
 //! Units are taken in the order one call would take them, and each reads
 //! only what the units before it wrote, so the outcome is the same however
@@ -24,6 +25,7 @@
 
 use super::{MergeJob, MergeStatus, PairOutcome};
 use crate::merge::frames::MergeInput;
+use crate::merge::mapsearch::MapSearchSteps;
 use crate::merge::pairbudget::{BudgetSummary, Components, PairPlan};
 
 /// The decision stage between two calls.
@@ -34,6 +36,8 @@ pub(super) struct Deciding {
     /// (`None` until every pair has its verdict), and how many are done.
     searches: Option<Vec<usize>>,
     searched: usize,
+    /// Budget only: the search under way, between its steps.
+    searching: Option<MapSearchSteps>,
     /// Budget only: the groups the merged pairs make so far.
     joined: Components,
     summary: BudgetSummary,
@@ -45,6 +49,7 @@ impl Deciding {
             outcomes: Vec::with_capacity(pairs),
             searches: None,
             searched: 0,
+            searching: None,
             joined: Components::new(robots),
             summary: BudgetSummary {
                 pairs,
@@ -86,8 +91,9 @@ impl MergeJob {
             }
             while done < units && d.searched < d.searches.as_ref().map_or(0, Vec::len) {
                 let k = d.searches.as_ref().map_or(0, |s| s[d.searched]);
-                self.search_pair(input, k, &mut d);
-                d.searched += 1;
+                if self.search_pair(input, k, &mut d) {
+                    d.searched += 1;
+                }
                 done += 1;
             }
         }
@@ -178,12 +184,13 @@ impl MergeJob {
         order
     }
 
-    /// Step 2 for pair `k`: searched by its maps, or skipped when its
-    /// robots are already joined.
-    fn search_pair(&self, input: &impl MergeInput, k: usize, d: &mut Deciding) {
+    /// One step of step 2 for pair `k`: skipped when its robots are
+    /// already joined, else the next step of its map search. Returns
+    /// whether the pair is done.
+    fn search_pair(&self, input: &impl MergeInput, k: usize, d: &mut Deciding) -> bool {
         let p = &self.pairs[k];
         let o = &mut d.outcomes[k];
-        if d.joined.same(p.a, p.b) {
+        if d.searching.is_none() && d.joined.same(p.a, p.b) {
             d.summary.searches_skipped += 1;
             o.reason = format!(
                 "{}; maps not searched: {} and {} are already joined through merged pairs",
@@ -194,14 +201,23 @@ impl MergeJob {
             } else {
                 "none"
             });
-            return;
+            return true;
         }
-        d.summary.maps_searched += 1;
-        *o = self
+        if d.searching.is_none() {
+            d.summary.maps_searched += 1;
+        }
+        let steps = d.searching.get_or_insert_with(MapSearchSteps::default);
+        let Some(searched) = self
             .method
-            .search_after(&self.pair_input(input, p, true), o.clone());
+            .search_step(&self.pair_input(input, p, true), o, steps)
+        else {
+            return false;
+        };
+        *o = searched;
+        d.searching = None;
         if o.status == MergeStatus::Merged {
             d.joined.join(p.a, p.b);
         }
+        true
     }
 }

@@ -15,7 +15,7 @@
 use super::{pose3, MethodStages, PairInput};
 use crate::geom::wrap_angle;
 use crate::merge::config::MergeConfig;
-use crate::merge::mapsearch::search_maps;
+use crate::merge::mapsearch::{MapSearch, MapSearchSteps};
 use crate::merge::pairbudget::{
     map_overlaps, partners_per_robot, plan_pairs, visual_votes, PairBudget, PairPlan,
 };
@@ -166,7 +166,21 @@ impl MethodStages for Auto {
 
     /// Vision found nothing the maps confirm (and was not torn between two
     /// transforms): ask the maps alone.
-    fn search_after(&self, pair: &PairInput, mut o: PairOutcome) -> PairOutcome {
+    fn search_after(&self, pair: &PairInput, o: PairOutcome) -> PairOutcome {
+        let mut steps = MapSearchSteps::default();
+        loop {
+            if let Some(done) = self.search_step(pair, &o, &mut steps) {
+                return done;
+            }
+        }
+    }
+
+    fn search_step(
+        &self,
+        pair: &PairInput,
+        o: &PairOutcome,
+        steps: &mut MapSearchSteps,
+    ) -> Option<PairOutcome> {
         let config = pair.config;
         let ambiguous = o.verdict.as_ref().is_some_and(|d| d.ambiguous);
         let Some(ms) = config
@@ -174,32 +188,37 @@ impl MethodStages for Auto {
             .as_ref()
             .filter(|_| o.status != MergeStatus::Merged && !ambiguous)
         else {
-            return o;
+            return Some(o.clone());
         };
-        let m = search_maps(pair.map_a, pair.map_b, ms, &config.verdict);
-        if m.status == MergeStatus::Merged {
-            o.status = MergeStatus::Merged;
-            o.pose = m.pose.as_ref().map(pose3);
-            o.confidence = m.confidence;
-            o.support = 0;
-            o.reason = format!("merged: {} (vision: {})", m.reason, o.reason);
-        } else {
-            o.reason = format!("{}; {}", o.reason, m.reason);
-        }
-        if let Some(d) = o.verdict.as_mut() {
-            d.status = o.status;
-            d.pose = m
-                .pose
-                .filter(|_| m.status == MergeStatus::Merged)
-                .or(d.pose);
-            d.confidence = o.confidence;
-            if m.status == MergeStatus::Merged {
-                d.support.clear();
-            }
-            d.reason = o.reason.clone();
-        }
-        o
+        let m = steps.step(pair.map_a, pair.map_b, ms, &config.verdict)?;
+        Some(with_search(o.clone(), m))
     }
+}
+
+/// A pair's outcome after the search of its maps alone found `m`.
+fn with_search(mut o: PairOutcome, m: MapSearch) -> PairOutcome {
+    if m.status == MergeStatus::Merged {
+        o.status = MergeStatus::Merged;
+        o.pose = m.pose.as_ref().map(pose3);
+        o.confidence = m.confidence;
+        o.support = 0;
+        o.reason = format!("merged: {} (vision: {})", m.reason, o.reason);
+    } else {
+        o.reason = format!("{}; {}", o.reason, m.reason);
+    }
+    if let Some(d) = o.verdict.as_mut() {
+        d.status = o.status;
+        d.pose = m
+            .pose
+            .filter(|_| m.status == MergeStatus::Merged)
+            .or(d.pose);
+        d.confidence = o.confidence;
+        if m.status == MergeStatus::Merged {
+            d.support.clear();
+        }
+        d.reason = o.reason.clone();
+    }
+    o
 }
 
 /// The pair budget of a run with many robots ([`crate::merge::pairbudget`]):

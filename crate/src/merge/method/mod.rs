@@ -23,6 +23,7 @@ pub mod map_only;
 pub mod thesis;
 
 use super::config::MergeConfig;
+use super::mapsearch::MapSearchSteps;
 use super::verify::{PairCheck, VerifyConfig};
 use super::work::{PairOutcome, PairWork, RobotFrames};
 use super::{FrameInfo, MergeMethod};
@@ -91,6 +92,18 @@ pub trait MethodStages: Sync {
     /// the maps alone. The default changes nothing.
     fn search_after(&self, _pair: &PairInput, decided: PairOutcome) -> PairOutcome {
         decided
+    }
+
+    /// [`MethodStages::search_after`] a step at a time, so that one search
+    /// need not be one long call ([`MapSearchSteps`]): `None` until the
+    /// last step, then the outcome. `steps` is fresh for each pair.
+    fn search_step(
+        &self,
+        pair: &PairInput,
+        decided: &PairOutcome,
+        _steps: &mut MapSearchSteps,
+    ) -> Option<PairOutcome> {
+        Some(self.search_after(pair, decided.clone()))
     }
 }
 
