@@ -414,21 +414,26 @@ test('your log: open a CARMEN log, step, play and pause it, see a loop closed, d
   await page.waitForFunction(() => window.slamlab.logView.snapshot().done === 5, null, { timeout: 60000 });
   assert.match(await page.locator('#log-progress').innerText(), /^scan 5 of 281 · 0 loop closures$/);
 
-  // Play fast until a loop is closed (the second lap meets the first).
+  // Play fast, then Pause early in the first lap: the step under way when
+  // Pause was pressed ends and no other starts. (Pausing is tested here,
+  // well before the end, so a fast machine cannot finish the replay first.)
   await page.locator('#log-speed').fill('20');
   await page.getByRole('button', { name: 'Play' }).click();
-  await page.waitForFunction(() => window.slamlab.logView.snapshot().closures > 0, null, { timeout: 300000, polling: 100 });
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().done >= 45, null, { timeout: 300000 });
+  await page.getByRole('button', { name: 'Pause' }).click();
+  await page.waitForFunction(() => !window.slamlab.logView.snapshot().busy);
+  const paused = await log();
+  assert.ok(paused.done >= 45 && paused.done < 281 && !paused.finished, `paused at scan ${paused.done}`);
+  await page.waitForTimeout(400);
+  assert.equal((await log()).done, paused.done, 'no scan is replayed while paused');
+  assert.match(await page.locator('#log-progress').innerText(), new RegExp(`^scan ${paused.done} of 281 · `));
+
+  // Play on until a loop is closed (the second lap meets the first), and to the end.
+  await page.getByRole('button', { name: 'Play' }).click();
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().closures > 0, null, { timeout: 300000 });
   const first = await log();
   assert.ok(first.done > 100 && first.done <= 281, `the first loop closed at scan ${first.done}`);
-  await page.getByRole('button', { name: 'Pause' }).click();
-  // The step under way when Pause was pressed ends; no other starts.
-  await page.waitForFunction(() => !window.slamlab.logView.snapshot().busy);
-  const paused = (await log()).done;
-  await page.waitForTimeout(400);
-  assert.equal((await log()).done, paused, 'no scan is replayed while paused');
   await page.screenshot({ path: path.join(ARTIFACTS, 'page-log-loop.png') });
-
-  await page.getByRole('button', { name: 'Play' }).click();
   await page.waitForFunction(() => window.slamlab.logView.snapshot().finished, null, { timeout: 300000, polling: 100 });
   const done = await log();
   assert.equal(done.done, 281);
