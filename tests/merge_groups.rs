@@ -137,39 +137,64 @@ fn each_group_map_is_fused_in_its_first_robots_frame(lab: &Lab) {
     assert_eq!(err, "there is no group 3: the merge found 3");
 }
 
-/// The decision stage, cut into single units as the page cuts it, comes
-/// out exactly as in one call (the command line's way), and it is cut:
-/// one unit per pair's verdict, then one per map search, with the stage's
-/// progress counting them.
+/// The proposal and decision stages, cut into single units as the page
+/// cuts them, come out exactly as in one call (the command line's way),
+/// and they are cut: the proposals one step for the vocabulary, then one
+/// per robot's bags, the votes, coarse map, coarse overlap and pair's
+/// to-do list; the decision one unit per pair's
+/// verdict, then one per map search step; each stage's progress counting
+/// them.
 #[wasm_bindgen_test(unsupported = test)]
-fn the_decision_a_unit_at_a_time_equals_the_decision_at_once() {
+fn the_merge_a_unit_at_a_time_equals_the_merge_at_once() {
     let mut lab = Lab::new(SCENARIO).expect("the scenario parses");
     lab.run_to_end().expect("runs");
     let mut report_of = |units: usize| {
         lab.merge_start(MergeMethod::Auto).expect("starts");
-        let mut decision_calls = 0;
-        let mut seen_total = 0;
+        let (mut decision_calls, mut proposal_calls) = (0, 0);
+        let (mut seen_total, mut proposal_total) = (0, 0);
         loop {
             let before = lab.merge_progress().expect("progress");
             if before.finished {
                 break;
             }
             let after = lab.merge_advance(units).expect("advances");
-            if before.stage == "decision" {
-                decision_calls += 1;
-                if after.stage == "decision" {
-                    assert!(after.done <= after.total, "{after:?}");
-                    seen_total = seen_total.max(after.total);
+            if after.stage == before.stage {
+                assert!(after.done <= after.total, "{after:?}");
+            }
+            match (before.stage, after.stage == before.stage) {
+                ("decision", same) => {
+                    decision_calls += 1;
+                    if same {
+                        seen_total = seen_total.max(after.total);
+                    }
                 }
+                ("proposals", same) => {
+                    proposal_calls += 1;
+                    if same {
+                        proposal_total = proposal_total.max(after.total);
+                    }
+                }
+                _ => {}
             }
         }
         let mut report = lab.merge_report().expect("a report");
         report.timings_ms = Default::default();
         let json = serde_json::to_string(&report).expect("serialises");
-        (json, decision_calls, seen_total)
+        (
+            json,
+            decision_calls,
+            seen_total,
+            proposal_calls,
+            proposal_total,
+        )
     };
-    let (whole, calls_whole, _) = report_of(usize::MAX);
-    let (cut, calls_cut, total) = report_of(1);
+    let (whole, calls_whole, _, proposals_whole, _) = report_of(usize::MAX);
+    let (cut, calls_cut, total, proposals_cut, proposals_total) = report_of(1);
+    assert_eq!(proposals_whole, 1, "one call proposes every pair");
+    // Five robots, over the budget's four: the vocabulary, five robots'
+    // bags, the votes, five coarse maps, ten overlaps, ten to-do lists.
+    assert_eq!(proposals_total, 32, "the proposal steps");
+    assert_eq!(proposals_cut, 32, "one call per proposal step");
     assert_eq!(calls_whole, 1, "one call decides every pair");
     // Five robots: ten pairs under the budget, then at least one search.
     assert!(total > 10, "the searches count as units: {total}");

@@ -19,7 +19,9 @@
 //!    every kept frame of the other (§6.2.3). The automatic method cannot
 //!    afford that on hundreds of frames, so a bag of visual words trained on
 //!    this run's descriptors proposes the pairs most likely to show the same
-//!    place ([`super::vocabulary`]).
+//!    place ([`super::vocabulary`]); with many robots a pair budget chooses
+//!    which pairs of robots to check at all ([`super::pairbudget`]). A step
+//!    at a time ([`super::method::auto::ProposalSteps`]).
 //! 4. **Verification.** Each proposed pair is matched (ratio test), fitted
 //!    with MSAC ([`super::verify`]); the inlier count fills one cell of the
 //!    table. One unit of work per pair.
@@ -43,6 +45,7 @@ use super::described::{describe_image, DescribedFrames};
 use super::frames::MergeInput;
 use super::fuse::fuse;
 use super::graph::{groups, spanning_tree, Joined, PairEdge};
+use super::method::auto::ProposalSteps;
 use super::method::{pose3, stages_of, MethodStages, PairInput};
 use super::pairbudget::{BudgetSummary, PairBudget, PairPlan};
 use super::verify::{verify_pair, PairCheck, VerifyConfig};
@@ -165,6 +168,8 @@ pub struct MergeJob {
     /// Frames described ahead, elsewhere ([`super::described`]): taken
     /// instead of describing them again.
     described: DescribedFrames,
+    /// The proposal stage between calls ([`ProposalSteps`]).
+    proposing: Option<ProposalSteps>,
     /// The decision stage between calls ([`decision`]).
     deciding: Option<decision::Deciding>,
 }
@@ -224,6 +229,7 @@ impl MergeJob {
             merged: None,
             times_ms: Default::default(),
             described: DescribedFrames::default(),
+            proposing: None,
             deciding: None,
         })
     }
@@ -266,6 +272,10 @@ impl MergeJob {
                 let done: usize = self.pairs.iter().map(|p| p.cells.len()).sum();
                 (done, total)
             }
+            Stage::Proposals => self
+                .proposing
+                .as_ref()
+                .map_or((0, 1), |p| p.progress(self.robots.len(), &self.config)),
             Stage::Decision => self
                 .deciding
                 .as_ref()
@@ -278,23 +288,15 @@ impl MergeJob {
     }
 
     /// Does up to `units` units of work (frames described, pairs checked,
-    /// pairs decided or searched; the proposal and fusion stages are one
-    /// unit each) without
+    /// proposal steps, pairs decided or searched; the fusion stage is one
+    /// unit) without
     /// leaving the current stage. `input` must be what the job was made
     /// from. Returns the units done (0 once finished).
     pub fn advance(&mut self, input: &impl MergeInput, units: usize) -> Result<usize, String> {
         let units = units.max(1);
         match self.stage {
             Stage::Features => Ok(self.advance_features(input, units)),
-            Stage::Proposals => {
-                let maps: Vec<&OccupancyGrid> = (0..self.robots.len())
-                    .map(|i| input.map(i, self.config.mapper))
-                    .collect();
-                self.method
-                    .propose(&self.robots, &mut self.pairs, &maps, &self.config);
-                self.stage = Stage::Matching;
-                Ok(1)
-            }
+            Stage::Proposals => Ok(self.advance_proposals(input, units)),
             Stage::Matching => Ok(self.advance_matching(units)),
             Stage::Decision => {
                 let done = self.advance_decision(input, units);
@@ -379,6 +381,26 @@ impl MergeJob {
             ^ ((ib.index as u64) << 40)
             ^ ((a * 16 + b) as u64);
         Some(verify_pair(&self.camera, ia, fa, ib, fb, verify, seed))
+    }
+
+    /// Up to `units` steps of the method's proposals ([`ProposalSteps`]);
+    /// on to matching once every pair's to-do list is filled.
+    fn advance_proposals(&mut self, input: &impl MergeInput, units: usize) -> usize {
+        let maps: Vec<&OccupancyGrid> = (0..self.robots.len())
+            .map(|i| input.map(i, self.config.mapper))
+            .collect();
+        let steps = self.proposing.get_or_insert_with(ProposalSteps::default);
+        for done in 1..=units {
+            if self
+                .method
+                .propose_step(&self.robots, &mut self.pairs, &maps, &self.config, steps)
+            {
+                self.proposing = None;
+                self.stage = Stage::Matching;
+                return done;
+            }
+        }
+        units
     }
 
     fn advance_matching(&mut self, units: usize) -> usize {

@@ -471,20 +471,19 @@ fn correlate(a: &Raster, b: &Raster) -> Correlation {
 /// A map prepared once for the coarse comparisons of many pairs
 /// ([`super::pairbudget`]): its wall spectrum and its raster at the
 /// coarse cell in its own axes (the part of [`coarse_overlap`] that does
-/// not depend on the other map).
-pub struct CoarseMap<'g> {
-    grid: &'g OccupancyGrid,
+/// not depend on the other map). It owns what it holds, so a caller that
+/// works a step at a time can keep it between calls.
+pub struct CoarseMap {
     spectrum: WallSpectrum,
     cell_m: f64,
     raster: Option<Raster>,
 }
 
-impl<'g> CoarseMap<'g> {
+impl CoarseMap {
     /// `grid` drawn at `cell_m` (at least its own cell).
-    pub fn new(grid: &'g OccupancyGrid, cell_m: f64, free_penalty: i32) -> CoarseMap<'g> {
+    pub fn new(grid: &OccupancyGrid, cell_m: f64, free_penalty: i32) -> CoarseMap {
         let cell_m = cell_m.max(grid.resolution_m());
         CoarseMap {
-            grid,
             spectrum: WallSpectrum::of(grid),
             cell_m,
             raster: Raster::draw(grid, 0.0, cell_m, free_penalty),
@@ -502,7 +501,14 @@ impl<'g> CoarseMap<'g> {
 /// for [`super::pairbudget`], never a reason to merge: a maze's lattice
 /// lays unrelated maps partly on each other too. (At this coarse cell the
 /// exhaustive correlation is cheaper than the branch and bound's bounds.)
-pub fn coarse_overlap(a: &CoarseMap, b: &CoarseMap, free_penalty: i32) -> f64 {
+/// `grid_b` is the map `b` was made from: B is drawn turned for each
+/// rotation.
+pub fn coarse_overlap(
+    a: &CoarseMap,
+    b: &CoarseMap,
+    grid_b: &OccupancyGrid,
+    free_penalty: i32,
+) -> f64 {
     let Some(delta) = rotation_between(&a.spectrum, &b.spectrum) else {
         return 0.0;
     };
@@ -513,7 +519,7 @@ pub fn coarse_overlap(a: &CoarseMap, b: &CoarseMap, free_penalty: i32) -> f64 {
     let mut walls_b = 0;
     for k in 0..4 {
         let theta = wrap_angle(delta + k as f64 * FRAC_PI_2);
-        let Some(rb) = Raster::draw(b.grid, theta, a.cell_m, free_penalty) else {
+        let Some(rb) = Raster::draw(grid_b, theta, a.cell_m, free_penalty) else {
             return 0.0;
         };
         walls_b = rb.walls.len();

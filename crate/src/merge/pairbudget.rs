@@ -172,23 +172,86 @@ fn best_of_others(scores: &[f64], owner: &[usize], me: usize, k: usize) -> Vec<u
     best
 }
 
-/// The coarse map overlap of every pair of robots (step 2 of the module
-/// doc): `out[a][b]`, symmetric (computed for `a < b`), 0 on the diagonal.
-pub fn map_overlaps(maps: &[&OccupancyGrid], cfg: &PairBudgetConfig) -> Vec<Vec<f64>> {
-    let n = maps.len();
-    let coarse: Vec<CoarseMap> = maps
-        .iter()
-        .map(|m| CoarseMap::new(m, cfg.coarse_cell_m, cfg.free_penalty))
-        .collect();
-    let mut out = vec![vec![0.0; n]; n];
-    for a in 0..n {
-        for b in a + 1..n {
-            let s = coarse_overlap(&coarse[a], &coarse[b], cfg.free_penalty);
-            out[a][b] = s;
-            out[b][a] = s;
+/// The whole budget (steps 1 to 3 of the module doc) a step at a time, so
+/// that a caller with a page to draw never waits for all of it: the visual
+/// votes, then each robot's coarse map (its spectrum and raster,
+/// [`CoarseMap`]), then each pair's coarse overlap (step 2; 120 pairs for
+/// sixteen robots, tens of milliseconds each on 60 m maps), then the plan.
+/// Run to the end it is the same budget however the steps are spread over
+/// calls.
+pub struct BudgetSteps {
+    /// Partners kept per robot (`k`).
+    k: usize,
+    votes: Option<Vec<Vec<f64>>>,
+    coarse: Vec<CoarseMap>,
+    /// `overlaps[a][b]`, symmetric, filled pair by pair.
+    overlaps: Vec<Vec<f64>>,
+    /// The next pair whose overlap is computed, `a < b`.
+    next: (usize, usize),
+    pairs_done: usize,
+}
+
+impl BudgetSteps {
+    /// The budget of `robots` robots keeping `k` partners each.
+    pub fn new(robots: usize, k: usize) -> BudgetSteps {
+        BudgetSteps {
+            k,
+            votes: None,
+            coarse: Vec::with_capacity(robots),
+            overlaps: vec![vec![0.0; robots]; robots],
+            next: (0, 1),
+            pairs_done: 0,
         }
     }
-    out
+
+    /// Steps in all for `robots` robots: the votes, a coarse map each, an
+    /// overlap per pair.
+    pub fn total(robots: usize) -> usize {
+        1 + robots + robots * robots.saturating_sub(1) / 2
+    }
+
+    /// Steps taken so far.
+    pub fn done(&self) -> usize {
+        usize::from(self.votes.is_some()) + self.coarse.len() + self.pairs_done
+    }
+
+    /// One step; the plan of every pair `(a, b)`, `a < b`, in that order,
+    /// once the last overlap is in. `bags[r]` holds robot `r`'s frames'
+    /// bags and `maps[r]` its map, the same on every call.
+    pub fn step(
+        &mut self,
+        bags: &[Vec<Bag>],
+        maps: &[&OccupancyGrid],
+        cfg: &PairBudgetConfig,
+    ) -> Option<Vec<PairBudget>> {
+        let n = maps.len();
+        let Some(votes) = &self.votes else {
+            self.votes = Some(visual_votes(bags, cfg.votes_per_frame));
+            return None;
+        };
+        if self.coarse.len() < n {
+            let map = maps[self.coarse.len()];
+            self.coarse
+                .push(CoarseMap::new(map, cfg.coarse_cell_m, cfg.free_penalty));
+            return None;
+        }
+        let (a, b) = self.next;
+        if b < n {
+            let s = coarse_overlap(&self.coarse[a], &self.coarse[b], maps[b], cfg.free_penalty);
+            self.overlaps[a][b] = s;
+            self.overlaps[b][a] = s;
+            self.pairs_done += 1;
+            self.next = if b + 1 < n {
+                (a, b + 1)
+            } else {
+                (a + 1, a + 2)
+            };
+            if self.next.1 < n {
+                return None;
+            }
+        }
+        Some(plan_pairs(votes, &self.overlaps, self.k))
+    }
 }
 
 /// Robot `a`'s partners by `figure[a]`, best first (positive figures only;

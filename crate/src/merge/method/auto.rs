@@ -12,20 +12,18 @@
 //! confirm, and was not torn between two, the maps alone are searched
 //! ([`crate::merge::mapsearch`]) and judged as strictly.
 
+mod proposals;
+
 use super::{pose3, MethodStages, PairInput};
 use crate::geom::wrap_angle;
 use crate::merge::config::MergeConfig;
 use crate::merge::mapsearch::{MapSearch, MapSearchSteps};
-use crate::merge::pairbudget::{
-    map_overlaps, partners_per_robot, plan_pairs, visual_votes, PairBudget, PairPlan,
-};
 use crate::merge::verdict::{decide_pair_after_search, SearchSummary};
 use crate::merge::verify::{PairCheck, VerifyConfig};
-use crate::merge::vocabulary::{propose_pairs, Bag, Vocabulary};
 use crate::merge::work::{PairOutcome, PairWork, RobotFrames};
 use crate::merge::{Candidate, FrameInfo, MergeStatus};
 use crate::slam::OccupancyGrid;
-use crate::surf::Features;
+pub use proposals::ProposalSteps;
 use std::collections::HashMap;
 
 /// The `auto` method.
@@ -79,7 +77,8 @@ impl MethodStages for Auto {
     /// The vocabulary's proposals: trained on every described frame of
     /// every robot, then each robot pair's frames nominate their partners.
     /// With many robots only the pairs the budget keeps are proposed
-    /// ([`pair_budget`]).
+    /// ([`crate::merge::pairbudget`]). The steps of [`proposals`] run to
+    /// the end.
     fn propose(
         &self,
         robots: &[RobotFrames],
@@ -87,32 +86,19 @@ impl MethodStages for Auto {
         maps: &[&OccupancyGrid],
         config: &MergeConfig,
     ) {
-        let sets: Vec<&Features> = robots.iter().flat_map(|r| r.features.iter()).collect();
-        let vocabulary = Vocabulary::train(&sets, &config.vocabulary, config.seed ^ 0x766f_6361);
-        let bags: Vec<Vec<Bag>> = robots
-            .iter()
-            .map(|r| r.features.iter().map(|f| vocabulary.bag(f)).collect())
-            .collect();
-        let budget = pair_budget(robots, &bags, maps, config);
-        let n = robots.len();
-        for p in pairs {
-            // Pairs (a, b), a < b, in order: the index of (a, b).
-            p.budget = budget
-                .as_ref()
-                .and_then(|b| b.get(p.a * n - p.a * (p.a + 1) / 2 + p.b - p.a - 1))
-                .copied();
-            if p.budget.is_some_and(|b| b.plan != PairPlan::Full) {
-                p.todo.clear();
-                continue;
-            }
-            let proposals = propose_pairs(
-                &bags[p.a],
-                &bags[p.b],
-                config.proposals_per_frame,
-                config.max_pairs,
-            );
-            p.todo = proposals.into_iter().map(|(i, j, _)| (i, j)).collect();
-        }
+        let mut steps = ProposalSteps::default();
+        while !proposals::step(&mut steps, robots, pairs, maps, config) {}
+    }
+
+    fn propose_step(
+        &self,
+        robots: &[RobotFrames],
+        pairs: &mut [PairWork],
+        maps: &[&OccupancyGrid],
+        config: &MergeConfig,
+        steps: &mut ProposalSteps,
+    ) -> bool {
+        proposals::step(steps, robots, pairs, maps, config)
     }
 
     /// The decision rests on the rigid fit alone: the homography (the
@@ -219,25 +205,4 @@ fn with_search(mut o: PairOutcome, m: MapSearch) -> PairOutcome {
         d.reason = o.reason.clone();
     }
     o
-}
-
-/// The pair budget of a run with many robots ([`crate::merge::pairbudget`]):
-/// each pair's plan, in the order (a, b), a < b; `None` (every pair in
-/// full) up to `all_pairs_up_to` robots.
-fn pair_budget(
-    robots: &[RobotFrames],
-    bags: &[Vec<Bag>],
-    maps: &[&OccupancyGrid],
-    config: &MergeConfig,
-) -> Option<Vec<PairBudget>> {
-    let cfg = &config.pair_budget;
-    let n = robots.len();
-    if n <= cfg.all_pairs_up_to || maps.len() != n {
-        return None;
-    }
-    let frames: usize = robots.iter().map(|r| r.selected.len()).sum();
-    let k = partners_per_robot(n, frames as f64 / n as f64);
-    let votes = visual_votes(bags, cfg.votes_per_frame);
-    let overlaps = map_overlaps(maps, cfg);
-    Some(plan_pairs(&votes, &overlaps, k))
 }

@@ -29,6 +29,7 @@ use super::work::{PairOutcome, PairWork, RobotFrames};
 use super::{FrameInfo, MergeMethod};
 use crate::camera::PinholeCamera;
 use crate::slam::OccupancyGrid;
+use auto::ProposalSteps;
 
 /// What the decision on one pair of robots reads: both robots' frames
 /// (empty for a method that reads the maps only), the checked cells, both
@@ -73,6 +74,22 @@ pub trait MethodStages: Sync {
         _maps: &[&OccupancyGrid],
         _config: &MergeConfig,
     ) {
+    }
+
+    /// [`MethodStages::propose`] a step at a time, so that the stage need
+    /// not be one long call (the automatic method's vocabulary, then its
+    /// pair budget piece by piece, [`ProposalSteps`]): true once every
+    /// to-do list is filled. `steps` is fresh for each job.
+    fn propose_step(
+        &self,
+        robots: &[RobotFrames],
+        pairs: &mut [PairWork],
+        maps: &[&OccupancyGrid],
+        config: &MergeConfig,
+        _steps: &mut ProposalSteps,
+    ) -> bool {
+        self.propose(robots, pairs, maps, config);
+        true
     }
 
     /// The verification settings of the matching stage (a pair the user
