@@ -95,10 +95,11 @@
 mod steps;
 
 pub use steps::MapSearchSteps;
+use steps::RotationSearch;
 
 use super::align::refine_alignment;
 use super::correlation::{add_row, Correlation};
-use super::peaksearch::{best_translations, pyramid_of, MaxPyramid, ScoreImage};
+use super::peaksearch::ScoreImage;
 use super::verdict::{contradiction_reason, map_agreement, Agreement, VerdictConfig};
 use super::MergeStatus;
 use crate::geom::{wrap_angle, Pose2};
@@ -259,7 +260,8 @@ pub fn dominant_rotation(a: &OccupancyGrid, b: &OccupancyGrid) -> Option<f64> {
 }
 
 /// A map's folded Hough spectrum ([`hough_spectrum`]), computed once per
-/// map when many pairs are compared ([`super::pairbudget`]).
+/// map when many pairs are compared ([`super::pairbudget`], and the
+/// searches of [`MapSearchSteps::with_spectra`]).
 #[derive(Clone, Debug)]
 pub struct WallSpectrum {
     folded: Vec<f64>,
@@ -603,31 +605,6 @@ fn wall_centroid(grid: &OccupancyGrid) -> DVec2 {
     cells.iter().copied().sum::<DVec2>() / cells.len() as f64
 }
 
-/// [`best_translations`] on two rasters, as translations with
-/// [`correlate`]'s offset; `a_max` is A's pyramid, built for the first
-/// rotation and kept. The pyramids hold cell scores in a byte: a
-/// `free_penalty` beyond that falls back to the exhaustive correlation.
-fn branch_and_bound(
-    a: &Raster,
-    a_max: &mut Option<Option<MaxPyramid>>,
-    b: &Raster,
-    count: usize,
-    apart: f64,
-) -> Vec<([i64; 2], i32)> {
-    let t0 = translation_origin(a, b);
-    let found = a_max
-        .get_or_insert_with(|| pyramid_of(&a.image()))
-        .as_mut()
-        .and_then(|m| best_translations(a.image(), m, b.image(), count, apart));
-    match found {
-        Some(peaks) => peaks
-            .into_iter()
-            .map(|(i, v)| ([i[0] + t0[0], i[1] + t0[1]], v))
-            .collect(),
-        None => correlate(a, b).peaks(count, apart),
-    }
-}
-
 /// How [`coarse_peaks`] finds the best translations of each rotation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TranslationSearch {
@@ -650,23 +627,25 @@ pub fn coarse_peaks(
     cfg: &MapSearchConfig,
     how: TranslationSearch,
 ) -> Result<(f64, Vec<(Pose2, i64)>), String> {
-    let (delta, ra) = coarse_start(a, b, cfg)?;
+    let (delta, ra) = coarse_start(a, &WallSpectrum::of(a), &WallSpectrum::of(b), cfg)?;
     let mut a_max = None;
     let mut coarse: Vec<(Pose2, i64)> = Vec::new();
     for k in 0..4 {
-        coarse.extend(coarse_rotation(a, &ra, &mut a_max, b, delta, k, cfg, how)?);
+        let mut rotation = RotationSearch::start(a, &ra, &mut a_max, b, delta, k, cfg, how)?;
+        coarse.extend(rotation.run_to_end(&mut a_max));
     }
     Ok((delta, coarse_ranked(coarse, cfg)))
 }
 
-/// Step 1 of [`coarse_peaks`]: the rotation from the wall directions, and
-/// A drawn unturned.
+/// Step 1 of [`coarse_peaks`]: the rotation from the wall directions
+/// (`sa`, `sb`: the two maps' spectra), and A drawn unturned.
 fn coarse_start(
     a: &OccupancyGrid,
-    b: &OccupancyGrid,
+    sa: &WallSpectrum,
+    sb: &WallSpectrum,
     cfg: &MapSearchConfig,
 ) -> Result<(f64, Raster), String> {
-    let Some(delta) = dominant_rotation(a, b) else {
+    let Some(delta) = rotation_between(sa, sb) else {
         return Err("maps alone: too few walls to find their directions".into());
     };
     let cell = cfg.cell_m.max(a.resolution_m());
@@ -674,41 +653,6 @@ fn coarse_start(
         return Err("maps alone: a map is empty".into());
     };
     Ok((delta, ra))
-}
-
-/// Step 2 of [`coarse_peaks`] for rotation `k` of four: B turned by
-/// `delta + k·90°`, and its best translations over A's raster `ra`
-/// (`a_max`, A's pyramid, is built at the first rotation and kept).
-#[allow(clippy::too_many_arguments)]
-fn coarse_rotation(
-    a: &OccupancyGrid,
-    ra: &Raster,
-    a_max: &mut Option<Option<MaxPyramid>>,
-    b: &OccupancyGrid,
-    delta: f64,
-    k: usize,
-    cfg: &MapSearchConfig,
-    how: TranslationSearch,
-) -> Result<Vec<(Pose2, i64)>, String> {
-    let cell = cfg.cell_m.max(a.resolution_m());
-    let apart = cfg.distinct_m / cell;
-    let theta = wrap_angle(delta + k as f64 * FRAC_PI_2);
-    let Some(rb) = Raster::draw(b, theta, cell, cfg.free_penalty) else {
-        return Err("maps alone: a map is empty".into());
-    };
-    let peaks = match how {
-        TranslationSearch::Exhaustive => correlate(ra, &rb).peaks(cfg.peaks_per_rotation, apart),
-        TranslationSearch::BranchAndBound => {
-            branch_and_bound(ra, a_max, &rb, cfg.peaks_per_rotation, apart)
-        }
-    };
-    Ok(peaks
-        .into_iter()
-        .map(|(t, score)| {
-            let pose = Pose2::new(t[0] as f64 * cell, t[1] as f64 * cell, theta);
-            (pose, score as i64)
-        })
-        .collect())
 }
 
 /// Step 3 of [`coarse_peaks`]: every rotation's peaks, strongest first

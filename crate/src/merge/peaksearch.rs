@@ -55,6 +55,12 @@
 //!    search stops when `count` peaks are kept or the best bound left is
 //!    not positive (only positive maxima count).
 //!
+//! The queue and the peaks kept are all the search's state, so it can stop
+//! between two entries and go on later: [`PeakSearch::run`] does about as
+//! many pyramid lookups as it is given, and the map search takes one
+//! rotation's search in such pieces so that the page can draw between
+//! them ([`super::mapsearch::MapSearchSteps`]).
+//!
 //! Each bound costs one lookup per wall cell of both maps, so the saving
 //! depends on how fast the bounds fall below the peaks kept; the
 //! benchmark in BENCHMARKS.md ("The map search, branch and bound") has the
@@ -77,7 +83,8 @@ pub struct ScoreImage<'a> {
 
 /// The max images `M_{2^k}` of one score image, `k = 0, 1, …`: level `k`
 /// covers `x ∈ [−(2^k − 1), width)` (and the same in y), stored shifted
-/// by `2^k − 1`, row by row.
+/// by `2^k − 1`, row by row. (The default is empty: a placeholder.)
+#[derive(Default)]
 pub struct MaxPyramid {
     width: usize,
     height: usize,
@@ -230,39 +237,43 @@ impl PartialOrd for Entry {
 }
 
 /// The search over translation indices `i ∈ [0, nx) × [0, ny)`: the
-/// score's two sums, each a point set over a pyramid.
-struct Search<'p> {
-    terms: [(&'p MaxPyramid, Points); 2],
+/// score's two sums, each a point set over a pyramid (A's, passed in by
+/// the caller, who keeps it across B's rotations; B's turned, owned).
+struct Search {
+    b_max: MaxPyramid,
+    /// B's walls over A's pyramid, and A's walls over B's.
+    on_a: Points,
+    on_b: Points,
     nx: i64,
     ny: i64,
     exact: HashMap<[i64; 2], i32>,
+    /// Pyramid lookups so far: the measure of work done.
+    lookups: u64,
 }
 
-impl Search<'_> {
-    fn bound(&self, k: usize, c: [i64; 2]) -> i32 {
-        self.terms
-            .iter()
-            .map(|(pyramid, points)| points.bound(pyramid, k, c))
-            .sum()
+impl Search {
+    fn bound(&mut self, a_max: &MaxPyramid, k: usize, c: [i64; 2]) -> i32 {
+        self.lookups += (self.on_a.xs.len() + self.on_b.xs.len()) as u64;
+        self.on_a.bound(a_max, k, c) + self.on_b.bound(&self.b_max, k, c)
     }
 
-    fn score(&mut self, i: [i64; 2]) -> i32 {
+    fn score(&mut self, a_max: &MaxPyramid, i: [i64; 2]) -> i32 {
         if let Some(&v) = self.exact.get(&i) {
             return v;
         }
-        let v = self.bound(0, i);
+        let v = self.bound(a_max, 0, i);
         self.exact.insert(i, v);
         v
     }
 
     /// [`super::correlation::Correlation::peaks`]'s local maximum rule.
-    fn is_local_max(&mut self, i: [i64; 2], v: i32) -> bool {
+    fn is_local_max(&mut self, a_max: &MaxPyramid, i: [i64; 2], v: i32) -> bool {
         for dy in 0..3 {
             for dx in 0..3 {
                 if (dy, dx) == (1, 1) {
                     continue;
                 }
-                let w = self.score([i[0] + dx - 1, i[1] + dy - 1]);
+                let w = self.score(a_max, [i[0] + dx - 1, i[1] + dy - 1]);
                 if !(w < v || (w == v && (dy, dx) >= (1, 1))) {
                     return false;
                 }
@@ -299,88 +310,133 @@ pub fn pyramid_of(image: &ScoreImage) -> Option<MaxPyramid> {
     })
 }
 
-/// The best `count` positive local maxima of the correlation of B's
-/// raster over A's, at least `apart` translation cells from each other,
-/// as (translation index, score): exactly what
-/// [`super::correlation::Correlation::peaks`] returns on the exhaustive
-/// correlation (indices there are these plus its `t0`). `a_max` is A's
-/// pyramid ([`pyramid_of`]), kept by the caller across B's rotations.
-/// `None` when one of B's scores does not fit a byte.
-pub fn best_translations(
-    a: ScoreImage,
-    a_max: &mut MaxPyramid,
-    b: ScoreImage,
+/// [`best_translations`] a piece at a time: the search's queue and the
+/// peaks kept so far live here between calls of [`PeakSearch::run`], so a
+/// caller with a page to draw can stop after a bounded amount of work and
+/// go on later. The peaks do not depend on how the work is cut.
+pub struct PeakSearch {
+    search: Search,
+    queue: BinaryHeap<Entry>,
+    out: Vec<([i64; 2], i32)>,
     count: usize,
     apart: f64,
-) -> Option<Vec<([i64; 2], i32)>> {
-    let nx = (a.width + b.width - 1) as i64;
-    let ny = (a.height + b.height - 1) as i64;
-    if count == 0 || nx < 3 || ny < 3 {
-        return Some(Vec::new());
-    }
-    // The coarsest level tiles the translations with about 8 × 8 blocks.
-    let top = (64 - ((nx.max(ny) - 1) as u64).leading_zeros() as usize).saturating_sub(3);
-    // B turned by 180°, so that A's wall l meets B's cell i − l as a
-    // window of translations too.
-    let (bw, bh) = (b.width, b.height);
-    let mut b_max = MaxPyramid::new(bw, bh, |x, y| b.score[(bh - 1 - y) * bw + bw - 1 - x])?;
-    a_max.ensure(top);
-    b_max.ensure(top);
-    // B's wall l lands on A's cell i + l − (b.size − 1); A's wall l on
-    // the turned B's cell i − l.
-    let (bw, bh) = (bw as i64, bh as i64);
-    let on_a: Vec<[i64; 2]> = b
-        .walls
-        .iter()
-        .map(|&[x, y]| [x as i64 - (bw - 1), y as i64 - (bh - 1)])
-        .collect();
-    let on_b: Vec<[i64; 2]> = a
-        .walls
-        .iter()
-        .map(|&[x, y]| [-(x as i64), -(y as i64)])
-        .collect();
-    let mut search = Search {
-        terms: [(&*a_max, Points::new(on_a)), (&b_max, Points::new(on_b))],
-        nx,
-        ny,
-        exact: HashMap::new(),
-    };
-    Some(best_first(&mut search, top, count, apart))
 }
 
-/// Steps 2 and 3 of the module doc.
-fn best_first(search: &mut Search, top: usize, count: usize, apart: f64) -> Vec<([i64; 2], i32)> {
-    let (nx, ny) = (search.nx, search.ny);
-    let mut queue = BinaryHeap::new();
-    let s = 1i64 << top;
-    for by in 0..(ny + s - 1) / s {
-        for bx in 0..(nx + s - 1) / s {
-            let value = search.bound(top, [bx * s, by * s]);
-            queue.push(Entry {
-                value,
-                level: top,
-                at: [bx, by],
-            });
+impl PeakSearch {
+    /// The search of B's raster over A's for the best `count` positive
+    /// local maxima at least `apart` apart (see [`best_translations`]),
+    /// with the coarsest level's blocks queued. `a_max` is A's pyramid
+    /// ([`pyramid_of`]), the same one on every [`PeakSearch::run`]. `None`
+    /// when one of B's scores does not fit a byte.
+    pub fn new(
+        a: ScoreImage,
+        a_max: &mut MaxPyramid,
+        b: ScoreImage,
+        count: usize,
+        apart: f64,
+    ) -> Option<PeakSearch> {
+        let nx = (a.width + b.width - 1) as i64;
+        let ny = (a.height + b.height - 1) as i64;
+        // The coarsest level tiles the translations with about 8 × 8 blocks.
+        let top =
+            (64 - ((nx.max(ny) - 1).max(0) as u64).leading_zeros() as usize).saturating_sub(3);
+        // B turned by 180°, so that A's wall l meets B's cell i − l as a
+        // window of translations too.
+        let (bw, bh) = (b.width, b.height);
+        let mut b_max = MaxPyramid::new(bw, bh, |x, y| b.score[(bh - 1 - y) * bw + bw - 1 - x])?;
+        let mut queue = BinaryHeap::new();
+        let trivial = count == 0 || nx < 3 || ny < 3;
+        if !trivial {
+            a_max.ensure(top);
+            b_max.ensure(top);
         }
-    }
-    let mut out: Vec<([i64; 2], i32)> = Vec::new();
-    while let Some(e) = queue.pop() {
-        if e.value <= 0 || out.len() >= count {
-            break;
-        }
-        if e.level == 0 {
-            let i = e.at;
-            if !near(i, &out, apart) && search.is_local_max(i, e.value) {
-                out.push((i, e.value));
-            }
-            continue;
-        }
-        if out
+        // B's wall l lands on A's cell i + l − (b.size − 1); A's wall l on
+        // the turned B's cell i − l.
+        let (bw, bh) = (bw as i64, bh as i64);
+        let on_a: Vec<[i64; 2]> = b
+            .walls
             .iter()
-            .any(|(u, _)| block_within(e.level, e.at, *u, apart))
-        {
-            continue;
+            .map(|&[x, y]| [x as i64 - (bw - 1), y as i64 - (bh - 1)])
+            .collect();
+        let on_b: Vec<[i64; 2]> = a
+            .walls
+            .iter()
+            .map(|&[x, y]| [-(x as i64), -(y as i64)])
+            .collect();
+        let mut search = Search {
+            b_max,
+            on_a: Points::new(on_a),
+            on_b: Points::new(on_b),
+            nx,
+            ny,
+            exact: HashMap::new(),
+            lookups: 0,
+        };
+        if !trivial {
+            // Step 2 of the module doc begins: the coarsest blocks.
+            let s = 1i64 << top;
+            for by in 0..(ny + s - 1) / s {
+                for bx in 0..(nx + s - 1) / s {
+                    let value = search.bound(a_max, top, [bx * s, by * s]);
+                    queue.push(Entry {
+                        value,
+                        level: top,
+                        at: [bx, by],
+                    });
+                }
+            }
         }
+        Some(PeakSearch {
+            search,
+            queue,
+            out: Vec::new(),
+            count,
+            apart,
+        })
+    }
+
+    /// Pyramid lookups made so far (each wall of both maps, per bound).
+    pub fn lookups(&self) -> u64 {
+        self.search.lookups
+    }
+
+    /// Steps 2 and 3 of the module doc until the peaks are found, or until
+    /// about `work` more pyramid lookups are made (it stops between two
+    /// queue entries); the peaks, as [`best_translations`] returns them,
+    /// once found.
+    pub fn run(&mut self, a_max: &MaxPyramid, work: u64) -> Option<Vec<([i64; 2], i32)>> {
+        let until = self.search.lookups.saturating_add(work);
+        let (count, apart) = (self.count, self.apart);
+        while self.search.lookups < until {
+            let Some(e) = self.queue.pop() else {
+                return Some(std::mem::take(&mut self.out));
+            };
+            if e.value <= 0 || self.out.len() >= count {
+                self.queue.clear();
+                return Some(std::mem::take(&mut self.out));
+            }
+            if e.level == 0 {
+                let i = e.at;
+                if !near(i, &self.out, apart) && self.search.is_local_max(a_max, i, e.value) {
+                    self.out.push((i, e.value));
+                }
+                continue;
+            }
+            if self
+                .out
+                .iter()
+                .any(|(u, _)| block_within(e.level, e.at, *u, apart))
+            {
+                continue;
+            }
+            self.open(a_max, e);
+        }
+        None
+    }
+
+    /// Splits a block into its four children and queues their bounds.
+    fn open(&mut self, a_max: &MaxPyramid, e: Entry) {
+        let search = &mut self.search;
         let k = e.level - 1;
         let sk = 1i64 << k;
         for cy in 0..2 {
@@ -397,11 +453,11 @@ fn best_first(search: &mut Search, top: usize, count: usize, apart: f64) -> Vec<
                     continue;
                 }
                 let value = if k == 0 {
-                    search.score(c)
+                    search.score(a_max, c)
                 } else {
-                    search.bound(k, c)
+                    search.bound(a_max, k, c)
                 };
-                queue.push(Entry {
+                self.queue.push(Entry {
                     value,
                     level: k,
                     at,
@@ -409,7 +465,25 @@ fn best_first(search: &mut Search, top: usize, count: usize, apart: f64) -> Vec<
             }
         }
     }
-    out
+}
+
+/// The best `count` positive local maxima of the correlation of B's
+/// raster over A's, at least `apart` translation cells from each other,
+/// as (translation index, score): exactly what
+/// [`super::correlation::Correlation::peaks`] returns on the exhaustive
+/// correlation (indices there are these plus its `t0`). `a_max` is A's
+/// pyramid ([`pyramid_of`]), kept by the caller across B's rotations.
+/// `None` when one of B's scores does not fit a byte. [`PeakSearch`] run
+/// to the end.
+pub fn best_translations(
+    a: ScoreImage,
+    a_max: &mut MaxPyramid,
+    b: ScoreImage,
+    count: usize,
+    apart: f64,
+) -> Option<Vec<([i64; 2], i32)>> {
+    let mut search = PeakSearch::new(a, a_max, b, count, apart)?;
+    Some(search.run(a_max, u64::MAX).unwrap_or_default())
 }
 
 #[cfg(test)]
@@ -551,6 +625,21 @@ mod tests {
         assert_eq!(
             best_translations(a, &mut a_max, b, count, apart),
             Some(want.clone())
+        );
+        // Cut into pieces of a few bounds each, the same peaks.
+        let mut piecewise = PeakSearch::new(a, &mut a_max, b, count, apart).expect("fits");
+        let piece = (wa.len() + wb.len()) as u64 * 3;
+        let mut pieces = 1;
+        let got = loop {
+            match piecewise.run(&a_max, piece) {
+                Some(peaks) => break peaks,
+                None => pieces += 1,
+            }
+        };
+        assert_eq!(got, want, "in {pieces} pieces");
+        assert!(
+            want.is_empty() || pieces > 3,
+            "the work is cut: {pieces} pieces"
         );
         want.len()
     }

@@ -15,8 +15,10 @@
 //!    between two transforms and ranked for it by coarse map overlap are
 //!    searched by the maps alone, likeliest first; a pair whose robots
 //!    merged pairs have already joined is skipped. One unit per step of a
-//!    search ([`MapSearchSteps`]: its start, each of four rotations, each
-//!    hypothesis judged), so that no call holds a whole search.
+//!    search ([`MapSearchSteps`]: each map's wall spectrum, the start, each
+//!    rotation's translation search in pieces, each hypothesis judged), so
+//!    that no call holds a whole search. A map's spectrum is computed
+//!    once and kept for its later searches.
 //!
 //! Units are taken in the order one call would take them, and each reads
 //! only what the units before it wrote, so the outcome is the same however
@@ -25,7 +27,7 @@
 
 use super::{MergeJob, MergeStatus, PairOutcome};
 use crate::merge::frames::MergeInput;
-use crate::merge::mapsearch::MapSearchSteps;
+use crate::merge::mapsearch::{MapSearchSteps, WallSpectrum};
 use crate::merge::pairbudget::{BudgetSummary, Components, PairPlan};
 
 /// The decision stage between two calls.
@@ -38,6 +40,9 @@ pub(super) struct Deciding {
     searched: usize,
     /// Budget only: the search under way, between its steps.
     searching: Option<MapSearchSteps>,
+    /// Budget only: each robot's map's wall spectrum, once a search has
+    /// computed it (a map is searched against several others).
+    spectra: Vec<Option<WallSpectrum>>,
     /// Budget only: the groups the merged pairs make so far.
     joined: Components,
     summary: BudgetSummary,
@@ -50,6 +55,7 @@ impl Deciding {
             searches: None,
             searched: 0,
             searching: None,
+            spectra: vec![None; robots],
             joined: Components::new(robots),
             summary: BudgetSummary {
                 pairs,
@@ -206,11 +212,18 @@ impl MergeJob {
         if d.searching.is_none() {
             d.summary.maps_searched += 1;
         }
-        let steps = d.searching.get_or_insert_with(MapSearchSteps::default);
-        let Some(searched) = self
+        let steps = d.searching.get_or_insert_with(|| {
+            MapSearchSteps::with_spectra(d.spectra[p.a].clone(), d.spectra[p.b].clone())
+        });
+        let searched = self
             .method
-            .search_step(&self.pair_input(input, p, true), o, steps)
-        else {
+            .search_step(&self.pair_input(input, p, true), o, steps);
+        for (robot, spectrum) in [p.a, p.b].into_iter().zip(steps.spectra()) {
+            if d.spectra[robot].is_none() {
+                d.spectra[robot] = spectrum.cloned();
+            }
+        }
+        let Some(searched) = searched else {
             return false;
         };
         *o = searched;

@@ -77,7 +77,7 @@ impl MethodStages for Auto {
     /// The vocabulary's proposals: trained on every described frame of
     /// every robot, then each robot pair's frames nominate their partners.
     /// With many robots only the pairs the budget keeps are proposed
-    /// ([`crate::merge::pairbudget`]). The steps of [`proposals`] run to
+    /// ([`crate::merge::pairbudget`]). The steps of [`ProposalSteps`] run to
     /// the end.
     fn propose(
         &self,
