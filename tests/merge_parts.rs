@@ -14,7 +14,7 @@ use slamlab::merge::consistency::{
     ConsistencyConfig,
 };
 use slamlab::merge::frames::MergeInput;
-use slamlab::merge::fuse::fuse;
+use slamlab::merge::fuse::{fuse, FuseSteps};
 use slamlab::merge::graph::{groups, spanning_tree, PairEdge};
 use slamlab::merge::job::{MergeConfig, MergeJob, Stage};
 use slamlab::merge::lift::{column_bearing_rad, laser_range_at, lift_keypoint_3d};
@@ -825,6 +825,22 @@ fn fusion_adds_log_odds_and_resamples_rotated_maps_without_holes() {
         }
     }
     assert_eq!(holes, 0);
+    // A band of 7 rows at a time (as the page's merge calls fuse) gives the
+    // same grid, cell for cell.
+    let maps = [(&a, Pose2::IDENTITY), (&b, pose_b)];
+    let mut steps = FuseSteps::new(&maps, cfg.clone());
+    let (_, rows) = steps.progress();
+    assert_eq!(rows, merged.height());
+    let mut calls = 1;
+    while !steps.step(&maps, 7) {
+        calls += 1;
+    }
+    assert_eq!(calls, rows.div_ceil(7), "one call per band of 7 of {rows} rows");
+    let banded = steps.into_grid();
+    assert_eq!(
+        (banded.width(), banded.height(), banded.raw_units()),
+        (merged.width(), merged.height(), merged.raw_units())
+    );
     // Fusing one map alone reproduces it; nothing to fuse gives an empty grid.
     let alone = fuse(&[(&a, Pose2::IDENTITY)], cfg.clone());
     assert_eq!(units(&alone, on_wall), units(&a, on_wall));

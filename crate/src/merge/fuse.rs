@@ -88,45 +88,105 @@ fn fuse_row(
 /// Maps that are empty or have a non-finite pose are skipped; with nothing
 /// to fuse the result is an empty grid.
 pub fn fuse(maps: &[(&OccupancyGrid, Pose2)], config: GridConfig) -> OccupancyGrid {
-    let mut merged = OccupancyGrid::new(config.clone());
-    let usable: Vec<(&OccupancyGrid, Pose2, [DVec2; 4])> = maps
-        .iter()
-        .filter(|(_, pose)| pose.is_finite())
-        .filter_map(|(g, pose)| known_corners(g).map(|c| (*g, *pose, c)))
-        .collect();
-    if usable.is_empty() || config.resolution_m.is_nan() || config.resolution_m <= 0.0 {
-        return merged;
-    }
-    let mut lo = DVec2::splat(f64::INFINITY);
-    let mut hi = DVec2::splat(f64::NEG_INFINITY);
-    for (_, pose, corners) in &usable {
-        for &c in corners {
-            let q = pose.transform_point(c);
-            lo = lo.min(q);
-            hi = hi.max(q);
+    let mut steps = FuseSteps::new(maps, config);
+    while !steps.step(maps, usize::MAX) {}
+    steps.into_grid()
+}
+
+/// [`fuse`] a band of rows at a time, so that a caller with a page to draw
+/// need not wait for the whole grid: the merged grid is sized at the
+/// start, then each step pulls the next rows from the maps. The result is
+/// the same however the rows are cut.
+pub struct FuseSteps {
+    merged: OccupancyGrid,
+    /// Positions in the maps of those that are fused (finite pose, known
+    /// cells).
+    usable: Vec<usize>,
+    next_row: usize,
+}
+
+impl FuseSteps {
+    /// The merged grid for `maps` (each with its pose in the merged
+    /// frame), sized to cover what they know; no row fused yet.
+    pub fn new(maps: &[(&OccupancyGrid, Pose2)], config: GridConfig) -> FuseSteps {
+        let mut merged = OccupancyGrid::new(config.clone());
+        let usable: Vec<(usize, [DVec2; 4])> = maps
+            .iter()
+            .enumerate()
+            .filter(|(_, (_, pose))| pose.is_finite())
+            .filter_map(|(i, (g, _))| known_corners(g).map(|c| (i, c)))
+            .collect();
+        let nothing = FuseSteps {
+            merged: OccupancyGrid::new(config.clone()),
+            usable: Vec::new(),
+            next_row: 0,
+        };
+        if usable.is_empty() || config.resolution_m.is_nan() || config.resolution_m <= 0.0 {
+            return nothing;
+        }
+        let mut lo = DVec2::splat(f64::INFINITY);
+        let mut hi = DVec2::splat(f64::NEG_INFINITY);
+        for (i, corners) in &usable {
+            for &c in corners {
+                let q = maps[*i].1.transform_point(c);
+                lo = lo.min(q);
+                hi = hi.max(q);
+            }
+        }
+        if !merged.ensure_contains(lo, hi) {
+            // Too large for the cell budget: fuse what fits around the first map.
+            let (i, corners) = usable[0];
+            let [a, b, c, d] = corners.map(|c| maps[i].1.transform_point(c));
+            let (l, h) = (a.min(b).min(c).min(d), a.max(b).max(c).max(d));
+            if !merged.ensure_contains(l, h) {
+                return FuseSteps { merged, ..nothing };
+            }
+        }
+        FuseSteps {
+            merged,
+            usable: usable.into_iter().map(|(i, _)| i).collect(),
+            next_row: 0,
         }
     }
-    if !merged.ensure_contains(lo, hi) {
-        // Too large for the cell budget: fuse what fits around the first map.
-        let (_, pose, corners) = usable[0];
-        let [a, b, c, d] = corners.map(|c| pose.transform_point(c));
-        let (l, h) = (a.min(b).min(c).min(d), a.max(b).max(c).max(d));
-        if !merged.ensure_contains(l, h) {
-            return merged;
+
+    /// Rows (done, in all).
+    pub fn progress(&self) -> (usize, usize) {
+        let rows = if self.usable.is_empty() {
+            0
+        } else {
+            self.merged.height()
+        };
+        (self.next_row.min(rows), rows)
+    }
+
+    /// Fuses up to `rows` more rows (the same `maps` as at the start);
+    /// whether every row is fused.
+    pub fn step(&mut self, maps: &[(&OccupancyGrid, Pose2)], rows: usize) -> bool {
+        let (done, all) = self.progress();
+        if done >= all {
+            return true;
         }
+        // Each map's inverse pose as a function, its sine and cosine taken once.
+        let to_maps: Vec<_> = self
+            .usable
+            .iter()
+            .map(|&i| {
+                let inv = maps[i].1.inverse();
+                let (s, c) = inv.theta.sin_cos();
+                move |q: DVec2| inv.position() + DVec2::new(c * q.x - s * q.y, s * q.x + c * q.y)
+            })
+            .collect();
+        let grids: Vec<&OccupancyGrid> = self.usable.iter().map(|&i| maps[i].0).collect();
+        let end = done.saturating_add(rows).min(all);
+        for iy in done..end {
+            fuse_row(&mut self.merged, iy, &grids, &to_maps);
+        }
+        self.next_row = end;
+        end >= all
     }
-    // Each map's inverse pose as a function, its sine and cosine taken once.
-    let to_maps: Vec<_> = usable
-        .iter()
-        .map(|(_, p, _)| {
-            let inv = p.inverse();
-            let (s, c) = inv.theta.sin_cos();
-            move |q: DVec2| inv.position() + DVec2::new(c * q.x - s * q.y, s * q.x + c * q.y)
-        })
-        .collect();
-    let maps: Vec<&OccupancyGrid> = usable.iter().map(|(g, _, _)| *g).collect();
-    for iy in 0..merged.height() {
-        fuse_row(&mut merged, iy, &maps, &to_maps);
+
+    /// The merged grid (whole once [`FuseSteps::step`] has said so).
+    pub fn into_grid(self) -> OccupancyGrid {
+        self.merged
     }
-    merged
 }

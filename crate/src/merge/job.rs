@@ -33,7 +33,7 @@
 //!    grid-image fit ([`super::baseline`]). The pairwise results are joined
 //!    along the most confident spanning tree ([`super::graph`]).
 //! 6. **Fusion.** The joined maps are fused into one grid in the first
-//!    robot's frame ([`super::fuse`]).
+//!    robot's frame ([`super::fuse`]), a band of rows a unit.
 //!
 //! The job reads only what the robots knew: their frames, their SLAM poses
 //! and their maps. It never looks at the truth; the session layer
@@ -43,7 +43,7 @@ mod decision;
 
 use super::described::{describe_image, DescribedFrames};
 use super::frames::MergeInput;
-use super::fuse::fuse;
+use super::fuse::FuseSteps;
 use super::graph::{groups, spanning_tree, Joined, PairEdge};
 use super::method::auto::ProposalSteps;
 use super::method::{pose3, stages_of, MethodStages, PairInput};
@@ -60,6 +60,9 @@ use serde::Serialize;
 // works on.
 pub use super::config::MergeConfig;
 pub use super::work::{Cell, PairOutcome, PairWork, RobotFrames};
+
+/// Rows of the merged map fused per unit of the fusion stage.
+const ROWS_PER_UNIT: usize = 32;
 
 /// The stage a job is in; [`MergeJob::advance`] never crosses a stage
 /// boundary in one call, so a caller can time each stage.
@@ -172,6 +175,8 @@ pub struct MergeJob {
     proposing: Option<ProposalSteps>,
     /// The decision stage between calls ([`decision`]).
     deciding: Option<decision::Deciding>,
+    /// The fusion between calls ([`FuseSteps`]).
+    fusing: Option<FuseSteps>,
 }
 
 impl MergeJob {
@@ -231,6 +236,7 @@ impl MergeJob {
             described: DescribedFrames::default(),
             proposing: None,
             deciding: None,
+            fusing: None,
         })
     }
 
@@ -282,14 +288,14 @@ impl MergeJob {
                 .map_or((0, self.pairs.len().max(1)), |d| {
                     d.progress(self.pairs.len())
                 }),
+            Stage::Fusion => self.fusing.as_ref().map_or((0, 1), FuseSteps::progress),
             Stage::Done => (1, 1),
-            _ => (0, 1),
         }
     }
 
     /// Does up to `units` units of work (frames described, pairs checked,
-    /// proposal steps, pairs decided or searched; the fusion stage is one
-    /// unit) without
+    /// proposal steps, pairs decided or searched, bands of the merged map's
+    /// rows) without
     /// leaving the current stage. `input` must be what the job was made
     /// from. Returns the units done (0 once finished).
     pub fn advance(&mut self, input: &impl MergeInput, units: usize) -> Result<usize, String> {
@@ -306,11 +312,7 @@ impl MergeJob {
                 }
                 Ok(done.max(1))
             }
-            Stage::Fusion => {
-                self.fuse_maps(input);
-                self.stage = Stage::Done;
-                Ok(1)
-            }
+            Stage::Fusion => Ok(self.advance_fusion(input, units)),
             Stage::Done => Ok(0),
         }
     }
@@ -684,12 +686,33 @@ impl MergeJob {
         }
     }
 
-    fn fuse_maps(&mut self, input: &impl MergeInput) {
-        let Some(outcome) = &self.outcome else {
-            return;
+    /// Up to `units` bands of [`ROWS_PER_UNIT`] rows of the merged map
+    /// ([`FuseSteps`]); done at once when nothing merged.
+    fn advance_fusion(&mut self, input: &impl MergeInput, units: usize) -> usize {
+        let Some(maps) = self.fused_maps(input) else {
+            self.stage = Stage::Done;
+            return 1;
         };
+        let config = input.map(0, self.config.mapper).config.clone();
+        let steps = self
+            .fusing
+            .get_or_insert_with(|| FuseSteps::new(&maps, config));
+        if steps.step(&maps, units.saturating_mul(ROWS_PER_UNIT)) {
+            self.merged = self.fusing.take().map(FuseSteps::into_grid);
+            self.stage = Stage::Done;
+        }
+        units
+    }
+
+    /// The maps the merge joined to the first robot, with their poses in
+    /// its frame; `None` when nothing merged.
+    fn fused_maps<'i>(
+        &self,
+        input: &'i impl MergeInput,
+    ) -> Option<Vec<(&'i OccupancyGrid, Pose2)>> {
+        let outcome = self.outcome.as_ref()?;
         if outcome.status != MergeStatus::Merged {
-            return;
+            return None;
         }
         let maps: Vec<(&OccupancyGrid, Pose2)> = outcome
             .transforms
@@ -702,8 +725,7 @@ impl MergeJob {
                 ))
             })
             .collect();
-        let config = input.map(0, self.config.mapper).config.clone();
-        self.merged = Some(fuse(&maps, config));
+        Some(maps)
     }
 
     /// The matched-pair tables in the report's layout.

@@ -542,12 +542,24 @@ fn distinct(p: &Pose2, q: &Pose2, at: DVec2, cfg: &MapSearchConfig) -> bool {
         || wrap_angle(p.theta - q.theta).abs() >= cfg.distinct_rad
 }
 
-/// Refines one correlation peak and judges it (step 3 of the module doc).
-fn judge(
+/// Step 3 of the module doc, its first half: a correlation peak refined
+/// to a pose of B's frame in A's (`None` when too few walls overlap to align).
+fn refine(
     a: &OccupancyGrid,
     b: &OccupancyGrid,
     coarse: Pose2,
-    coarse_score: i64,
+    verdict: &VerdictConfig,
+) -> Option<Pose2> {
+    refine_alignment(a, b, &coarse, &verdict.align).map(|aligned| aligned.pose)
+}
+
+/// Step 3's second half: the maps' agreement at the refined pose ([`refine`])
+/// of the peak `(coarse pose, score)`, and the verdict on it.
+fn judge_refined(
+    a: &OccupancyGrid,
+    b: &OccupancyGrid,
+    (coarse, coarse_score): (Pose2, i64),
+    refined: Option<Pose2>,
     cfg: &MapSearchConfig,
     verdict: &VerdictConfig,
 ) -> MapHypothesis {
@@ -560,12 +572,12 @@ fn judge(
         plausible: false,
         failure: None,
     };
-    let Some(aligned) = refine_alignment(a, b, &coarse, &verdict.align) else {
+    let Some(pose) = refined else {
         h.failure = Some("too few walls overlap to align".into());
         return h;
     };
-    let agreement = map_agreement(a, b, &aligned.pose);
-    h.pose = Some(aligned.pose);
+    let agreement = map_agreement(a, b, &pose);
+    h.pose = Some(pose);
     h.agreement = Some(agreement);
     h.net = agreement.occupied_agree as f64
         - cfg.free_penalty as f64 * agreement.occupied_contradict as f64;

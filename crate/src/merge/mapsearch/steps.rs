@@ -17,15 +17,17 @@
 //!    begun, then that search ([`PeakSearch`]) in pieces of
 //!    [`WORK_PER_STEP`] pyramid lookups (a whole rotation on 60 m maps is
 //!    up to half a second in the page);
-//! 3. each hypothesis refined and judged, strongest first;
+//! 3. each hypothesis refined (a step), then judged (a step), strongest
+//!    first;
 //! 4. the decision (with the last judgement).
 //!
 //! [`super::search_maps`] is this, stepped to the end in one call, so the
 //! answer cannot depend on how the steps are spread over calls.
 
 use super::{
-    coarse_ranked, coarse_start, correlate, decide, judge, translation_origin, wall_centroid,
-    MapHypothesis, MapSearch, MapSearchConfig, Raster, TranslationSearch, WallSpectrum,
+    coarse_ranked, coarse_start, correlate, decide, judge_refined, refine, translation_origin,
+    wall_centroid, MapHypothesis, MapSearch, MapSearchConfig, Raster, TranslationSearch,
+    WallSpectrum,
 };
 use crate::geom::{wrap_angle, Pose2};
 use crate::merge::peaksearch::{pyramid_of, MaxPyramid, PeakSearch};
@@ -60,11 +62,13 @@ enum Phase {
         rotation: Option<RotationSearch>,
         coarse: Vec<(Pose2, i64)>,
     },
-    /// The ranked peaks, and the hypotheses judged so far.
+    /// The ranked peaks, the hypotheses judged so far, and the next one's
+    /// refined pose once refined.
     Judge {
         delta: f64,
         coarse: Vec<(Pose2, i64)>,
         hypotheses: Vec<MapHypothesis>,
+        refined: Option<Option<Pose2>>,
     },
     Finished,
 }
@@ -160,6 +164,7 @@ impl MapSearchSteps {
                         delta,
                         coarse: coarse_ranked(coarse, cfg),
                         hypotheses: Vec::new(),
+                        refined: None,
                     }
                 };
                 None
@@ -168,17 +173,26 @@ impl MapSearchSteps {
                 delta,
                 coarse,
                 mut hypotheses,
+                refined,
             } => {
-                if let Some(&(pose, score)) = coarse.get(hypotheses.len()) {
-                    hypotheses.push(judge(a, b, pose, score, cfg, verdict));
-                }
-                if hypotheses.len() < coarse.len() {
-                    self.phase = Phase::Judge {
-                        delta,
-                        coarse,
-                        hypotheses,
+                // Each hypothesis in two steps: refined, then judged.
+                if let Some(&peak) = coarse.get(hypotheses.len()) {
+                    let refined = match refined {
+                        None => Some(refine(a, b, peak.0, verdict)),
+                        Some(pose) => {
+                            hypotheses.push(judge_refined(a, b, peak, pose, cfg, verdict));
+                            None
+                        }
                     };
-                    return None;
+                    if refined.is_some() || hypotheses.len() < coarse.len() {
+                        self.phase = Phase::Judge {
+                            delta,
+                            coarse,
+                            hypotheses,
+                            refined,
+                        };
+                        return None;
+                    }
                 }
                 self.finish(decide(hypotheses, wall_centroid(b), delta, cfg))
             }
