@@ -835,7 +835,11 @@ fn fusion_adds_log_odds_and_resamples_rotated_maps_without_holes() {
     while !steps.step(&maps, 7) {
         calls += 1;
     }
-    assert_eq!(calls, rows.div_ceil(7), "one call per band of 7 of {rows} rows");
+    assert_eq!(
+        calls,
+        rows.div_ceil(7),
+        "one call per band of 7 of {rows} rows"
+    );
     let banded = steps.into_grid();
     assert_eq!(
         (banded.width(), banded.height(), banded.raw_units()),

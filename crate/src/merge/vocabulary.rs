@@ -281,69 +281,15 @@ impl Vocabulary {
     /// [`Vocabulary::train`], also returning the bag of every training frame
     /// (the same as [`Vocabulary::bag`] would give, at no extra cost: the
     /// words are needed for the document frequencies anyway).
+    /// [`VocabularyTraining`]'s steps in one call.
     pub fn train_with_bags(
         sets: &[&Features],
         cfg: &VocabularyConfig,
         seed: u64,
     ) -> (Vocabulary, Vec<Bag>) {
-        let per_frame = cfg.max_words_per_frame.max(1);
-        let chosen: Vec<Vec<usize>> = sets.iter().map(|f| strongest(f, per_frame)).collect();
-        // Descriptors by sign of the Laplacian, an even stride over all.
-        let total: usize = chosen.iter().map(Vec::len).sum();
-        let stride = total.div_ceil(cfg.max_training.max(1)).max(1);
-        let mut pools: [Vec<[f32; 64]>; 2] = [Vec::new(), Vec::new()];
-        let mut counter = 0usize;
-        for (f, idx) in sets.iter().zip(&chosen) {
-            for &i in idx {
-                if counter.is_multiple_of(stride) {
-                    let sign = usize::from(f.keypoints[i].laplacian > 0);
-                    pools[sign].push(f.descriptors[i].0);
-                }
-                counter += 1;
-            }
-        }
-        let leaf = Node {
-            first_child: 0,
-            children: 0,
-            word: 0,
-        };
-        let mut vocab = Vocabulary {
-            nodes: vec![leaf.clone(), leaf],
-            centres: vec![[0.0; 64]; 2],
-            half_norm2: vec![0.0; 2],
-            idf: Vec::new(),
-            max_words_per_frame: per_frame,
-        };
-        let mut rng = SplitMix64::new(seed);
-        let mut words = 0usize;
-        for (root, pool) in pools.iter().enumerate() {
-            vocab.grow(root, pool, cfg.depth, cfg, &mut rng, &mut words);
-        }
-        vocab.half_norm2 = vocab.centres.iter().map(|c| 0.5 * norm2(c)).collect();
-        // Every training frame's words, and each word's document frequency.
-        let frame_words: Vec<Vec<u32>> = sets
-            .iter()
-            .zip(&chosen)
-            .map(|(f, idx)| vocab.words_of(f, idx))
-            .collect();
-        let mut df = vec![0u32; words];
-        for fw in &frame_words {
-            let mut last = None;
-            for &w in fw {
-                if last != Some(w) {
-                    df[w as usize] += 1;
-                    last = Some(w);
-                }
-            }
-        }
-        let n = sets.len().max(1) as f32;
-        vocab.idf = df.iter().map(|&d| (n / d.max(1) as f32).ln()).collect();
-        let bags = frame_words
-            .iter()
-            .zip(&chosen)
-            .map(|(fw, idx)| vocab.weigh(fw, idx.len()))
-            .collect();
-        (vocab, bags)
+        let mut training = VocabularyTraining::new(sets, cfg, seed);
+        training.add(sets);
+        training.finish()
     }
 
     /// Builds the subtree under `node` from `points`, `levels` deep.
@@ -461,6 +407,103 @@ impl Vocabulary {
     pub fn bag(&self, f: &Features) -> Bag {
         let idx = strongest(f, self.max_words_per_frame);
         self.weigh(&self.words_of(f, &idx), idx.len())
+    }
+}
+
+/// [`Vocabulary::train_with_bags`] a step at a time, for a caller that
+/// cannot wait for all of it (the page's merge): the tree
+/// ([`VocabularyTraining::new`], k-means on a subsample), then the words of
+/// the training frames a batch at a time ([`VocabularyTraining::add`], one
+/// robot's frames say: quantising every frame is most of the work), then
+/// the idf weights and every frame's bag ([`VocabularyTraining::finish`]).
+pub struct VocabularyTraining {
+    /// The tree, its idf not yet known.
+    vocab: Vocabulary,
+    /// Document frequency of each word over the frames added so far.
+    df: Vec<u32>,
+    /// Each added frame's sorted words and its keypoints used, in order.
+    frame_words: Vec<(Vec<u32>, usize)>,
+}
+
+impl VocabularyTraining {
+    /// The tree trained on the frames `sets`, by sign of the Laplacian, on
+    /// an even stride over their strongest descriptors. Deterministic for a
+    /// given `seed`.
+    pub fn new(sets: &[&Features], cfg: &VocabularyConfig, seed: u64) -> VocabularyTraining {
+        let per_frame = cfg.max_words_per_frame.max(1);
+        let chosen: Vec<Vec<usize>> = sets.iter().map(|f| strongest(f, per_frame)).collect();
+        // Descriptors by sign of the Laplacian, an even stride over all.
+        let total: usize = chosen.iter().map(Vec::len).sum();
+        let stride = total.div_ceil(cfg.max_training.max(1)).max(1);
+        let mut pools: [Vec<[f32; 64]>; 2] = [Vec::new(), Vec::new()];
+        let mut counter = 0usize;
+        for (f, idx) in sets.iter().zip(&chosen) {
+            for &i in idx {
+                if counter.is_multiple_of(stride) {
+                    let sign = usize::from(f.keypoints[i].laplacian > 0);
+                    pools[sign].push(f.descriptors[i].0);
+                }
+                counter += 1;
+            }
+        }
+        let leaf = Node {
+            first_child: 0,
+            children: 0,
+            word: 0,
+        };
+        let mut vocab = Vocabulary {
+            nodes: vec![leaf.clone(), leaf],
+            centres: vec![[0.0; 64]; 2],
+            half_norm2: vec![0.0; 2],
+            idf: Vec::new(),
+            max_words_per_frame: per_frame,
+        };
+        let mut rng = SplitMix64::new(seed);
+        let mut words = 0usize;
+        for (root, pool) in pools.iter().enumerate() {
+            vocab.grow(root, pool, cfg.depth, cfg, &mut rng, &mut words);
+        }
+        vocab.half_norm2 = vocab.centres.iter().map(|c| 0.5 * norm2(c)).collect();
+        VocabularyTraining {
+            vocab,
+            df: vec![0; words],
+            frame_words: Vec::new(),
+        }
+    }
+
+    /// The words of more training frames, counted into the document
+    /// frequencies. Every frame the tree was trained on is added once, in
+    /// the same order.
+    pub fn add(&mut self, sets: &[&Features]) {
+        for f in sets {
+            let idx = strongest(f, self.vocab.max_words_per_frame);
+            let fw = self.vocab.words_of(f, &idx);
+            let mut last = None;
+            for &w in &fw {
+                if last != Some(w) {
+                    self.df[w as usize] += 1;
+                    last = Some(w);
+                }
+            }
+            self.frame_words.push((fw, idx.len()));
+        }
+    }
+
+    /// The vocabulary, each word weighted by `ln(N / nᵢ)` over the `N`
+    /// frames added, and the bag of every frame added, in order.
+    pub fn finish(mut self) -> (Vocabulary, Vec<Bag>) {
+        let n = self.frame_words.len().max(1) as f32;
+        self.vocab.idf = self
+            .df
+            .iter()
+            .map(|&d| (n / d.max(1) as f32).ln())
+            .collect();
+        let bags = self
+            .frame_words
+            .iter()
+            .map(|(fw, total)| self.vocab.weigh(fw, *total))
+            .collect();
+        (self.vocab, bags)
     }
 }
 

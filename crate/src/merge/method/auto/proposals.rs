@@ -3,9 +3,10 @@
 //! Before any frame pair is matched, the automatic method decides which
 //! pairs to match (stage 3 of [`crate::merge::job`]):
 //!
-//! 1. **The vocabulary.** A vocabulary of visual words is trained on the
-//!    described frames of every robot, then each frame becomes a bag of
-//!    words ([`crate::merge::vocabulary`], after Sivic and Zisserman 2003
+//! 1. **The vocabulary.** A vocabulary tree of visual words is trained on
+//!    the described frames of every robot, each frame's descriptors become
+//!    words (and count into each word's document frequency), then each
+//!    frame becomes a bag of weighted words ([`crate::merge::vocabulary`], after Sivic and Zisserman 2003
 //!    and Nistér and Stewénius 2006).
 //! 2. **The pair budget** (many robots only): the visual votes, each
 //!    robot's coarse map and each pair's coarse map overlap, then the plan
@@ -17,8 +18,8 @@
 //!
 //! Done in one call, this is seconds on a crowded hour (sixteen robots: 120
 //! coarse overlaps of 60 m maps), time in which a page could not draw. So
-//! it is cut into steps: step 1 is one for the training and one per robot's
-//! bags, step 2 one for the votes and one per coarse map and overlap, step 3
+//! it is cut into steps: step 1 is one for the tree, one per robot's words
+//! and one for the weights, step 2 one for the votes and one per coarse map and overlap, step 3
 //! one per pair of robots. [`ProposalSteps`] keeps
 //! what is done between calls. The steps are taken in the order one call
 //! takes them, so the proposals do not depend on how the steps are spread
@@ -26,7 +27,7 @@
 
 use crate::merge::config::MergeConfig;
 use crate::merge::pairbudget::{partners_per_robot, BudgetSteps, PairBudget, PairPlan};
-use crate::merge::vocabulary::{propose_pairs, Bag, Vocabulary};
+use crate::merge::vocabulary::{propose_pairs, Bag, VocabularyTraining};
 use crate::merge::work::{PairWork, RobotFrames};
 use crate::slam::OccupancyGrid;
 use crate::surf::Features;
@@ -34,10 +35,12 @@ use crate::surf::Features;
 /// The proposal stage between calls; fresh for each merge.
 #[derive(Default)]
 pub struct ProposalSteps {
-    /// The vocabulary (step 1), once trained.
-    vocabulary: Option<Vocabulary>,
-    /// The robots' frames as bags of words (step 1), robot by robot.
-    bags: Vec<Vec<Bag>>,
+    /// The vocabulary under training (step 1): its tree, then the words of
+    /// `worded` robots' frames.
+    training: Option<VocabularyTraining>,
+    worded: usize,
+    /// The robots' frames as bags of words, once the training is done.
+    bags: Option<Vec<Vec<Bag>>>,
     /// The pair budget under way (step 2; `None` when every pair is
     /// checked in full).
     budget: Option<BudgetSteps>,
@@ -56,11 +59,12 @@ impl ProposalSteps {
         } else {
             0
         };
-        let done = usize::from(self.vocabulary.is_some())
-            + self.bags.len()
+        let done = usize::from(self.training.is_some() || self.bags.is_some())
+            + self.worded
+            + usize::from(self.bags.is_some())
             + self.budget.as_ref().map_or(0, |b| b.done())
             + self.filled;
-        (done, 1 + robots + budget + pairs)
+        (done, 1 + robots + 1 + budget + pairs)
     }
 }
 
@@ -80,23 +84,10 @@ pub fn step(
     maps: &[&OccupancyGrid],
     config: &MergeConfig,
 ) -> bool {
-    let Some(vocabulary) = &steps.vocabulary else {
-        let sets: Vec<&Features> = robots.iter().flat_map(|r| r.features.iter()).collect();
-        steps.vocabulary = Some(Vocabulary::train(
-            &sets,
-            &config.vocabulary,
-            config.seed ^ 0x766f_6361,
-        ));
-        steps.budget = budget_steps(robots, maps, config);
+    let Some(bags) = &steps.bags else {
+        train(steps, robots, maps, config);
         return false;
     };
-    if let Some(r) = robots.get(steps.bags.len()) {
-        steps
-            .bags
-            .push(r.features.iter().map(|f| vocabulary.bag(f)).collect());
-        return false;
-    }
-    let bags = &steps.bags;
     if let Some(budget) = steps.budget.as_mut() {
         if steps.plan.is_none() {
             // The step that computes the last overlap makes the plan.
@@ -110,6 +101,38 @@ pub fn step(
     fill(p, bags, steps.plan.as_deref(), config);
     steps.filled += 1;
     steps.filled == pairs.len()
+}
+
+/// One step of step 1: the tree, then one robot's words, then the bags.
+fn train(
+    steps: &mut ProposalSteps,
+    robots: &[RobotFrames],
+    maps: &[&OccupancyGrid],
+    config: &MergeConfig,
+) {
+    let Some(training) = steps.training.as_mut() else {
+        let sets: Vec<&Features> = robots.iter().flat_map(|r| r.features.iter()).collect();
+        let seed = config.seed ^ 0x766f_6361;
+        steps.training = Some(VocabularyTraining::new(&sets, &config.vocabulary, seed));
+        steps.budget = budget_steps(robots, maps, config);
+        return;
+    };
+    if let Some(r) = robots.get(steps.worded) {
+        let sets: Vec<&Features> = r.features.iter().collect();
+        training.add(&sets);
+        steps.worded += 1;
+        return;
+    }
+    let Some(training) = steps.training.take() else {
+        return;
+    };
+    let mut bags = training.finish().1.into_iter();
+    steps.bags = Some(
+        robots
+            .iter()
+            .map(|r| bags.by_ref().take(r.features.len()).collect())
+            .collect(),
+    );
 }
 
 /// Step 2's state for a run with many robots: `k` partners a robot from
