@@ -139,11 +139,11 @@ fn each_group_map_is_fused_in_its_first_robots_frame(lab: &Lab) {
 
 /// The proposal and decision stages, cut into single units as the page
 /// cuts them, come out exactly as in one call (the command line's way),
-/// and they are cut: the proposals one step for the vocabulary's tree, then
-/// one per robot's words, one for the bags, one for the votes, coarse map, coarse overlap and pair's
-/// to-do list; the decision one unit per pair's
-/// verdict, then one per map search step; each stage's progress counting
-/// them.
+/// and they are cut: the proposals one step for the vocabulary's tree, one
+/// per robot's words, one for the bags, one for the votes' inverted file,
+/// one per robot's votes, coarse map, coarse overlap and pair's to-do
+/// list; the decision one unit per pair's verdict, then one per map search
+/// step; each stage's progress counting them.
 #[wasm_bindgen_test(unsupported = test)]
 fn the_merge_a_unit_at_a_time_equals_the_merge_at_once() {
     let mut lab = Lab::new(SCENARIO).expect("the scenario parses");
@@ -192,10 +192,10 @@ fn the_merge_a_unit_at_a_time_equals_the_merge_at_once() {
     let (cut, calls_cut, total, proposals_cut, proposals_total) = report_of(1);
     assert_eq!(proposals_whole, 1, "one call proposes every pair");
     // Five robots, over the budget's four: the vocabulary's tree, five
-    // robots' words, the bags, the votes, five coarse maps, ten overlaps,
-    // ten to-do lists.
-    assert_eq!(proposals_total, 33, "the proposal steps");
-    assert_eq!(proposals_cut, 33, "one call per proposal step");
+    // robots' words, the bags, the votes' inverted file, five robots'
+    // votes, five coarse maps, ten overlaps, ten to-do lists.
+    assert_eq!(proposals_total, 38, "the proposal steps");
+    assert_eq!(proposals_cut, 38, "one call per proposal step");
     assert_eq!(calls_whole, 1, "one call decides every pair");
     // Five robots: ten pairs under the budget, then at least one search.
     assert!(total > 10, "the searches count as units: {total}");

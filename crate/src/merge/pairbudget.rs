@@ -121,40 +121,76 @@ pub fn partners_per_robot(robots: usize, mean_frames: f64) -> usize {
 
 /// The visual-vote figure of every pair of robots (step 1 of the module
 /// doc): `out[a][b]`, symmetric, 0 on the diagonal. `bags[r]` holds robot
-/// `r`'s frames' bags.
+/// `r`'s frames' bags. [`VoteTally`] run to the end.
 pub fn visual_votes(bags: &[Vec<Bag>], votes_per_frame: usize) -> Vec<Vec<f64>> {
-    let n = bags.len();
-    let owner: Vec<usize> = (0..n).flat_map(|r| vec![r; bags[r].len()]).collect();
-    let all: Vec<&Bag> = bags.iter().flatten().collect();
-    // One inverted file over every frame of every robot.
-    let postings = inverted_file(all.iter().copied(), word_count(all.iter().copied()));
-    let mut votes = vec![vec![0usize; n]; n];
-    let mut scores = vec![0f64; all.len()];
-    for (i, bag) in all.iter().enumerate() {
-        scores.iter_mut().for_each(|s| *s = 0.0);
-        for &(w, va) in &bag.words {
-            for &(j, vb) in &postings[w as usize] {
-                scores[j as usize] += va as f64 * vb as f64;
-            }
-        }
-        for j in best_of_others(&scores, &owner, owner[i], votes_per_frame) {
-            votes[owner[i]][owner[j]] += 1;
+    let mut tally = VoteTally::new(bags);
+    for r in 0..bags.len() {
+        tally.vote(bags, r, votes_per_frame);
+    }
+    tally.shares(bags)
+}
+
+/// The visual votes a robot at a time: one inverted file over every frame
+/// of every robot, then each robot's frames cast their votes.
+struct VoteTally {
+    postings: Vec<Vec<(u32, f32)>>,
+    /// The robot of each frame, frames numbered robot after robot.
+    owner: Vec<usize>,
+    /// `votes[a][b]`: frames of `a` that voted for `b`.
+    votes: Vec<Vec<usize>>,
+    /// Robots whose frames have voted.
+    voted: usize,
+}
+
+impl VoteTally {
+    fn new(bags: &[Vec<Bag>]) -> VoteTally {
+        let n = bags.len();
+        let all: Vec<&Bag> = bags.iter().flatten().collect();
+        VoteTally {
+            postings: inverted_file(all.iter().copied(), word_count(all.iter().copied())),
+            owner: (0..n).flat_map(|r| vec![r; bags[r].len()]).collect(),
+            votes: vec![vec![0; n]; n],
+            voted: 0,
         }
     }
-    let share = |a: usize, b: usize| votes[a][b] as f64 / bags[a].len().max(1) as f64;
-    (0..n)
-        .map(|a| {
-            (0..n)
-                .map(|b| {
-                    if a == b {
-                        0.0
-                    } else {
-                        share(a, b) + share(b, a)
-                    }
-                })
-                .collect()
-        })
-        .collect()
+
+    /// Robot `r`'s frames vote, each for the robots holding its
+    /// `votes_per_frame` most similar frames of other robots.
+    fn vote(&mut self, bags: &[Vec<Bag>], r: usize, votes_per_frame: usize) {
+        let mut scores = vec![0f64; self.owner.len()];
+        for bag in &bags[r] {
+            scores.iter_mut().for_each(|s| *s = 0.0);
+            for &(w, va) in &bag.words {
+                for &(j, vb) in &self.postings[w as usize] {
+                    scores[j as usize] += va as f64 * vb as f64;
+                }
+            }
+            for j in best_of_others(&scores, &self.owner, r, votes_per_frame) {
+                self.votes[r][self.owner[j]] += 1;
+            }
+        }
+        self.voted += 1;
+    }
+
+    /// A pair's figure: the share of each robot's frames that voted for
+    /// the other, added.
+    fn shares(&self, bags: &[Vec<Bag>]) -> Vec<Vec<f64>> {
+        let n = bags.len();
+        let share = |a: usize, b: usize| self.votes[a][b] as f64 / bags[a].len().max(1) as f64;
+        (0..n)
+            .map(|a| {
+                (0..n)
+                    .map(|b| {
+                        if a == b {
+                            0.0
+                        } else {
+                            share(a, b) + share(b, a)
+                        }
+                    })
+                    .collect()
+            })
+            .collect()
+    }
 }
 
 /// The `k` frames with the best positive scores that belong to a robot
@@ -173,8 +209,9 @@ fn best_of_others(scores: &[f64], owner: &[usize], me: usize, k: usize) -> Vec<u
 }
 
 /// The whole budget (steps 1 to 3 of the module doc) a step at a time, so
-/// that a caller with a page to draw never waits for all of it: the visual
-/// votes, then each robot's coarse map (its spectrum and raster,
+/// that a caller with a page to draw never waits for all of it: the
+/// inverted file of the visual votes, each robot's votes, then each
+/// robot's coarse map (its spectrum and raster,
 /// [`CoarseMap`]), then each pair's coarse overlap (step 2; 120 pairs for
 /// sixteen robots, tens of milliseconds each on 60 m maps), then the plan.
 /// Run to the end it is the same budget however the steps are spread over
@@ -182,6 +219,7 @@ fn best_of_others(scores: &[f64], owner: &[usize], me: usize, k: usize) -> Vec<u
 pub struct BudgetSteps {
     /// Partners kept per robot (`k`).
     k: usize,
+    tally: Option<VoteTally>,
     votes: Option<Vec<Vec<f64>>>,
     coarse: Vec<CoarseMap>,
     /// `overlaps[a][b]`, symmetric, filled pair by pair.
@@ -196,6 +234,7 @@ impl BudgetSteps {
     pub fn new(robots: usize, k: usize) -> BudgetSteps {
         BudgetSteps {
             k,
+            tally: None,
             votes: None,
             coarse: Vec::with_capacity(robots),
             overlaps: vec![vec![0.0; robots]; robots],
@@ -204,15 +243,20 @@ impl BudgetSteps {
         }
     }
 
-    /// Steps in all for `robots` robots: the votes, a coarse map each, an
-    /// overlap per pair.
+    /// Steps in all for `robots` robots: the inverted file, a robot's votes
+    /// each, a coarse map each, an overlap per pair.
     pub fn total(robots: usize) -> usize {
-        1 + robots + robots * robots.saturating_sub(1) / 2
+        1 + 2 * robots + robots * robots.saturating_sub(1) / 2
     }
 
     /// Steps taken so far.
     pub fn done(&self) -> usize {
-        usize::from(self.votes.is_some()) + self.coarse.len() + self.pairs_done
+        let (file, voted) = match (&self.tally, &self.votes) {
+            (Some(t), _) => (1, t.voted),
+            (None, Some(v)) => (1, v.len()),
+            (None, None) => (0, 0),
+        };
+        file + voted + self.coarse.len() + self.pairs_done
     }
 
     /// One step; the plan of every pair `(a, b)`, `a < b`, in that order,
@@ -226,7 +270,18 @@ impl BudgetSteps {
     ) -> Option<Vec<PairBudget>> {
         let n = maps.len();
         let Some(votes) = &self.votes else {
-            self.votes = Some(visual_votes(bags, cfg.votes_per_frame));
+            match self.tally.as_mut() {
+                None => self.tally = Some(VoteTally::new(bags)),
+                Some(tally) => {
+                    if tally.voted < bags.len() {
+                        tally.vote(bags, tally.voted, cfg.votes_per_frame);
+                    }
+                    if tally.voted >= bags.len() {
+                        self.votes = Some(tally.shares(bags));
+                        self.tally = None;
+                    }
+                }
+            }
             return None;
         };
         if self.coarse.len() < n {

@@ -19,11 +19,12 @@
 //! Done in one call, this is seconds on a crowded hour (sixteen robots: 120
 //! coarse overlaps of 60 m maps), time in which a page could not draw. So
 //! it is cut into steps: step 1 is one for the tree, one per robot's words
-//! and one for the weights, step 2 one for the votes and one per coarse map and overlap, step 3
-//! one per pair of robots. [`ProposalSteps`] keeps
-//! what is done between calls. The steps are taken in the order one call
-//! takes them, so the proposals do not depend on how the steps are spread
-//! over calls (`tests/merge_groups.rs` checks it).
+//! and one for the weights; step 2 one for the votes' inverted file, one
+//! per robot's votes, one per coarse map and one per overlap; step 3 one
+//! per pair of robots. [`ProposalSteps`] keeps what is done between calls.
+//! The steps are taken in the order one call takes them, so the proposals
+//! do not depend on how the steps are spread over calls
+//! (`tests/merge_groups.rs` checks it).
 
 use crate::merge::config::MergeConfig;
 use crate::merge::pairbudget::{partners_per_robot, BudgetSteps, PairBudget, PairPlan};
