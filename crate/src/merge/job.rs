@@ -693,10 +693,10 @@ impl MergeJob {
             self.stage = Stage::Done;
             return 1;
         };
-        let config = input.map(0, self.config.mapper).config.clone();
+        let mapper = self.config.mapper;
         let steps = self
             .fusing
-            .get_or_insert_with(|| FuseSteps::new(&maps, config));
+            .get_or_insert_with(|| FuseSteps::new(&maps, input.map(0, mapper).config.clone()));
         if steps.step(&maps, units.saturating_mul(ROWS_PER_UNIT)) {
             self.merged = self.fusing.take().map(FuseSteps::into_grid);
             self.stage = Stage::Done;

@@ -16,7 +16,8 @@
 //!    searched by the maps alone, likeliest first; a pair whose robots
 //!    merged pairs have already joined is skipped. One unit per step of a
 //!    search ([`MapSearchSteps`]: each map's wall spectrum, the start, each
-//!    rotation's translation search in pieces, each hypothesis judged), so
+//!    rotation's translation search in pieces, each hypothesis refined,
+//!    then judged), so
 //!    that no call holds a whole search. A map's spectrum is computed
 //!    once and kept for its later searches.
 //!

@@ -6,8 +6,8 @@
 //! 1. **The vocabulary.** A vocabulary tree of visual words is trained on
 //!    the described frames of every robot, each frame's descriptors become
 //!    words (and count into each word's document frequency), then each
-//!    frame becomes a bag of weighted words ([`crate::merge::vocabulary`], after Sivic and Zisserman 2003
-//!    and Nistér and Stewénius 2006).
+//!    frame becomes a bag of weighted words ([`crate::merge::vocabulary`],
+//!    after Sivic and Zisserman 2003 and Nistér and Stewénius 2006).
 //! 2. **The pair budget** (many robots only): the visual votes, each
 //!    robot's coarse map and each pair's coarse map overlap, then the plan
 //!    of which pairs are matched, searched by their maps only, or left
