@@ -83,12 +83,17 @@ pub struct ScoreImage<'a> {
 
 /// The max images `M_{2^k}` of one score image, `k = 0, 1, …`: level `k`
 /// covers `x ∈ [−(2^k − 1), width)` (and the same in y), stored shifted
-/// by `2^k − 1`, row by row. (The default is empty: a placeholder.)
+/// by `2^k − 1`, row by row; and the same images transposed (stored
+/// column by column), so that a run of wall cells down a column is read
+/// as one contiguous slice too ([`Points`]). A window is a square, so the
+/// transposed max image is the max image of the transposed scores. (The
+/// default is empty: a placeholder.)
 #[derive(Default)]
 pub struct MaxPyramid {
     width: usize,
     height: usize,
     levels: Vec<Vec<i8>>,
+    transposed: Vec<Vec<i8>>,
 }
 
 impl MaxPyramid {
@@ -104,106 +109,182 @@ impl MaxPyramid {
                 base.push(i8::try_from(cell(x, y)).ok()?);
             }
         }
+        let mut transposed = vec![0i8; width * height];
+        for (y, row) in base.chunks_exact(width.max(1)).enumerate() {
+            for (x, &v) in row.iter().enumerate() {
+                transposed[x * height + y] = v;
+            }
+        }
         Some(MaxPyramid {
             width,
             height,
             levels: vec![base],
+            transposed: vec![transposed],
         })
     }
 
-    /// Builds the levels up to `top`. Level `k` from level `k − 1`
-    /// (`h = 2^(k−1)`): `M_{2h}(x) = max` of `M_h` at `x` and `x + h` in
-    /// each axis, which in the shifted storage is index `j` and `j − h`.
+    /// Builds the levels up to `top`, in both storages.
     fn ensure(&mut self, top: usize) {
         while self.levels.len() <= top {
             let k = self.levels.len();
-            let half = 1usize << (k - 1);
-            let (pw, ph) = (self.width + half - 1, self.height + half - 1);
-            let (lw, lh) = (pw + half, ph + half);
-            let prev = &self.levels[k - 1];
-            let pick = |row: &[i8], j: usize| -> i8 {
-                let a = if j >= half { row[j - half] } else { 0 };
-                let b = if j < row.len() { row[j] } else { 0 };
-                a.max(b)
-            };
-            let mut wide = vec![0i8; lw * ph];
-            for y in 0..ph {
-                let src = &prev[y * pw..][..pw];
-                for (j, d) in wide[y * lw..][..lw].iter_mut().enumerate() {
-                    *d = pick(src, j);
-                }
-            }
-            let mut next = vec![0i8; lw * lh];
-            for (j, row) in next.chunks_exact_mut(lw).enumerate() {
-                let upper = (j >= half).then(|| &wide[(j - half) * lw..][..lw]);
-                let lower = (j < ph).then(|| &wide[j * lw..][..lw]);
-                for (x, d) in row.iter_mut().enumerate() {
-                    let a = upper.map_or(0, |r| r[x]);
-                    let b = lower.map_or(0, |r| r[x]);
-                    *d = a.max(b);
-                }
-            }
+            let next = next_level(&self.levels[k - 1], self.width, self.height, k);
             self.levels.push(next);
+            let next = next_level(&self.transposed[k - 1], self.height, self.width, k);
+            self.transposed.push(next);
         }
     }
 }
 
-/// Points (translation-index offsets) grouped by row: `Σ_p M(c + p)`
-/// over them reads each row of a level once, left to right.
+/// Level `k` of a max image `width × height` from level `k − 1`
+/// (`h = 2^(k−1)`): `M_{2h}(x) = max` of `M_h` at `x` and `x + h` in each
+/// axis, which in the shifted storage is index `j` and `j − h`.
+fn next_level(prev: &[i8], width: usize, height: usize, k: usize) -> Vec<i8> {
+    let half = 1usize << (k - 1);
+    let (pw, ph) = (width + half - 1, height + half - 1);
+    let (lw, lh) = (pw + half, ph + half);
+    let pick = |row: &[i8], j: usize| -> i8 {
+        let a = if j >= half { row[j - half] } else { 0 };
+        let b = if j < row.len() { row[j] } else { 0 };
+        a.max(b)
+    };
+    let mut wide = vec![0i8; lw * ph];
+    for y in 0..ph {
+        let src = &prev[y * pw..][..pw];
+        for (j, d) in wide[y * lw..][..lw].iter_mut().enumerate() {
+            *d = pick(src, j);
+        }
+    }
+    let mut next = vec![0i8; lw * lh];
+    for (j, row) in next.chunks_exact_mut(lw).enumerate() {
+        let upper = (j >= half).then(|| &wide[(j - half) * lw..][..lw]);
+        let lower = (j < ph).then(|| &wide[j * lw..][..lw]);
+        for (x, d) in row.iter_mut().enumerate() {
+            let a = upper.map_or(0, |r| r[x]);
+            let b = lower.map_or(0, |r| r[x]);
+            *d = a.max(b);
+        }
+    }
+    next
+}
+
+/// Points (translation-index offsets) as runs of neighbours: a wall cell
+/// whose run along its row is at least as long as its run down its column
+/// joins a row run, the others a column run. `Σ_p M(c + p)` over them is
+/// then a sum over contiguous slices of the level (rows) and of its
+/// transpose (columns), which the compiler turns into vector additions;
+/// walls of a few cells' thickness make runs of their length. The sum is
+/// the same integer however the points are grouped.
 struct Points {
-    /// (row offset, range of `xs`), rows ascending.
-    rows: Vec<(i64, std::ops::Range<usize>)>,
-    /// Column offsets, ascending within a row.
-    xs: Vec<i64>,
+    /// Row runs, by row.
+    rows: Runs,
+    /// Column runs, with x and y swapped (rows of the transpose).
+    cols: Runs,
+    /// How many points (each a lookup of the exhaustive sum).
+    count: usize,
 }
 
-impl Points {
-    fn new(mut points: Vec<[i64; 2]>) -> Points {
-        points.sort_unstable_by_key(|p| (p[1], p[0]));
-        let mut rows: Vec<(i64, std::ops::Range<usize>)> = Vec::new();
-        let mut xs = Vec::with_capacity(points.len());
-        for (i, p) in points.iter().enumerate() {
-            match rows.last_mut() {
-                Some((y, r)) if *y == p[1] => r.end = i + 1,
-                _ => rows.push((p[1], i..i + 1)),
+/// Runs of consecutive points along rows: (row offset, range of `runs`),
+/// rows ascending; each run (first column offset, length), ascending.
+#[derive(Default)]
+struct Runs {
+    rows: Vec<(i64, std::ops::Range<usize>)>,
+    runs: Vec<(i64, i64)>,
+}
+
+impl Runs {
+    /// From points sorted by row, then column.
+    fn new(points: &[[i64; 2]]) -> Runs {
+        let mut out = Runs::default();
+        for p in points {
+            let last = out.rows.last().map(|(y, _)| *y);
+            if last != Some(p[1]) {
+                let n = out.runs.len();
+                out.rows.push((p[1], n..n));
             }
-            xs.push(p[0]);
+            let (_, range) = out.rows.last_mut().expect("pushed above");
+            match out.runs.last_mut() {
+                Some((x0, len)) if range.end > range.start && *x0 + *len == p[0] => *len += 1,
+                _ => {
+                    out.runs.push((p[0], 1));
+                    range.end += 1;
+                }
+            }
         }
-        Points { rows, xs }
+        out
     }
 
-    /// `Σ_p M_{2^k}(c + p)` (0 outside the level), the bound of the
-    /// block of translations starting at `c` (the exact sum at level 0).
-    fn bound(&self, pyramid: &MaxPyramid, k: usize, c: [i64; 2]) -> i32 {
-        let shift = (1i64 << k) - 1;
-        let m = &pyramid.levels[k];
-        let lw = (pyramid.width as i64 + shift) as usize;
-        let lh = pyramid.height as i64 + shift;
-        let (cx, cy) = (c[0] + shift, c[1] + shift);
+    /// `Σ M(c + p)` over the runs, `level` being `lw` wide and `lh` high
+    /// (0 outside).
+    fn sum(&self, level: &[i8], lw: usize, lh: i64, cx: i64, cy: i64) -> i32 {
         let mut sum = 0i32;
         for (py, range) in &self.rows {
             let y = cy + py;
             if y < 0 || y >= lh {
                 continue;
             }
-            let row = &m[y as usize * lw..][..lw];
-            let xs = &self.xs[range.clone()];
-            // Columns inside the level: 0 <= cx + px < lw. Most rows lie
-            // wholly inside (xs ascend: the first and last tell); only the
-            // others need the two binary searches.
-            let (first, last) = (xs[0], xs[xs.len() - 1]);
-            let xs = if cx + first >= 0 && cx + last < lw as i64 {
-                xs
-            } else {
-                let lo = xs.partition_point(|&px| cx + px < 0);
-                let hi = xs.partition_point(|&px| cx + px < lw as i64);
-                &xs[lo..hi.max(lo)]
-            };
-            for &px in xs {
-                sum += row[(cx + px) as usize] as i32;
+            let row = &level[y as usize * lw..][..lw];
+            for &(px, len) in &self.runs[range.clone()] {
+                let lo = (cx + px).max(0);
+                let hi = (cx + px + len).min(lw as i64);
+                if lo < hi {
+                    sum += row[lo as usize..hi as usize]
+                        .iter()
+                        .map(|&v| v as i32)
+                        .sum::<i32>();
+                }
             }
         }
         sum
+    }
+}
+
+impl Points {
+    fn new(mut points: Vec<[i64; 2]>) -> Points {
+        let count = points.len();
+        // Each point's run length along its row, then down its column.
+        let along = |points: &mut Vec<[i64; 2]>, axis: usize| -> HashMap<[i64; 2], i64> {
+            let other = 1 - axis;
+            points.sort_unstable_by_key(|p| (p[other], p[axis]));
+            let mut length = HashMap::with_capacity(points.len());
+            let mut start = 0;
+            for i in 1..=points.len() {
+                let breaks = i == points.len()
+                    || points[i][other] != points[i - 1][other]
+                    || points[i][axis] != points[i - 1][axis] + 1;
+                if breaks {
+                    for p in &points[start..i] {
+                        length.insert(*p, (i - start) as i64);
+                    }
+                    start = i;
+                }
+            }
+            length
+        };
+        let down = along(&mut points, 1);
+        let across = along(&mut points, 0);
+        // `points` is now sorted by row, then column.
+        let (in_rows, in_cols): (Vec<[i64; 2]>, Vec<[i64; 2]>) =
+            points.iter().copied().partition(|p| across[p] >= down[p]);
+        let mut swapped: Vec<[i64; 2]> = in_cols.iter().map(|p| [p[1], p[0]]).collect();
+        swapped.sort_unstable_by_key(|p| (p[1], p[0]));
+        Points {
+            rows: Runs::new(&in_rows),
+            cols: Runs::new(&swapped),
+            count,
+        }
+    }
+
+    /// `Σ_p M_{2^k}(c + p)` (0 outside the level), the bound of the
+    /// block of translations starting at `c` (the exact sum at level 0).
+    fn bound(&self, pyramid: &MaxPyramid, k: usize, c: [i64; 2]) -> i32 {
+        let shift = (1i64 << k) - 1;
+        let lw = pyramid.width as i64 + shift;
+        let lh = pyramid.height as i64 + shift;
+        let (cx, cy) = (c[0] + shift, c[1] + shift);
+        self.rows.sum(&pyramid.levels[k], lw as usize, lh, cx, cy)
+            + self
+                .cols
+                .sum(&pyramid.transposed[k], lh as usize, lw, cy, cx)
     }
 }
 
@@ -253,7 +334,7 @@ struct Search {
 
 impl Search {
     fn bound(&mut self, a_max: &MaxPyramid, k: usize, c: [i64; 2]) -> i32 {
-        self.lookups += (self.on_a.xs.len() + self.on_b.xs.len()) as u64;
+        self.lookups += (self.on_a.count + self.on_b.count) as u64;
         self.on_a.bound(a_max, k, c) + self.on_b.bound(&self.b_max, k, c)
     }
 
