@@ -20,7 +20,9 @@ use slamlab::merge::job::{MergeConfig, MergeJob, Stage};
 use slamlab::merge::lift::{column_bearing_rad, laser_range_at, lift_keypoint_3d};
 use slamlab::merge::mapsearch::{dominant_rotation, search_maps, MapSearchConfig};
 use slamlab::merge::rigid::{fit_rigid_least_squares, fit_rigid_msac, RigidConfig};
-use slamlab::merge::verdict::{decide_pair, map_agreement, PairDecision, VerdictConfig};
+use slamlab::merge::verdict::{
+    decide_pair, map_agreement, PairDecision, SearchSummary, VerdictConfig, VerdictSteps,
+};
 use slamlab::merge::vocabulary::{propose_pairs, similarity, Vocabulary, VocabularyConfig};
 use slamlab::merge::{Candidate, FrameInfo, MergeMethod, MergeStatus};
 use slamlab::rng::Rng;
@@ -554,6 +556,30 @@ fn grid_alignment_recovers_a_perturbed_transform_and_the_verdict_refuses_wrong_o
         let a = d.agreement.expect("judged on the maps");
         assert!(a.occupied_contradict > 50, "{a:?}");
     }
+    // Both transforms proposed at once: each is judged in a step of its
+    // own (after the step that finds them, before the one that compares
+    // them), and the decision is the one call's: the right one, merged.
+    let mut both = right.clone();
+    // (seen from other places: two candidates of one place are one place)
+    let elsewhere = [DVec2::new(1.5, 0.6), DVec2::new(1.5, 5.4)];
+    both.extend(
+        elsewhere
+            .iter()
+            .enumerate()
+            .map(|(k, &p)| cand(truth.inverse().transform_point(p), turned, k + 2)),
+    );
+    let whole = decide_pair(&both, map_a, map_b, &cfg);
+    assert_eq!(whole.status, MergeStatus::Merged, "{}", whole.reason);
+    let mut steps = VerdictSteps::default();
+    let mut calls = 1;
+    let stepped = loop {
+        match steps.step(&both, &SearchSummary::default(), map_a, map_b, &cfg) {
+            Some(d) => break d,
+            None => calls += 1,
+        }
+    };
+    assert_eq!(calls, 4, "rivals, two judgements, the comparison");
+    assert_eq!(stepped, whole);
     // One place alone is not enough, however good.
     let d = decide_pair(&right[..1], map_a, map_b, &cfg);
     assert_eq!(d.status, MergeStatus::NoMerge);

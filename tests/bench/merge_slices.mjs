@@ -6,6 +6,10 @@
 //
 //   node tests/bench/merge_slices.mjs SCENARIO.json [--units N]
 //
+// The calls over 100 ms are listed too (`long`: stage, the stage's units
+// done before the call and in all, and its time), to find the unit that
+// holds the page.
+//
 // SLAMLAB_PKG=DIR measures another wasm build (web/cli/wasm.mjs).
 import { readFileSync } from 'node:fs';
 import { performance } from 'node:perf_hooks';
@@ -27,10 +31,12 @@ lab.runToEnd();
 const runS = (performance.now() - t0) / 1000;
 
 const stages = new Map();
+const long = [];
 let progress = JSON.parse(lab.mergeStart('auto'));
 let calls = 0;
 while (!progress.finished) {
   const stage = progress.stage;
+  const before = `${progress.done} / ${progress.total}`;
   const t = performance.now();
   progress = JSON.parse(lab.mergeAdvance(units));
   const dt = performance.now() - t;
@@ -39,10 +45,13 @@ while (!progress.finished) {
   s.calls += 1;
   s.total_ms += dt;
   s.longest_ms = Math.max(s.longest_ms, dt);
-  if (dt > 100) s.over_100ms += 1;
+  if (dt > 100) {
+    s.over_100ms += 1;
+    long.push({ stage, before, ms: Math.round(dt) });
+  }
   stages.set(stage, s);
 }
-const out = { scenario: file, units, run_s: +runS.toFixed(1), calls, stages: {} };
+const out = { scenario: file, units, run_s: +runS.toFixed(1), calls, stages: {}, long };
 for (const [k, v] of stages) {
   out.stages[k] = {
     calls: v.calls,

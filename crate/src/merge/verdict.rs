@@ -439,9 +439,69 @@ pub fn decide_pair_after_search(
     b: &OccupancyGrid,
     cfg: &VerdictConfig,
 ) -> PairDecision {
+    let mut steps = VerdictSteps::default();
+    loop {
+        if let Some(d) = steps.step(cands, summary, a, b, cfg) {
+            return d;
+        }
+    }
+}
+
+/// [`decide_pair_after_search`] a step at a time, so that a caller with a
+/// page to draw need not judge every rival transform in one call: the
+/// first step finds the hypotheses (and refuses at once when none spans
+/// enough places), each later step judges one of them against the maps
+/// (an alignment and a map comparison, the costly part), and the step
+/// after the last compares the judged. The decision does not depend on
+/// how the steps are spread over calls.
+#[derive(Default)]
+pub struct VerdictSteps {
+    /// The hypotheses with enough places, once found.
+    hypotheses: Option<Vec<ConsistentSet>>,
+    /// The verdict on each hypothesis judged so far, in order.
+    judged: Vec<PairDecision>,
+}
+
+impl VerdictSteps {
+    /// The next step with the same inputs as every earlier one; the
+    /// decision after the last.
+    pub fn step(
+        &mut self,
+        cands: &[Candidate],
+        summary: &SearchSummary,
+        a: &OccupancyGrid,
+        b: &OccupancyGrid,
+        cfg: &VerdictConfig,
+    ) -> Option<PairDecision> {
+        let Some(hypotheses) = &self.hypotheses else {
+            return match rivals(cands, summary, cfg) {
+                Rivals::ToJudge(h) => {
+                    self.hypotheses = Some(h);
+                    None
+                }
+                Rivals::Refused(refused) => Some(refused),
+            };
+        };
+        if let Some(h) = hypotheses.get(self.judged.len()) {
+            self.judged.push(judge_hypothesis(cands, h, a, b, cfg));
+            return None;
+        }
+        Some(compare_judged(std::mem::take(&mut self.judged), cfg))
+    }
+}
+
+/// What the frames propose: rival transforms to judge, or a refusal.
+enum Rivals {
+    ToJudge(Vec<ConsistentSet>),
+    Refused(PairDecision),
+}
+
+/// The rival transforms to judge (the consistent sets spanning enough
+/// places), or the refusal when there is none.
+fn rivals(cands: &[Candidate], summary: &SearchSummary, cfg: &VerdictConfig) -> Rivals {
     if cands.is_empty() {
         let n = summary.proposed_pairs;
-        return refuse(if n == 0 {
+        return Rivals::Refused(refuse(if n == 0 {
             "no common place seen: no frame pair was verified".to_string()
         } else if summary.best_rigid_inliers >= 3 {
             format!(
@@ -451,7 +511,7 @@ pub fn decide_pair_after_search(
             )
         } else {
             format!("no common place seen: 0 of {n} proposed frame pairs verified")
-        });
+        }));
     }
     let hypotheses = consistent_hypotheses(cands, &cfg.consistency, cfg.max_hypotheses.max(1));
     let min_places = cfg.min_places.max(1);
@@ -482,14 +542,20 @@ pub fn decide_pair_after_search(
         });
         d.support = largest.members;
         d.places = largest.places;
-        return d;
+        return Rivals::Refused(d);
     }
     // Every rival transform with enough places is checked against the maps.
-    let judged: Vec<PairDecision> = hypotheses
-        .iter()
-        .filter(|h| h.places >= min_places)
-        .map(|h| judge_hypothesis(cands, h, a, b, cfg))
-        .collect();
+    Rivals::ToJudge(
+        hypotheses
+            .into_iter()
+            .filter(|h| h.places >= min_places)
+            .collect(),
+    )
+}
+
+/// The decision from the verdicts on the rival transforms: the one that
+/// passed, or "ambiguous" when two different ones did.
+fn compare_judged(judged: Vec<PairDecision>, cfg: &VerdictConfig) -> PairDecision {
     let passed: Vec<&PairDecision> = judged
         .iter()
         .filter(|d| d.status == MergeStatus::Merged)

@@ -7,10 +7,12 @@
 //! stage's state between calls, so [`MergeJob::advance`] can do it a unit
 //! at a time, like the features and matching before it:
 //!
-//! 1. **Verdicts.** One unit per pair of robots: the method's decision
-//!    on its frames (without a pair budget, with its map search too);
-//!    under a budget ([`crate::merge::pairbudget`]), pairs left unmatched
-//!    get their "not checked" outcome.
+//! 1. **Verdicts.** A pair of robots at a time: the method's decision on
+//!    its frames a step a unit ([`VerdictSteps`]: the rival transforms its
+//!    frames propose, then each judged against the maps; without a pair
+//!    budget the map search follows in the last step); under a budget
+//!    ([`crate::merge::pairbudget`]), pairs left unmatched get their "not
+//!    checked" outcome in one unit.
 //! 2. **Searches** (budget only). The pairs that are not merged, not torn
 //!    between two transforms and ranked for it by coarse map overlap are
 //!    searched by the maps alone, likeliest first; a pair whose robots
@@ -30,11 +32,14 @@ use super::{MergeJob, MergeStatus, PairOutcome};
 use crate::merge::frames::MergeInput;
 use crate::merge::mapsearch::{MapSearchSteps, WallSpectrum};
 use crate::merge::pairbudget::{BudgetSummary, Components, PairPlan};
+use crate::merge::verdict::VerdictSteps;
 
 /// The decision stage between two calls.
 pub(super) struct Deciding {
     /// One outcome per pair decided so far (in pair order).
     outcomes: Vec<PairOutcome>,
+    /// The next pair's decision under way, between its steps.
+    judging: Option<VerdictSteps>,
     /// Budget only: the pairs to search by their maps, likeliest first
     /// (`None` until every pair has its verdict), and how many are done.
     searches: Option<Vec<usize>>,
@@ -53,6 +58,7 @@ impl Deciding {
     pub(super) fn new(robots: usize, pairs: usize) -> Deciding {
         Deciding {
             outcomes: Vec::with_capacity(pairs),
+            judging: None,
             searches: None,
             searched: 0,
             searching: None,
@@ -88,8 +94,9 @@ impl MergeJob {
         let budgeted = self.budgeted();
         let mut done = 0;
         while done < units && d.outcomes.len() < self.pairs.len() {
-            let o = self.verdict(input, d.outcomes.len(), budgeted, &mut d.summary);
-            d.outcomes.push(o);
+            if let Some(o) = self.verdict_step(input, budgeted, &mut d) {
+                d.outcomes.push(o);
+            }
             done += 1;
         }
         if budgeted && d.outcomes.len() == self.pairs.len() {
@@ -137,29 +144,31 @@ impl MergeJob {
         self.outcome = Some(outcome);
     }
 
-    /// Step 1 for pair `k`.
-    fn verdict(
+    /// One unit of step 1 for the next pair: `None` until its outcome.
+    fn verdict_step(
         &self,
         input: &impl MergeInput,
-        k: usize,
         budgeted: bool,
-        summary: &mut BudgetSummary,
-    ) -> PairOutcome {
-        let p = &self.pairs[k];
-        if !budgeted {
-            return self.method.decide(&self.pair_input(input, p, true));
-        }
+        d: &mut Deciding,
+    ) -> Option<PairOutcome> {
+        let p = &self.pairs[d.outcomes.len()];
         let b = p.budget.unwrap_or_default();
-        summary.partners_per_robot = b.partners;
-        match b.plan {
-            PairPlan::Full => {
-                summary.matched += 1;
-                let mut o = self.method.decide(&self.pair_input(input, p, false));
-                o.check = Some("full");
-                o
+        if budgeted {
+            d.summary.partners_per_robot = b.partners;
+            if b.plan != PairPlan::Full {
+                return Some(self.unmatched(p, &b));
             }
-            _ => self.unmatched(p, &b),
         }
+        let steps = d.judging.get_or_insert_with(VerdictSteps::default);
+        let mut o = self
+            .method
+            .decide_step(&self.pair_input(input, p, !budgeted), steps)?;
+        d.judging = None;
+        if budgeted {
+            d.summary.matched += 1;
+            o.check = Some("full");
+        }
+        Some(o)
     }
 
     /// Between steps 1 and 2: the groups the verdicts joined, and the

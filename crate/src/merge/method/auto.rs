@@ -18,7 +18,7 @@ use super::{pose3, MethodStages, PairInput};
 use crate::geom::wrap_angle;
 use crate::merge::config::MergeConfig;
 use crate::merge::mapsearch::{MapSearch, MapSearchSteps};
-use crate::merge::verdict::{decide_pair_after_search, SearchSummary};
+use crate::merge::verdict::{SearchSummary, VerdictSteps};
 use crate::merge::verify::{PairCheck, VerifyConfig};
 use crate::merge::work::{PairOutcome, PairWork, RobotFrames};
 use crate::merge::{Candidate, FrameInfo, MergeStatus};
@@ -115,6 +115,15 @@ impl MethodStages for Auto {
     }
 
     fn decide(&self, pair: &PairInput) -> PairOutcome {
+        let mut steps = VerdictSteps::default();
+        loop {
+            if let Some(o) = self.decide_step(pair, &mut steps) {
+                return o;
+            }
+        }
+    }
+
+    fn decide_step(&self, pair: &PairInput, steps: &mut VerdictSteps) -> Option<PairOutcome> {
         let (p, config) = (pair.work, pair.config);
         let cands: Vec<Candidate> = p.cells.iter().filter_map(|c| c.candidate.clone()).collect();
         let summary = SearchSummary {
@@ -127,7 +136,7 @@ impl MethodStages for Auto {
                 .unwrap_or(0),
             min_inliers: config.verify.min_inliers,
         };
-        let d = decide_pair_after_search(&cands, &summary, pair.map_a, pair.map_b, &config.verdict);
+        let d = steps.step(&cands, &summary, pair.map_a, pair.map_b, &config.verdict)?;
         let outcome = PairOutcome {
             a: pair.robot_a.name.clone(),
             b: pair.robot_b.name.clone(),
@@ -143,11 +152,11 @@ impl MethodStages for Auto {
             check: None,
             verdict: Some(d),
         };
-        if pair.search_maps {
+        Some(if pair.search_maps {
             self.search_after(pair, outcome)
         } else {
             outcome
-        }
+        })
     }
 
     /// Vision found nothing the maps confirm (and was not torn between two

@@ -24,6 +24,7 @@ pub mod thesis;
 
 use super::config::MergeConfig;
 use super::mapsearch::MapSearchSteps;
+use super::verdict::VerdictSteps;
 use super::verify::{PairCheck, VerifyConfig};
 use super::work::{PairOutcome, PairWork, RobotFrames};
 use super::{FrameInfo, MergeMethod};
@@ -103,6 +104,14 @@ pub trait MethodStages: Sync {
 
     /// The decision on one pair of robots.
     fn decide(&self, pair: &PairInput) -> PairOutcome;
+
+    /// [`MethodStages::decide`] a step at a time, so that one decision
+    /// need not be one long call (the automatic method judges a rival
+    /// transform a step, [`VerdictSteps`]): `None` until the last step,
+    /// then the outcome. `steps` is fresh for each pair.
+    fn decide_step(&self, pair: &PairInput, _steps: &mut VerdictSteps) -> Option<PairOutcome> {
+        Some(self.decide(pair))
+    }
 
     /// A second look at a pair [`MethodStages::decide`] did not merge
     /// (asked with `search_maps` false): the automatic method's search of
