@@ -556,9 +556,10 @@ fn grid_alignment_recovers_a_perturbed_transform_and_the_verdict_refuses_wrong_o
         let a = d.agreement.expect("judged on the maps");
         assert!(a.occupied_contradict > 50, "{a:?}");
     }
-    // Both transforms proposed at once: each is judged in a step of its
-    // own (after the step that finds them, before the one that compares
-    // them), and the decision is the one call's: the right one, merged.
+    // Both transforms proposed at once: each is refined, then judged, in
+    // steps of their own (after the step that finds them, before the one
+    // that compares them), and the decision is the one call's: the right
+    // one, merged.
     let mut both = right.clone();
     // (seen from other places: two candidates of one place are one place)
     let elsewhere = [DVec2::new(1.5, 0.6), DVec2::new(1.5, 5.4)];
@@ -578,7 +579,7 @@ fn grid_alignment_recovers_a_perturbed_transform_and_the_verdict_refuses_wrong_o
             None => calls += 1,
         }
     };
-    assert_eq!(calls, 4, "rivals, two judgements, the comparison");
+    assert_eq!(calls, 6, "rivals, two refined and judged, the comparison");
     assert_eq!(stepped, whole);
     // One place alone is not enough, however good.
     let d = decide_pair(&right[..1], map_a, map_b, &cfg);

@@ -511,28 +511,74 @@ pub fn coarse_overlap(
     grid_b: &OccupancyGrid,
     free_penalty: i32,
 ) -> f64 {
-    let Some(delta) = rotation_between(&a.spectrum, &b.spectrum) else {
-        return 0.0;
-    };
-    let Some(ra) = a.raster.as_ref() else {
-        return 0.0;
-    };
-    let mut best = 0i64;
-    let mut walls_b = 0;
-    for k in 0..4 {
-        let theta = wrap_angle(delta + k as f64 * FRAC_PI_2);
-        let Some(rb) = Raster::draw(grid_b, theta, a.cell_m, free_penalty) else {
-            return 0.0;
+    let mut overlap = CoarseOverlap::new(a, b);
+    loop {
+        if let Some(score) = overlap.step(a, grid_b, free_penalty) {
+            return score;
+        }
+    }
+}
+
+/// [`coarse_overlap`] a rotation at a time (a correlation of 60 m maps
+/// at the coarse cell is tens of milliseconds in wasm, four of them too
+/// long for one call of the page): the best score so far between steps.
+pub struct CoarseOverlap {
+    /// The rotation between the maps' wall directions (`None`: too few
+    /// walls, no overlap).
+    delta: Option<f64>,
+    /// Quarter turns done.
+    turns: usize,
+    best: i64,
+    walls_b: usize,
+}
+
+impl CoarseOverlap {
+    /// The comparison of B (`b`) with A (`a`), no rotation tried yet.
+    pub fn new(a: &CoarseMap, b: &CoarseMap) -> CoarseOverlap {
+        CoarseOverlap {
+            delta: rotation_between(&a.spectrum, &b.spectrum),
+            turns: 0,
+            best: 0,
+            walls_b: 0,
+        }
+    }
+
+    /// Quarter turns tried so far (four in all).
+    pub fn turns(&self) -> usize {
+        self.turns
+    }
+
+    /// The next quarter turn's correlation, with the same arguments on
+    /// every call (`grid_b` is the map `b` was made from); the overlap
+    /// after the fourth, or as soon as there can be none.
+    pub fn step(
+        &mut self,
+        a: &CoarseMap,
+        grid_b: &OccupancyGrid,
+        free_penalty: i32,
+    ) -> Option<f64> {
+        let (Some(delta), Some(ra)) = (self.delta, a.raster.as_ref()) else {
+            return Some(0.0);
         };
-        walls_b = rb.walls.len();
+        let theta = wrap_angle(delta + self.turns as f64 * FRAC_PI_2);
+        let Some(rb) = Raster::draw(grid_b, theta, a.cell_m, free_penalty) else {
+            return Some(0.0);
+        };
+        self.walls_b = rb.walls.len();
         let corr = correlate(ra, &rb);
-        best = best.max(corr.acc.iter().copied().max().unwrap_or(0) as i64);
+        self.best = self
+            .best
+            .max(corr.acc.iter().copied().max().unwrap_or(0) as i64);
+        self.turns += 1;
+        if self.turns < 4 {
+            return None;
+        }
+        let smaller = ra.walls.len().min(self.walls_b);
+        if smaller == 0 {
+            return Some(0.0);
+        }
+        Some((self.best as f64 / (2 * smaller) as f64).max(0.0))
     }
-    let smaller = ra.walls.len().min(walls_b);
-    if smaller == 0 {
-        return 0.0;
-    }
-    (best as f64 / (2 * smaller) as f64).max(0.0)
 }
 
 /// Whether two transforms of B differ by more than the settings allow, at

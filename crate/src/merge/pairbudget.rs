@@ -52,7 +52,7 @@
 //! Nothing here reads the truth; everything is deterministic (ties go to
 //! the lower robot index).
 
-use super::mapsearch::{coarse_overlap, CoarseMap};
+use super::mapsearch::{CoarseMap, CoarseOverlap};
 use super::vocabulary::{inverted_file, word_count, Bag};
 use crate::slam::OccupancyGrid;
 use serde::Serialize;
@@ -224,8 +224,10 @@ pub struct BudgetSteps {
     coarse: Vec<CoarseMap>,
     /// `overlaps[a][b]`, symmetric, filled pair by pair.
     overlaps: Vec<Vec<f64>>,
-    /// The next pair whose overlap is computed, `a < b`.
+    /// The next pair whose overlap is computed, `a < b`, and its
+    /// comparison under way (a quarter turn a step).
     next: (usize, usize),
+    overlap: Option<CoarseOverlap>,
     pairs_done: usize,
 }
 
@@ -239,14 +241,16 @@ impl BudgetSteps {
             coarse: Vec::with_capacity(robots),
             overlaps: vec![vec![0.0; robots]; robots],
             next: (0, 1),
+            overlap: None,
             pairs_done: 0,
         }
     }
 
     /// Steps in all for `robots` robots: the inverted file, a robot's votes
-    /// each, a coarse map each, an overlap per pair.
+    /// each, a coarse map each, four quarter turns per pair's overlap (a
+    /// pair whose maps show too few walls takes one).
     pub fn total(robots: usize) -> usize {
-        1 + 2 * robots + robots * robots.saturating_sub(1) / 2
+        1 + 2 * robots + 4 * (robots * robots.saturating_sub(1) / 2)
     }
 
     /// Steps taken so far.
@@ -256,7 +260,8 @@ impl BudgetSteps {
             (None, Some(v)) => (1, v.len()),
             (None, None) => (0, 0),
         };
-        file + voted + self.coarse.len() + self.pairs_done
+        let turns = self.overlap.as_ref().map_or(0, CoarseOverlap::turns);
+        file + voted + self.coarse.len() + 4 * self.pairs_done + turns
     }
 
     /// One step; the plan of every pair `(a, b)`, `a < b`, in that order,
@@ -292,7 +297,11 @@ impl BudgetSteps {
         }
         let (a, b) = self.next;
         if b < n {
-            let s = coarse_overlap(&self.coarse[a], &self.coarse[b], maps[b], cfg.free_penalty);
+            let overlap = self
+                .overlap
+                .get_or_insert_with(|| CoarseOverlap::new(&self.coarse[a], &self.coarse[b]));
+            let s = overlap.step(&self.coarse[a], maps[b], cfg.free_penalty)?;
+            self.overlap = None;
             self.overlaps[a][b] = s;
             self.overlaps[b][a] = s;
             self.pairs_done += 1;

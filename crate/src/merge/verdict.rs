@@ -450,9 +450,10 @@ pub fn decide_pair_after_search(
 /// [`decide_pair_after_search`] a step at a time, so that a caller with a
 /// page to draw need not judge every rival transform in one call: the
 /// first step finds the hypotheses (and refuses at once when none spans
-/// enough places), each later step judges one of them against the maps
-/// (an alignment and a map comparison, the costly part), and the step
-/// after the last compares the judged. The decision does not depend on
+/// enough places), then each of them takes two steps against the maps
+/// (the grids' alignment, [`refine_hypothesis`], then the maps compared,
+/// [`judge_refined`]: the costly part), and the step after the last
+/// compares the judged. The decision does not depend on
 /// how the steps are spread over calls.
 #[derive(Default)]
 pub struct VerdictSteps {
@@ -460,6 +461,8 @@ pub struct VerdictSteps {
     hypotheses: Option<Vec<ConsistentSet>>,
     /// The verdict on each hypothesis judged so far, in order.
     judged: Vec<PairDecision>,
+    /// The next hypothesis, refined but not yet judged.
+    refined: Option<RefinedHypothesis>,
 }
 
 impl VerdictSteps {
@@ -483,7 +486,10 @@ impl VerdictSteps {
             };
         };
         if let Some(h) = hypotheses.get(self.judged.len()) {
-            self.judged.push(judge_hypothesis(cands, h, a, b, cfg));
+            match self.refined.take() {
+                None => self.refined = Some(refine_hypothesis(cands, h, a, b, cfg)),
+                Some(r) => self.judged.push(judge_refined(cands, h, r, a, b, cfg)),
+            }
             return None;
         }
         Some(compare_judged(std::mem::take(&mut self.judged), cfg))
@@ -625,18 +631,58 @@ pub fn judge_hypothesis(
     b: &OccupancyGrid,
     cfg: &VerdictConfig,
 ) -> PairDecision {
+    let refined = refine_hypothesis(cands, set, a, b, cfg);
+    judge_refined(cands, set, refined, a, b, cfg)
+}
+
+/// A hypothesis's transform as its frames see it (`vision`, `None` when
+/// they have none in common) and as the grids' alignment refines it
+/// (`None` when too few walls lie near the common places): the first
+/// half of [`judge_hypothesis`].
+#[derive(Clone, Copy, Debug)]
+pub struct RefinedHypothesis {
+    vision: Option<Pose2>,
+    aligned: Option<Pose2>,
+}
+
+/// [`judge_hypothesis`]'s first half: vision's transform, refined on the
+/// grids.
+pub fn refine_hypothesis(
+    cands: &[Candidate],
+    set: &ConsistentSet,
+    a: &OccupancyGrid,
+    b: &OccupancyGrid,
+    cfg: &VerdictConfig,
+) -> RefinedHypothesis {
+    let vision = mean_pose(cands, &set.members);
+    let aligned = vision
+        .and_then(|v| refine_alignment(a, b, &v, &cfg.align))
+        .map(|Alignment { pose, .. }| pose);
+    RefinedHypothesis { vision, aligned }
+}
+
+/// [`judge_hypothesis`]'s second half: the maps compared at the refined
+/// transform, and the verdict.
+pub fn judge_refined(
+    cands: &[Candidate],
+    set: &ConsistentSet,
+    refined: RefinedHypothesis,
+    a: &OccupancyGrid,
+    b: &OccupancyGrid,
+    cfg: &VerdictConfig,
+) -> PairDecision {
     let with_support = |mut d: PairDecision| {
         d.support = set.members.clone();
         d.places = set.places;
         d
     };
-    let Some(vision) = mean_pose(cands, &set.members) else {
+    let Some(vision) = refined.vision else {
         return with_support(refuse(
             "candidates disagree: no common transform".to_string(),
         ));
     };
     let (vision_m, vision_rad) = spread(cands, &set.members, &vision);
-    let Some(Alignment { pose, .. }) = refine_alignment(a, b, &vision, &cfg.align) else {
+    let Some(pose) = refined.aligned else {
         return with_support(refuse(
             "maps barely overlap: too few wall cells near the common places to confirm the transform"
                 .to_string(),
