@@ -8,36 +8,49 @@
 //! that keeps the search exact).
 //!
 //! ```text
-//! cargo run --release -p slamlab --example bench_peaks -- [--size 700] [--rounds 3]
+//! cargo run --release -p slamlab --example bench_peaks -- [--size 700] [--rounds 3] [--turn DEG]
 //! ```
+//!
+//! `--turn` turns the lattice by whole degrees in the raster (the hour's
+//! maps: robots start at random headings, so their walls are staircases).
+//! It also builds for `wasm32-wasip1` and runs in node's WASI, to measure
+//! the wasm build (BENCHMARKS.md, session 21).
 
 use slamlab::merge::peaksearch::{pyramid_of, PeakSearch, ScoreImage};
 use std::time::Instant;
 
-/// Score and wall cells of a lattice maze `size` cells a side.
-fn lattice(size: usize, period: usize, seed: u64) -> (Vec<i32>, Vec<[usize; 2]>) {
+/// Score and wall cells of a lattice maze `size` cells a side, its walls
+/// turned by `turn` (radians) about the raster's centre: a map whose frame
+/// is not along its walls draws them as staircases.
+fn lattice(size: usize, period: usize, seed: u64, turn: f64) -> (Vec<i32>, Vec<[usize; 2]>) {
     let mut rng = slamlab::rng::Rng::new(seed);
+    // Which lattice segments stand, for lattice cells over a margin wide
+    // enough for any turn: keep[cell][0] along x, [1] along y.
+    let cells = 3 * (size / period + 2);
+    let keep: Vec<[bool; 2]> = (0..cells * cells)
+        .map(|_| {
+            [
+                !rng.next_u64().is_multiple_of(3),
+                !rng.next_u64().is_multiple_of(3),
+            ]
+        })
+        .collect();
+    let (s, c) = turn.sin_cos();
+    let centre = size as f64 / 2.0;
+    let offset = (cells / 3 * period) as f64;
+    let on_wall = |x: usize, y: usize| {
+        let (dx, dy) = (x as f64 + 0.5 - centre, y as f64 + 0.5 - centre);
+        let u = c * dx + s * dy + centre + offset;
+        let v = -s * dx + c * dy + centre + offset;
+        let (cu, cv) = ((u / period as f64) as usize, (v / period as f64) as usize);
+        let (fu, fv) = (u % period as f64, v % period as f64);
+        let cell = |cu: usize, cv: usize| keep.get(cv * cells + cu).copied().unwrap_or([false; 2]);
+        (fv < 2.0 && cell(cu, cv)[0]) || (fu < 2.0 && cell(cu, cv)[1])
+    };
     let mut wall = vec![false; size * size];
-    let cells = size / period + 1;
-    for cy in 0..cells {
-        for cx in 0..cells {
-            for along_x in [true, false] {
-                if rng.next_u64().is_multiple_of(3) {
-                    continue;
-                }
-                for d in 0..=period {
-                    for t in 0..2 {
-                        let (x, y) = if along_x {
-                            (cx * period + d, cy * period + t)
-                        } else {
-                            (cx * period + t, cy * period + d)
-                        };
-                        if x < size && y < size {
-                            wall[y * size + x] = true;
-                        }
-                    }
-                }
-            }
+    for y in 0..size {
+        for x in 0..size {
+            wall[y * size + x] = on_wall(x, y);
         }
     }
     let mut score = vec![0; size * size];
@@ -64,7 +77,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         })
     };
     let (size, rounds) = (opt("--size", 700)?, opt("--rounds", 3)?);
-    let (sa, wa) = lattice(size, 30, 7);
+    let turn = (opt("--turn", 0)? as f64).to_radians();
+    let (sa, wa) = lattice(size, 30, 7, turn);
     // B: the middle half of A, turned by a quarter turn.
     let (lo, n) = (size / 4, size / 2);
     let mut sb = vec![0; n * n];
