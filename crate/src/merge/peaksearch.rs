@@ -61,7 +61,8 @@
 //! rotation's search in such pieces so that the page can draw between
 //! them ([`super::mapsearch::MapSearchSteps`]).
 //!
-//! Each bound costs one lookup per wall cell of both maps, so the saving
+//! Each bound costs one lookup per wall cell of both maps (long runs of
+//! neighbouring wall cells are added as slices, [`Points`]), so the saving
 //! depends on how fast the bounds fall below the peaks kept; the
 //! benchmark in BENCHMARKS.md ("The map search, branch and bound") has the
 //! figures. The answer does not depend on it: the test module checks it
@@ -201,7 +202,7 @@ struct Runs {
 /// set-up costs more than it saves on a staircase of short steps (walls
 /// drawn turned). Chosen on `examples/bench_peaks.rs`: at 6 or 12, walls
 /// turned 23° or 45° took up to 1.45× as long as cell by cell; at 24 they
-/// take as long (within 6 %), and walls along the axes 3–4.7× less.
+/// take as long (within 6 %), and walls along the axes 3–4× less.
 const MIN_RUN: i64 = 24;
 
 impl Runs {
