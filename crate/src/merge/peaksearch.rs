@@ -62,7 +62,7 @@
 //! them ([`super::mapsearch::MapSearchSteps`]).
 //!
 //! Each bound costs one lookup per wall cell of both maps (long runs of
-//! neighbouring wall cells are added as slices, [`Points`]), so the saving
+//! neighbouring wall cells are added as slices, `Points`), so the saving
 //! depends on how fast the bounds fall below the peaks kept; the
 //! benchmark in BENCHMARKS.md ("The map search, branch and bound") has the
 //! figures. The answer does not depend on it: the test module checks it
@@ -86,7 +86,7 @@ pub struct ScoreImage<'a> {
 /// covers `x ∈ [−(2^k − 1), width)` (and the same in y), stored shifted
 /// by `2^k − 1`, row by row; and the same images transposed (stored
 /// column by column), so that a run of wall cells down a column is read
-/// as one contiguous slice too ([`Points`]). A window is a square, so the
+/// as one contiguous slice too (`Points`). A window is a square, so the
 /// transposed max image is the max image of the transposed scores. (The
 /// default is empty: a placeholder.)
 #[derive(Default)]
