@@ -193,10 +193,10 @@ fn the_merge_a_unit_at_a_time_equals_the_merge_at_once() {
     assert_eq!(proposals_whole, 1, "one call proposes every pair");
     // Five robots, over the budget's four: the vocabulary's tree, five
     // robots' words, the bags, the votes' inverted file, five robots'
-    // votes, five coarse maps, ten overlaps of four quarter turns each,
-    // ten to-do lists.
-    assert_eq!(proposals_total, 68, "the proposal steps");
-    assert_eq!(proposals_cut, 68, "one call per proposal step");
+    // votes, five coarse maps of two steps each (spectrum, raster), ten
+    // overlaps of four quarter turns each, ten to-do lists.
+    assert_eq!(proposals_total, 73, "the proposal steps");
+    assert_eq!(proposals_cut, 73, "one call per proposal step");
     assert_eq!(calls_whole, 1, "one call decides every pair");
     // Five robots: ten pairs under the budget, then at least one search.
     assert!(total > 10, "the searches count as units: {total}");

@@ -484,9 +484,20 @@ pub struct CoarseMap {
 impl CoarseMap {
     /// `grid` drawn at `cell_m` (at least its own cell).
     pub fn new(grid: &OccupancyGrid, cell_m: f64, free_penalty: i32) -> CoarseMap {
+        CoarseMap::with_spectrum(grid, WallSpectrum::of(grid), cell_m, free_penalty)
+    }
+
+    /// [`CoarseMap::new`] given the grid's spectrum (`WallSpectrum::of(grid)`),
+    /// for a caller that computes the two halves in separate steps.
+    pub fn with_spectrum(
+        grid: &OccupancyGrid,
+        spectrum: WallSpectrum,
+        cell_m: f64,
+        free_penalty: i32,
+    ) -> CoarseMap {
         let cell_m = cell_m.max(grid.resolution_m());
         CoarseMap {
-            spectrum: WallSpectrum::of(grid),
+            spectrum,
             cell_m,
             raster: Raster::draw(grid, 0.0, cell_m, free_penalty),
         }

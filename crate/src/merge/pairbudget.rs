@@ -52,7 +52,7 @@
 //! Nothing here reads the truth; everything is deterministic (ties go to
 //! the lower robot index).
 
-use super::mapsearch::{CoarseMap, CoarseOverlap};
+use super::mapsearch::{CoarseMap, CoarseOverlap, WallSpectrum};
 use super::vocabulary::{inverted_file, word_count, Bag};
 use crate::slam::OccupancyGrid;
 use serde::Serialize;
@@ -222,6 +222,9 @@ pub struct BudgetSteps {
     tally: Option<VoteTally>,
     votes: Option<Vec<Vec<f64>>>,
     coarse: Vec<CoarseMap>,
+    /// The next robot's wall spectrum, once computed (its coarse map is
+    /// two steps: the spectrum, then the raster).
+    spectrum: Option<WallSpectrum>,
     /// `overlaps[a][b]`, symmetric, filled pair by pair.
     overlaps: Vec<Vec<f64>>,
     /// The next pair whose overlap is computed, `a < b`, and its
@@ -239,6 +242,7 @@ impl BudgetSteps {
             tally: None,
             votes: None,
             coarse: Vec::with_capacity(robots),
+            spectrum: None,
             overlaps: vec![vec![0.0; robots]; robots],
             next: (0, 1),
             overlap: None,
@@ -247,10 +251,11 @@ impl BudgetSteps {
     }
 
     /// Steps in all for `robots` robots: the inverted file, a robot's votes
-    /// each, a coarse map each, four quarter turns per pair's overlap (a
-    /// pair whose maps show too few walls takes one).
+    /// each, two per coarse map (its spectrum, its raster), four quarter
+    /// turns per pair's overlap (a pair whose maps show too few walls takes
+    /// one).
     pub fn total(robots: usize) -> usize {
-        1 + 2 * robots + 4 * (robots * robots.saturating_sub(1) / 2)
+        1 + 3 * robots + 4 * (robots * robots.saturating_sub(1) / 2)
     }
 
     /// Steps taken so far.
@@ -261,7 +266,8 @@ impl BudgetSteps {
             (None, None) => (0, 0),
         };
         let turns = self.overlap.as_ref().map_or(0, CoarseOverlap::turns);
-        file + voted + self.coarse.len() + 4 * self.pairs_done + turns
+        let spectra = self.coarse.len() + usize::from(self.spectrum.is_some());
+        file + voted + self.coarse.len() + spectra + 4 * self.pairs_done + turns
     }
 
     /// One step; the plan of every pair `(a, b)`, `a < b`, in that order,
@@ -291,8 +297,15 @@ impl BudgetSteps {
         };
         if self.coarse.len() < n {
             let map = maps[self.coarse.len()];
-            self.coarse
-                .push(CoarseMap::new(map, cfg.coarse_cell_m, cfg.free_penalty));
+            match self.spectrum.take() {
+                None => self.spectrum = Some(WallSpectrum::of(map)),
+                Some(spectrum) => self.coarse.push(CoarseMap::with_spectrum(
+                    map,
+                    spectrum,
+                    cfg.coarse_cell_m,
+                    cfg.free_penalty,
+                )),
+            }
             return None;
         }
         let (a, b) = self.next;

@@ -20,8 +20,8 @@
 //! coarse overlaps of 60 m maps), time in which a page could not draw. So
 //! it is cut into steps: step 1 is one for the tree, one per robot's words
 //! and one for the weights; step 2 one for the votes' inverted file, one
-//! per robot's votes, one per coarse map and one per quarter turn of each
-//! pair's overlap; step 3 one per pair of robots. [`ProposalSteps`] keeps what is done between calls.
+//! per robot's votes, two per coarse map (its spectrum, its raster) and one
+//! per quarter turn of each pair's overlap; step 3 one per pair of robots. [`ProposalSteps`] keeps what is done between calls.
 //! The steps are taken in the order one call takes them, so the proposals
 //! do not depend on how the steps are spread over calls
 //! (`tests/merge_groups.rs` checks it).
