@@ -7,8 +7,10 @@
 //   node tests/bench/merge_slices.mjs SCENARIO.json [--units N]
 //
 // The calls over 100 ms are listed too (`long`: stage, the stage's units
-// done before the call and in all, and its time), to find the unit that
-// holds the page.
+// done before the call and in all, `#n` the call's place among those made
+// at that progress, and its time), to find the unit that holds the page:
+// with `--units 1`, `#0` of a pair's verdict is its rivals, `#1` the first
+// rival's grid alignment, `#2` its map comparison, and so on.
 //
 // SLAMLAB_PKG=DIR measures another wasm build (web/cli/wasm.mjs).
 import { readFileSync } from 'node:fs';
@@ -32,11 +34,18 @@ const runS = (performance.now() - t0) / 1000;
 
 const stages = new Map();
 const long = [];
+let lastBefore = '';
+let nth = 0;
 let progress = JSON.parse(lab.mergeStart('auto'));
 let calls = 0;
 while (!progress.finished) {
   const stage = progress.stage;
-  const before = `${progress.done} / ${progress.total}`;
+  // `#n`: the call's place among the calls made at the same progress
+  // (the steps of one pair's verdict or map search leave it unchanged).
+  const at = `${progress.done} / ${progress.total}`;
+  nth = at === lastBefore ? nth + 1 : 0;
+  lastBefore = at;
+  const before = `${at} #${nth}`;
   const t = performance.now();
   progress = JSON.parse(lab.mergeAdvance(units));
   const dt = performance.now() - t;
