@@ -87,8 +87,10 @@ pub struct ScoreImage<'a> {
 /// by `2^k − 1`, row by row; and the same images transposed (stored
 /// column by column), so that a run of wall cells down a column is read
 /// as one contiguous slice too (`Points`). A window is a square, so the
-/// transposed max image is the max image of the transposed scores. (The
-/// default is empty: a placeholder.)
+/// transposed max image is the max image of the transposed scores. The
+/// transposed copy is built only for a search that reads it (walls drawn
+/// turned have no long column runs). (The default is empty: a
+/// placeholder.)
 #[derive(Default)]
 pub struct MaxPyramid {
     width: usize,
@@ -110,26 +112,37 @@ impl MaxPyramid {
                 base.push(i8::try_from(cell(x, y)).ok()?);
             }
         }
-        let mut transposed = vec![0i8; width * height];
-        for (y, row) in base.chunks_exact(width.max(1)).enumerate() {
-            for (x, &v) in row.iter().enumerate() {
-                transposed[x * height + y] = v;
-            }
-        }
         Some(MaxPyramid {
             width,
             height,
             levels: vec![base],
-            transposed: vec![transposed],
+            transposed: Vec::new(),
         })
     }
 
-    /// Builds the levels up to `top`, in both storages.
-    fn ensure(&mut self, top: usize) {
+    /// Builds the levels up to `top`, and their transposed copies when
+    /// `transposed`.
+    fn ensure(&mut self, top: usize, transposed: bool) {
         while self.levels.len() <= top {
             let k = self.levels.len();
             let next = next_level(&self.levels[k - 1], self.width, self.height, k);
             self.levels.push(next);
+        }
+        if !transposed {
+            return;
+        }
+        if self.transposed.is_empty() {
+            let (width, height) = (self.width, self.height);
+            let mut base = vec![0i8; width * height];
+            for (y, row) in self.levels[0].chunks_exact(width.max(1)).enumerate() {
+                for (x, &v) in row.iter().enumerate() {
+                    base[x * height + y] = v;
+                }
+            }
+            self.transposed.push(base);
+        }
+        while self.transposed.len() <= top {
+            let k = self.transposed.len();
             let next = next_level(&self.transposed[k - 1], self.height, self.width, k);
             self.transposed.push(next);
         }
@@ -321,10 +334,13 @@ impl Points {
         let lw = pyramid.width as i64 + shift;
         let lh = pyramid.height as i64 + shift;
         let (cx, cy) = (c[0] + shift, c[1] + shift);
-        self.rows.sum(&pyramid.levels[k], lw as usize, lh, cx, cy)
-            + self
-                .cols
-                .sum(&pyramid.transposed[k], lh as usize, lw, cy, cx)
+        let rows = self.rows.sum(&pyramid.levels[k], lw as usize, lh, cx, cy);
+        if self.cols.rows.is_empty() {
+            return rows;
+        }
+        rows + self
+            .cols
+            .sum(&pyramid.transposed[k], lh as usize, lw, cy, cx)
     }
 }
 
@@ -464,13 +480,9 @@ impl PeakSearch {
         // B turned by 180°, so that A's wall l meets B's cell i − l as a
         // window of translations too.
         let (bw, bh) = (b.width, b.height);
-        let mut b_max = MaxPyramid::new(bw, bh, |x, y| b.score[(bh - 1 - y) * bw + bw - 1 - x])?;
+        let b_max = MaxPyramid::new(bw, bh, |x, y| b.score[(bh - 1 - y) * bw + bw - 1 - x])?;
         let mut queue = BinaryHeap::new();
         let trivial = count == 0 || nx < 3 || ny < 3;
-        if !trivial {
-            a_max.ensure(top);
-            b_max.ensure(top);
-        }
         // B's wall l lands on A's cell i + l − (b.size − 1); A's wall l on
         // the turned B's cell i − l.
         let (bw, bh) = (bw as i64, bh as i64);
@@ -494,6 +506,10 @@ impl PeakSearch {
             lookups: 0,
         };
         if !trivial {
+            // B's walls read A's pyramid, A's walls B's: each transposed
+            // only where column runs read it.
+            a_max.ensure(top, !search.on_a.cols.rows.is_empty());
+            search.b_max.ensure(top, !search.on_b.cols.rows.is_empty());
             // Step 2 of the module doc begins: the coarsest blocks.
             let s = 1i64 << top;
             for by in 0..(ny + s - 1) / s {
@@ -794,7 +810,7 @@ mod tests {
             walls: &wa,
         };
         let mut m = pyramid_of(&a).expect("fits");
-        m.ensure(5);
+        m.ensure(5, true);
         let points: Vec<[i64; 2]> = wa
             .iter()
             .map(|&[x, y]| [x as i64 - 40, y as i64 - 30])
