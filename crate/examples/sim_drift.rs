@@ -68,13 +68,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .iter()
                 .position(|r| &r.spec.name == n)
                 .ok_or(format!("no robot '{n}'"))?;
-            let mapping = RobotMapping::new(SlamConfig {
-                back_end,
-                ..SlamConfig::default()
-            });
-            let mut mapping = mapping;
             // Experiments: a few settings from the environment.
             let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
+            let mut config = SlamConfig {
+                back_end,
+                ..SlamConfig::default()
+            };
+            config.match_noise_m = env("SLAM_MATCH_NOISE_M").unwrap_or(config.match_noise_m);
+            let o = &mut config.odometry_noise;
+            o.radians_per_metre = env("SLAM_ODO_RAD_PER_M").unwrap_or(o.radians_per_metre);
+            o.metres_per_metre = env("SLAM_ODO_M_PER_M").unwrap_or(o.metres_per_metre);
+            let mut mapping = RobotMapping::new(config);
             if let Some(g) = &mut mapping.graph {
                 let c = &mut g.config;
                 c.floor_m = env("GRAPH_FLOOR_M").unwrap_or(c.floor_m);
@@ -87,6 +91,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     env("GRAPH_CLOSURE_SIGMA_DEG").map_or(c.loops.sigma_rad, f64::to_radians);
                 c.cooldown_keys = env("GRAPH_COOLDOWN").map_or(c.cooldown_keys, |v| v as usize);
                 c.loops.window.linear_m = env("GRAPH_WINDOW_M").unwrap_or(c.loops.window.linear_m);
+                c.loops.min_score = env("GRAPH_MIN_SCORE").unwrap_or(c.loops.min_score);
+                c.loops.search_radius_m = env("GRAPH_RADIUS_M").unwrap_or(c.loops.search_radius_m);
+                c.min_constraint = env("GRAPH_MIN_CONSTRAINT").unwrap_or(c.min_constraint);
                 if env("GRAPH_NO_LOOPS").is_some() {
                     c.loops.min_key_gap = usize::MAX / 2;
                 }

@@ -131,6 +131,13 @@ fn run_one(
     let cfg = config_from_env();
     let n = sim.robots.len();
     let mut mappers: Vec<RobotMapping> = (0..n).map(|_| RobotMapping::new(cfg.clone())).collect();
+    // The back end's closure gates (with SLAM_BACK_END=1).
+    let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
+    for g in mappers.iter_mut().filter_map(|m| m.graph.as_mut()) {
+        let c = &mut g.config;
+        c.loops.min_score = env("GRAPH_MIN_SCORE").unwrap_or(c.loops.min_score);
+        c.min_constraint = env("GRAPH_MIN_CONSTRAINT").unwrap_or(c.min_constraint);
+    }
     let mut odometry_only: Vec<OccupancyGrid> = (0..n)
         .map(|_| OccupancyGrid::new(cfg.grid.clone()))
         .collect();

@@ -99,6 +99,19 @@
 //! corrected trajectory repeats the first lap's error every lap (robot 5 at
 //! 300 s intervals: 0.03 0.19 0.26 0.16 0.01 | 0.04 0.19 0.27 0.16 0.02).
 //!
+//! ## The first lap's closures (session 22)
+//! Those robots' "loop" is not a 240 m square: robot 7's lap is 1,385 keys
+//! (550 m), a left-wall tour of the outer wall and every wall joined to it,
+//! and its first lap, where the error is made, accepted no closure. A
+//! wall-follower walks each corridor twice, along either wall, 1.8 m apart
+//! and facing the other way; the scan walking back scores only 0.4–0.6
+//! against the keys walking in, and in a corridor it pins little across,
+//! so `min_score` (0.6) and `min_constraint` (20) refuse it. At 0.4 and 5
+//! the first lap closes (robot 7 at 1,450 s: 0.381 → 0.049 m) and the
+//! hour's worst robot is 0.171 m (robot 7 0.068), but on the 300 s mazes
+//! those low-scoring closures cost precision (maze 11: 0.012 → 0.047 m),
+//! so the defaults stay (BENCHMARKS.md, "Session 22").
+//!
 //! ## Scan-to-scan key edges: measured, not added
 //! Karto's "chain of recent scans" links each key to the previous keys its
 //! laser still overlaps by matching the scans directly. [`RobotGraph::match_keys`]
