@@ -94,6 +94,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 c.loops.min_score = env("GRAPH_MIN_SCORE").unwrap_or(c.loops.min_score);
                 c.loops.search_radius_m = env("GRAPH_RADIUS_M").unwrap_or(c.loops.search_radius_m);
                 c.min_constraint = env("GRAPH_MIN_CONSTRAINT").unwrap_or(c.min_constraint);
+                c.drift_per_metre = env("GRAPH_DRIFT_PER_M").unwrap_or(c.drift_per_metre);
                 if env("GRAPH_NO_LOOPS").is_some() {
                     c.loops.min_key_gap = usize::MAX / 2;
                 }

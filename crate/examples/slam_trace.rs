@@ -137,6 +137,10 @@ fn run_one(
         let c = &mut g.config;
         c.loops.min_score = env("GRAPH_MIN_SCORE").unwrap_or(c.loops.min_score);
         c.min_constraint = env("GRAPH_MIN_CONSTRAINT").unwrap_or(c.min_constraint);
+        c.drift_per_metre = env("GRAPH_DRIFT_PER_M").unwrap_or(c.drift_per_metre);
+        c.loops.sigma_m = env("GRAPH_CLOSURE_SIGMA_M").unwrap_or(c.loops.sigma_m);
+        c.loops.sigma_rad =
+            env("GRAPH_CLOSURE_SIGMA_DEG").map_or(c.loops.sigma_rad, f64::to_radians);
     }
     let mut odometry_only: Vec<OccupancyGrid> = (0..n)
         .map(|_| OccupancyGrid::new(cfg.grid.clone()))
