@@ -109,8 +109,9 @@
 //! so `min_score` (0.6) and `min_constraint` (20) refuse it. At 0.4 and 5
 //! the first lap closes (robot 7 at 1,450 s: 0.381 → 0.049 m) and the
 //! hour's worst robot is 0.171 m (robot 7 0.068), but on the 300 s mazes
-//! those low-scoring closures cost precision (maze 11: 0.012 → 0.047 m),
-//! so the defaults stay (BENCHMARKS.md, "Session 22").
+//! those low-scoring closures cost precision (maze 11's robots: 0.012 and
+//! 0.011 → 0.040 and 0.047 m), so the defaults stay (BENCHMARKS.md,
+//! "Session 22", with the variants tried since).
 //!
 //! ## Scan-to-scan key edges: measured, not added
 //! Karto's "chain of recent scans" links each key to the previous keys its
