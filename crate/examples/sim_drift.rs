@@ -23,6 +23,9 @@
 //! two key scans ([`slamlab::slam::robot_graph::RobotGraph::match_keys`])
 //! beside the front end's answer.
 
+#[path = "support/back_end.rs"]
+mod back_end_support;
+
 use slamlab::geom::{wrap_angle, Pose2};
 use slamlab::scenario::Scenario;
 use slamlab::sim::Simulation;
@@ -34,6 +37,8 @@ struct Traced {
     mapping: RobotMapping,
     last_err: f64,
     last_counts: MatchCounts,
+    /// The slowest SLAM steps: (ms, step, closures accepted by then).
+    slowest: Vec<(f64, usize, usize)>,
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -78,32 +83,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let o = &mut config.odometry_noise;
             o.radians_per_metre = env("SLAM_ODO_RAD_PER_M").unwrap_or(o.radians_per_metre);
             o.metres_per_metre = env("SLAM_ODO_M_PER_M").unwrap_or(o.metres_per_metre);
-            let mut mapping = RobotMapping::new(config);
-            if let Some(g) = &mut mapping.graph {
-                let c = &mut g.config;
-                c.floor_m = env("GRAPH_FLOOR_M").unwrap_or(c.floor_m);
-                c.floor_rad = env("GRAPH_FLOOR_DEG").map_or(c.floor_rad, f64::to_radians);
-                c.loop_every = env("GRAPH_LOOP_EVERY").map_or(c.loop_every, |v| v as usize);
-                c.satisfied_m = env("GRAPH_SATISFIED_M").unwrap_or(c.satisfied_m);
-                c.refine_closures = env("GRAPH_REFINE").is_none_or(|v| v != 0.0);
-                c.loops.sigma_m = env("GRAPH_CLOSURE_SIGMA_M").unwrap_or(c.loops.sigma_m);
-                c.loops.sigma_rad =
-                    env("GRAPH_CLOSURE_SIGMA_DEG").map_or(c.loops.sigma_rad, f64::to_radians);
-                c.cooldown_keys = env("GRAPH_COOLDOWN").map_or(c.cooldown_keys, |v| v as usize);
-                c.loops.window.linear_m = env("GRAPH_WINDOW_M").unwrap_or(c.loops.window.linear_m);
-                c.loops.min_score = env("GRAPH_MIN_SCORE").unwrap_or(c.loops.min_score);
-                c.loops.search_radius_m = env("GRAPH_RADIUS_M").unwrap_or(c.loops.search_radius_m);
-                c.min_constraint = env("GRAPH_MIN_CONSTRAINT").unwrap_or(c.min_constraint);
-                c.drift_per_metre = env("GRAPH_DRIFT_PER_M").unwrap_or(c.drift_per_metre);
-                if env("GRAPH_NO_LOOPS").is_some() {
-                    c.loops.min_key_gap = usize::MAX / 2;
-                }
-            }
+            back_end_support::config_from_env(&mut config.graph);
+            let mapping = RobotMapping::new(config);
             Ok(Traced {
                 index,
                 mapping,
                 last_err: 0.0,
                 last_counts: MatchCounts::default(),
+                slowest: Vec::new(),
             })
         })
         .collect::<Result<_, String>>()?;
@@ -115,9 +102,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let r = &sim.robots[t.index];
             let odometry = r.odometry.pose();
             let seen = t.mapping.graph.as_ref().map_or(0, |g| g.closures.len());
+            let t0 = std::time::Instant::now();
             t.mapping.observe(&odometry, &r.last_scan);
+            let ms = t0.elapsed().as_secs_f64() * 1e3;
+            let accepted = t.mapping.graph.as_ref().map_or(0, |g| g.closures.len());
+            t.slowest.push((ms, step, accepted));
+            if t.slowest.len() > 64 {
+                t.slowest.sort_by(|a, b| b.0.total_cmp(&a.0));
+                t.slowest.truncate(5);
+            }
             let start = r.spec.start_pose();
-            print_closures(r, &t.mapping, seen);
+            back_end_support::print_accepted(r, &t.mapping, seen);
             let truth = start.inverse().compose(&r.truth);
             let est = t.mapping.estimate();
             let err = est.position().distance(truth.position());
@@ -127,7 +122,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             t.last_err = err;
         }
     }
-    for t in &traced {
+    for t in &mut traced {
         let r = &sim.robots[t.index];
         let start = r.spec.start_pose();
         let errors = position_errors_m(&start, t.mapping.estimates(), &r.log.truth);
@@ -141,7 +136,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             r.spec.name,
             profile.join(" ")
         );
+        t.slowest.sort_by(|a, b| b.0.total_cmp(&a.0));
+        let slow: Vec<String> = t
+            .slowest
+            .iter()
+            .take(5)
+            .map(|(ms, step, c)| format!("{ms:.1} ms at step {step} ({c} closures)"))
+            .collect();
+        println!("{} slowest SLAM steps: {}", r.spec.name, slow.join(", "));
         print_edge_errors(r, &t.mapping);
+        if std::env::var("GRAPH_TRIALS").is_ok() {
+            back_end_support::print_trials(r, &t.mapping);
+        }
         if probe {
             print_front_spans(r, &t.mapping);
             print_key_matches(r, &t.mapping);
@@ -157,29 +163,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     Ok(())
-}
-
-/// Accepted closures from the `seen`-th on, with their error against the
-/// truth (the relative pose between the two steps' true poses).
-fn print_closures(r: &slamlab::sim::RobotSim, mapping: &RobotMapping, seen: usize) {
-    let Some(g) = &mapping.graph else {
-        return;
-    };
-    for c in &g.closures[seen..] {
-        let (a, b) = (r.log.truth[c.from_step], r.log.truth[c.to_step]);
-        let e = a.between(&b).between(&c.measurement);
-        println!(
-            "{:>8} closure keys {}→{} (steps {}→{}) score {:.2}: error {:.3} m {:+.2}°",
-            r.spec.name,
-            c.from_key,
-            c.to_key,
-            c.from_step,
-            c.to_step,
-            c.score,
-            e.position().length(),
-            wrap_angle(e.theta).to_degrees()
-        );
-    }
 }
 
 /// RMS error of the front end's relative pose between consecutive keys

@@ -21,6 +21,8 @@
 //! and score: where a run goes wrong, and whether the matcher or the fusion
 //! took it there.
 
+#[path = "support/back_end.rs"]
+mod back_end_support;
 #[path = "../../tests/slam_support/mod.rs"]
 mod slam_support;
 
@@ -112,10 +114,11 @@ fn config_from_env() -> SlamConfig {
     if let Some(v) = env("SLAM_MOTION_S") {
         cfg.motion.max_interval_s = v;
     }
-    // The loop-closing back end: 1 on, 0 off.
+    // The loop-closing back end: 1 on (the default), 0 off; its settings.
     if let Some(v) = env("SLAM_BACK_END") {
         cfg.back_end = v != 0.0;
     }
+    back_end_support::config_from_env(&mut cfg.graph);
     cfg
 }
 
@@ -131,17 +134,6 @@ fn run_one(
     let cfg = config_from_env();
     let n = sim.robots.len();
     let mut mappers: Vec<RobotMapping> = (0..n).map(|_| RobotMapping::new(cfg.clone())).collect();
-    // The back end's closure gates (with SLAM_BACK_END=1).
-    let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
-    for g in mappers.iter_mut().filter_map(|m| m.graph.as_mut()) {
-        let c = &mut g.config;
-        c.loops.min_score = env("GRAPH_MIN_SCORE").unwrap_or(c.loops.min_score);
-        c.min_constraint = env("GRAPH_MIN_CONSTRAINT").unwrap_or(c.min_constraint);
-        c.drift_per_metre = env("GRAPH_DRIFT_PER_M").unwrap_or(c.drift_per_metre);
-        c.loops.sigma_m = env("GRAPH_CLOSURE_SIGMA_M").unwrap_or(c.loops.sigma_m);
-        c.loops.sigma_rad =
-            env("GRAPH_CLOSURE_SIGMA_DEG").map_or(c.loops.sigma_rad, f64::to_radians);
-    }
     let mut odometry_only: Vec<OccupancyGrid> = (0..n)
         .map(|_| OccupancyGrid::new(cfg.grid.clone()))
         .collect();
@@ -223,7 +215,14 @@ fn run_one(
             }
         }
     }
+    for m in &mut mappers {
+        m.settle();
+    }
     for (i, r) in sim.robots.iter().enumerate() {
+        back_end_support::print_accepted(r, &mappers[i], 0);
+        if std::env::var("GRAPH_TRIALS").is_ok() {
+            back_end_support::print_trials(r, &mappers[i]);
+        }
         let start = r.spec.start_pose();
         let slam = ate_m(&start, mappers[i].estimates(), &r.log.truth);
         let odo = ate_m(&start, &r.log.odometry, &r.log.truth);

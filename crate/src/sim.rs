@@ -522,6 +522,9 @@ impl Simulation {
             for r in &mut self.robots {
                 r.mapping.observe(&r.odometry.pose(), &r.last_scan);
             }
+            if self.finished() {
+                self.settle_maps();
+            }
         }
         // 7. capture: camera frames, once per capture period
         let t1 = self.clock.map_or(0.0, |now| now());
@@ -529,6 +532,15 @@ impl Simulation {
         if let Some(now) = self.clock {
             self.stage_times.slam_ms += t1 - t0;
             self.stage_times.camera_ms += now() - t1;
+        }
+    }
+
+    /// Completes every SLAM map the loop-closing back end is still
+    /// redrawing ([`crate::slam::RobotMapping::settle`]): done at the last
+    /// step, and before a merge reads the maps of a paused run.
+    pub fn settle_maps(&mut self) {
+        for r in &mut self.robots {
+            r.mapping.settle();
         }
     }
 

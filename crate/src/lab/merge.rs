@@ -191,6 +191,9 @@ impl Lab {
     /// Starts merging the current run's maps with `method`, replacing any
     /// earlier merge. The run may be finished or paused.
     pub fn merge_start(&mut self, method: MergeMethod) -> Result<MergeProgress, String> {
+        if let Some(sim) = &mut self.sim {
+            sim.settle_maps();
+        }
         let sim = self
             .simulation()
             .ok_or("nothing has run yet: run the robots before merging")?;

@@ -147,6 +147,9 @@ pub struct SlamConfig {
     /// Whether [`RobotMapping::new`] runs the loop-closing back end
     /// ([`super::robot_graph`]) beside the filter.
     pub back_end: bool,
+    /// The back end's settings (its odometry noise is taken from
+    /// `odometry_noise`).
+    pub graph: RobotGraphConfig,
 }
 
 impl Default for SlamConfig {
@@ -162,7 +165,8 @@ impl Default for SlamConfig {
             match_noise_m: 0.01,
             odometry_noise: OdometryNoise::default(),
             motion: MotionFilter::default(),
-            back_end: false,
+            back_end: true,
+            graph: RobotGraphConfig::default(),
         }
     }
 }
@@ -401,8 +405,8 @@ pub struct RobotMapping {
     pub counts: MatchCounts,
     pub last_outcome: Option<MatchOutcome>,
     /// The loop-closing back end ([`super::robot_graph`]), made when
-    /// [`SlamConfig::back_end`] is set; `None` (the default, until it helps
-    /// every robot: see its module doc) runs the filter alone.
+    /// [`SlamConfig::back_end`] is set (the default); `None` runs the
+    /// filter alone.
     pub graph: Option<RobotGraph>,
 }
 
@@ -418,7 +422,7 @@ impl RobotMapping {
         let graph = config.back_end.then(|| {
             RobotGraph::new(RobotGraphConfig {
                 odometry: config.odometry_noise.clone(),
-                ..RobotGraphConfig::default()
+                ..config.graph.clone()
             })
         });
         RobotMapping {
@@ -522,6 +526,15 @@ impl RobotMapping {
             );
         }
         self.last_outcome = Some(outcome);
+    }
+
+    /// Completes a SLAM map the back end is still redrawing after a loop
+    /// closure (it draws a few key scans per step): call at the end of a
+    /// run, before the map is read as the run's result.
+    pub fn settle(&mut self) {
+        if let Some(graph) = &mut self.graph {
+            graph.settle(&mut self.slam_map);
+        }
     }
 
     /// The map of one mapper.
