@@ -74,18 +74,18 @@ fn line(stage: &str, lab: &Lab) {
     );
 }
 
-/// One row of the table: six sizes in MB, then the frames kept.
-fn print_row(name: &str, row: &[usize; 7]) {
-    let sizes: Vec<String> = row[..6].iter().map(|&b| mb(b)).collect();
-    println!("| {name} | {} ({}) |", sizes.join(" | "), row[6]);
+/// One row of the table: seven sizes in MB, then the frames kept.
+fn print_row(name: &str, row: &[usize; 8]) {
+    let sizes: Vec<String> = row[..7].iter().map(|&b| mb(b)).collect();
+    println!("| {name} | {} ({}) |", sizes.join(" | "), row[7]);
 }
 
 fn table(m: &MemoryUse) {
     println!(
-        "| robot | log poses | log sensors | estimates | odometry map | SLAM map | frames (kept) |"
+        "| robot | log poses | log sensors | estimates | odometry map | SLAM map | back end | frames (kept) |"
     );
-    println!("|---|---|---|---|---|---|---|");
-    let mut sum = [0usize; 7];
+    println!("|---|---|---|---|---|---|---|---|");
+    let mut sum = [0usize; 8];
     for r in &m.robots {
         let row = [
             r.log_poses,
@@ -93,6 +93,7 @@ fn table(m: &MemoryUse) {
             r.estimates,
             r.odometry_map,
             r.slam_map,
+            r.back_end,
             r.frames,
             r.frames_kept,
         ];

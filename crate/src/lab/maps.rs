@@ -35,6 +35,9 @@ pub struct SlamFigures {
     pub matched_steps: usize,
     pub degenerate_steps: usize,
     pub odometry_only_steps: usize,
+    /// Loop closures the back end accepted (each moved the trajectory and,
+    /// where a key moved by more than a cell, redrew the map).
+    pub loop_closures: usize,
     /// Cells of the SLAM grid and their bytes.
     pub map_width: usize,
     pub map_height: usize,
@@ -73,6 +76,7 @@ pub fn figures(sim: &Simulation, robot: &RobotSim) -> SlamFigures {
         occupied_cells: slam.occupied_cells,
         matched_steps: m.counts.matched,
         degenerate_steps: m.counts.degenerate,
+        loop_closures: m.graph.as_ref().map_or(0, |g| g.stats.closures_accepted),
         odometry_only_steps: m.counts.odometry_only,
         map_width: m.slam_map.width(),
         map_height: m.slam_map.height(),

@@ -4,7 +4,8 @@
 //! under a memory target, and a target is met by measuring first. This
 //! file adds up, structure by structure, the heap bytes the session holds
 //! now: each robot's log (times, odometry, truth; the capped sensor rows),
-//! its SLAM estimates, its two occupancy grids, its stored camera frames;
+//! its SLAM estimates, its two occupancy grids, its loop-closing back end's
+//! key scans and pose graph, its stored camera frames;
 //! the texture cache; features described ahead by other threads; and a
 //! merge in progress (its frames' features, their infos, the checked
 //! cells, the merged map).
@@ -37,6 +38,8 @@ pub struct RobotMemory {
     pub estimates: usize,
     pub odometry_map: usize,
     pub slam_map: usize,
+    /// The loop-closing back end: key scans and its pose graph.
+    pub back_end: usize,
     /// Stored camera frames ([`crate::camera::capture::FrameStore`]).
     pub frames: usize,
     pub frames_kept: usize,
@@ -89,6 +92,7 @@ impl Lab {
                     estimates: std::mem::size_of_val(r.mapping.estimates()),
                     odometry_map: r.mapping.odometry_map.memory_bytes(),
                     slam_map: r.mapping.slam_map.memory_bytes(),
+                    back_end: r.mapping.graph.as_ref().map_or(0, |g| g.memory_bytes()),
                     frames: vec_bytes(&r.frames.frames) + r.frames.bytes()
                         - r.frames.frames.len()
                             * size_of::<crate::camera::capture::CapturedFrame>(),
@@ -115,7 +119,13 @@ impl Lab {
             .robots
             .iter()
             .map(|r| {
-                r.log_poses + r.log_sensors + r.estimates + r.odometry_map + r.slam_map + r.frames
+                r.log_poses
+                    + r.log_sensors
+                    + r.estimates
+                    + r.odometry_map
+                    + r.slam_map
+                    + r.back_end
+                    + r.frames
             })
             .sum::<usize>()
             + m.textures
