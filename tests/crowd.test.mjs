@@ -16,6 +16,7 @@ import { writeFileSync } from 'node:fs';
 import path from 'node:path';
 import { crowdMaze } from './bench/crowd_maze.mjs';
 import { runCli as run, tempDir } from './support/cli.mjs';
+import { overlaps as overlapsOf } from './support/overlaps.mjs';
 
 const tmp = tempDir('crowd');
 
@@ -60,28 +61,6 @@ function wrap(t) {
   return Math.atan2(Math.sin(t), Math.cos(t));
 }
 
-/**
- * The cells (of `cell` m) a robot drove through: within `reach` m of its
- * true path. Where two robots' cells meet is where both drove.
- */
-function footprint(truth, cell = 0.5, reach = 1.5) {
-  const cells = new Set();
-  const k = Math.ceil(reach / cell);
-  let last = null;
-  for (const [, x, y] of truth) {
-    if (last && Math.hypot(x - last[0], y - last[1]) < cell / 2) continue;
-    last = [x, y];
-    const [cx, cy] = [Math.floor(x / cell), Math.floor(y / cell)];
-    for (let i = -k; i <= k; i++) {
-      for (let j = -k; j <= k; j++) {
-        const [px, py] = [(cx + i + 0.5) * cell, (cy + j + 0.5) * cell];
-        if (Math.hypot(px - x, py - y) <= reach) cells.add(`${cx + i},${cy + j}`);
-      }
-    }
-  }
-  return cells;
-}
-
 /** Runs a crowded maze through the CLI; the parsed report. */
 function runCrowd(options, name) {
   const file = path.join(tmp, `${name}.json`);
@@ -111,15 +90,7 @@ function assertGroupsAgainstTruth(report, minOverlapping) {
   }
   // The truth: where the robots drove, and each start pose.
   const byName = Object.fromEntries(report.robots.map((x) => [x.name, x]));
-  const prints = report.robots.map((x) => footprint(x.truth));
-  const overlaps = [];
-  for (let i = 0; i < names.length; i++) {
-    for (let j = i + 1; j < names.length; j++) {
-      let shared = 0;
-      for (const c of prints[i]) if (prints[j].has(c)) shared += 1;
-      overlaps.push({ a: names[i], b: names[j], m2: shared * 0.25 });
-    }
-  }
+  const overlaps = overlapsOf(report);
   const groupOf = Object.fromEntries(groups.flatMap((g, k) => g.robots.map((n) => [n, k])));
   const overlapping = overlaps.filter((o) => o.m2 >= 50);
   assert.ok(overlapping.length >= minOverlapping, `an instance with overlaps: ${JSON.stringify(overlaps)}`);
