@@ -681,20 +681,21 @@ impl RobotGraph {
         let start = self.graph.nodes[c.edge.from].compose(&c.edge.measurement);
         let normals = scan_normals(points);
         let r = refine_to_surface(&map, points, &normals, &start, &RefineConfig::default());
+        // σ² (JᵀJ)⁻¹: its largest position eigenvalue and its heading entry.
         let s2 = self.config.closure_residual_m.powi(2);
-        let weak_m = inverse3(&r.information).map_or(f64::INFINITY, |cov| {
-            let (a, b, d) = (s2 * cov[0][0], s2 * cov[0][1], s2 * cov[1][1]);
-            let largest = 0.5 * (a + d) + (0.25 * (a - d).powi(2) + b * b).sqrt();
-            if largest.is_finite() && largest > 0.0 {
-                largest.sqrt()
+        let cov = inverse3(&r.information).map(|c| c.map(|row| row.map(|v| s2 * v)));
+        let sigma = |v: f64| {
+            if v.is_finite() && v > 0.0 {
+                v.sqrt()
             } else {
                 f64::INFINITY
             }
+        };
+        let (weak_m, heading_rad) = cov.map_or((f64::INFINITY, f64::INFINITY), |c| {
+            let (a, b, d) = (c[0][0], c[0][1], c[1][1]);
+            let largest = 0.5 * (a + d) + (0.25 * (a - d).powi(2) + b * b).sqrt();
+            (sigma(largest), sigma(c[2][2]))
         });
-        let heading_rad = inverse3(&r.information)
-            .map(|cov| s2 * cov[2][2])
-            .filter(|v| v.is_finite() && *v > 0.0)
-            .map_or(f64::INFINITY, f64::sqrt);
         ClosureFit {
             heading_rad,
             pose: r.pose,
