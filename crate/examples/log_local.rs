@@ -33,8 +33,8 @@
 use glam::DVec2;
 use slamlab::carmen::{CarmenLog, LogScan};
 use slamlab::geom::{wrap_angle, Pose2};
-use slamlab::slam::degeneracy::{scan_normals, symmetric_eigen2};
-use slamlab::slam::gauss_newton::solve3;
+use slamlab::slam::degeneracy::scan_normals;
+use slamlab::slam::icp::IcpTarget;
 use slamlab::slam::logslam::{scan_points, LogSlamConfig};
 use slamlab::slam::relations::{drift_odometry, relation_errors, DriftModel, RelationErrors};
 use std::collections::HashMap;
@@ -51,73 +51,19 @@ const CLAMP_M: f64 = 0.05;
 /// Least weak eigenvalue of `Σ n nᵀ` for a pair to be compared.
 const MIN_WEAK: f64 = 20.0;
 
-/// The earlier scan of a pair: its points, normals and a bucket grid.
-struct Target {
-    points: Vec<DVec2>,
-    normals: Vec<Option<DVec2>>,
-    buckets: HashMap<(i64, i64), Vec<usize>>,
-}
-
-fn bucket(p: DVec2) -> (i64, i64) {
-    (
-        (p.x / RADIUS_M).floor() as i64,
-        (p.y / RADIUS_M).floor() as i64,
-    )
-}
+/// The earlier scan of a pair, as the crate's ICP target
+/// (`slamlab::slam::icp`), with the alignment score this example adds.
+struct Target(IcpTarget);
 
 impl Target {
     fn new(points: Vec<DVec2>) -> Target {
-        let normals = scan_normals(&points);
-        let mut buckets: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
-        for (i, &p) in points.iter().enumerate() {
-            if normals[i].is_some() {
-                buckets.entry(bucket(p)).or_default().push(i);
-            }
-        }
-        Target {
-            points,
-            normals,
-            buckets,
-        }
-    }
-
-    /// The nearest point with a normal within `RADIUS_M` of `q`.
-    fn nearest(&self, q: DVec2) -> Option<(DVec2, DVec2)> {
-        let (bx, by) = bucket(q);
-        let mut best: Option<(f64, usize)> = None;
-        for dx in -1..=1 {
-            for dy in -1..=1 {
-                for &i in self.buckets.get(&(bx + dx, by + dy)).into_iter().flatten() {
-                    let d = self.points[i].distance_squared(q);
-                    if d < RADIUS_M * RADIUS_M && best.is_none_or(|b| d < b.0) {
-                        best = Some((d, i));
-                    }
-                }
-            }
-        }
-        best.map(|(_, i)| (self.points[i], self.normals[i].unwrap()))
-    }
-
-    /// Point-to-line residuals of `points` placed at `pose` in the target's
-    /// frame, with the Jacobian of each (None: no surface near).
-    fn residuals(&self, points: &[DVec2], pose: &Pose2) -> Vec<Option<(f64, [f64; 3])>> {
-        let (s, c) = pose.theta.sin_cos();
-        let f = pose.frame();
-        points
-            .iter()
-            .map(|&p| {
-                let q = f.to_parent(p);
-                let (a, n) = self.nearest(q)?;
-                let dq = DVec2::new(-s * p.x - c * p.y, c * p.x - s * p.y);
-                Some((n.dot(q - a), [n.x, n.y, n.dot(dq)]))
-            })
-            .collect()
+        Target(IcpTarget::new(&points, &scan_normals(&points), RADIUS_M))
     }
 
     /// Mean clamped |residual| (points off every surface count as
     /// `CLAMP_M`): how well `points` at `pose` lie on the target.
     fn misfit(&self, points: &[DVec2], pose: &Pose2) -> f64 {
-        let r = self.residuals(points, pose);
+        let r = self.0.residuals(points, pose);
         r.iter()
             .map(|x| x.map_or(CLAMP_M, |(v, _)| v.abs().min(CLAMP_M)))
             .sum::<f64>()
@@ -127,37 +73,8 @@ impl Target {
     /// Point-to-line ICP from `start`; the refined pose and the smaller
     /// eigenvalue of its translational information.
     fn icp(&self, points: &[DVec2], start: &Pose2) -> (Pose2, f64) {
-        let mut pose = *start;
-        let mut weak = 0.0;
-        for _ in 0..30 {
-            let mut h = [[0.0; 3]; 3];
-            let mut g = [0.0; 3];
-            for (r, j) in self.residuals(points, &pose).into_iter().flatten() {
-                let w = if r.abs() <= HUBER_M {
-                    1.0
-                } else {
-                    HUBER_M / r.abs()
-                };
-                for a in 0..3 {
-                    g[a] += w * j[a] * r;
-                    for b in 0..3 {
-                        h[a][b] += w * j[a] * j[b];
-                    }
-                }
-            }
-            weak = symmetric_eigen2(h[0][0], h[0][1], h[1][1]).1;
-            for (a, row) in h.iter_mut().enumerate() {
-                row[a] += 1e-6;
-            }
-            let Some(d) = solve3(h, [-g[0], -g[1], -g[2]]) else {
-                break;
-            };
-            pose = Pose2::new(pose.x + d[0], pose.y + d[1], wrap_angle(pose.theta + d[2]));
-            if DVec2::new(d[0], d[1]).length() < 1e-6 && d[2].abs() < 1e-7 {
-                break;
-            }
-        }
-        (pose, weak)
+        let fit = self.0.align(points, start, HUBER_M, 30);
+        (fit.pose, fit.weak)
     }
 }
 

@@ -86,9 +86,15 @@ const MAX_FLATNESS: f64 = 0.15;
 /// order), or `None` where the neighbours do not define one. The sign is
 /// arbitrary: only `n nᵀ` and `n·(q − s)` use it.
 pub fn scan_normals(points: &[DVec2]) -> Vec<Option<DVec2>> {
+    scan_normals_within(points, NORMAL_RADIUS_M)
+}
+
+/// [`scan_normals`] over neighbourhoods of `radius_m` (a scan thinned to
+/// one point per 10 cm needs more than the 0.12 m of a full one).
+pub fn scan_normals_within(points: &[DVec2], radius_m: f64) -> Vec<Option<DVec2>> {
     // The distance tests on squared lengths, with bounds that give the same
     // answers as on lengths (a square root per test was a third of this).
-    let (gap2, radius2) = (squared_bound(MAX_GAP_M), squared_bound(NORMAL_RADIUS_M));
+    let (gap2, radius2) = (squared_bound(MAX_GAP_M), squared_bound(radius_m));
     (0..points.len())
         .map(|i| {
             let p = points[i];

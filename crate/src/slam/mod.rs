@@ -20,6 +20,7 @@
 //! | drawing and ROS map export | [`export`] | ROS `map_server` format |
 //! | tables of scans for real lasers | [`multires`] | Olson, ICRA 2009 |
 //! | a match's covariance from its response | [`match_covariance`] | Olson, ICRA 2009 §IV-C; Konolige et al. 2010 |
+//! | point-to-line ICP on points, off the raster's grain | [`icp`] | Besl & McKay 1992; Chen & Medioni 1992 |
 //! | pose graph, sparse least squares | [`posegraph`] | Lu & Milios 1997; Grisetti et al. 2010 |
 //! | loop closure by correlative matching | [`loop_closure`] | Konolige et al. 2010; Hess et al. 2016 |
 //! | SLAM for real laser logs | [`logslam`] | Karto / slam_toolbox, Cartographer |
@@ -36,6 +37,7 @@ pub mod export;
 pub mod filter;
 pub mod gauss_newton;
 pub mod grid;
+pub mod icp;
 pub mod key_chain;
 pub mod likelihood;
 pub mod log_replay;
