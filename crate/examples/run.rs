@@ -18,7 +18,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .get(1)
         .ok_or("usage: run SCENARIO.json [auto|thesis|map-only|simulate]")?;
     let method_arg = args.get(2).map_or("auto", |s| s.as_str());
-    let simulate_only = method_arg == "simulate";
+    let simulate_only = method_arg == "simulate" || method_arg == "steps";
     let method = MergeMethod::parse(if simulate_only { "auto" } else { method_arg })?;
     let mut lab = Lab::new(&std::fs::read_to_string(path)?)?;
     let start = Instant::now();
@@ -26,7 +26,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         static EPOCH: std::sync::OnceLock<Instant> = std::sync::OnceLock::new();
         EPOCH.get_or_init(Instant::now).elapsed().as_secs_f64() * 1e3
     });
-    lab.run_to_end()?;
+    if method_arg == "steps" {
+        slowest_steps(&mut lab)?;
+    } else {
+        lab.run_to_end()?;
+    }
     let simulate = start.elapsed().as_secs_f64() * 1e3;
     if simulate_only {
         for (i, spec) in lab.scenario().robots.iter().enumerate() {
@@ -68,6 +72,33 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     println!("timings (ms): {:?}", report.timings_ms);
+    Ok(())
+}
+
+/// Runs `lab` one step at a time, as the page does, and prints the ten
+/// slowest steps with their SLAM and camera shares.
+fn slowest_steps(lab: &mut Lab) -> Result<(), Box<dyn std::error::Error>> {
+    let mut steps: Vec<(f64, f64, f64, usize)> = Vec::new();
+    let stages = |lab: &Lab| {
+        lab.simulation().map_or((0.0, 0.0), |s| {
+            (s.stage_times.slam_ms, s.stage_times.camera_ms)
+        })
+    };
+    loop {
+        let (slam0, camera0) = stages(lab);
+        let t = Instant::now();
+        if lab.step(1)? == 0 {
+            break;
+        }
+        let ms = t.elapsed().as_secs_f64() * 1e3;
+        let (slam1, camera1) = stages(lab);
+        let n = lab.simulation().map_or(0, |s| s.steps());
+        steps.push((ms, slam1 - slam0, camera1 - camera0, n));
+    }
+    steps.sort_by(|a, b| b.0.total_cmp(&a.0));
+    for (ms, slam, camera, n) in steps.iter().take(10) {
+        println!("step {n}: {ms:.1} ms (SLAM {slam:.1}, camera {camera:.1})");
+    }
     Ok(())
 }
 
