@@ -225,6 +225,15 @@ pub fn config_from_env() -> LogSlamConfig {
             "confirm_keys" => cfg.confirm_keys = v as usize,
             "wide_m" => cfg.wide.linear_m = v,
             "wide_deg" => cfg.wide.angular_rad = v.to_radians(),
+            "refine_rounds" => cfg.refine.rounds = v as usize,
+            "refine_radius_m" => cfg.refine.radius_m = v,
+            "refine_window_m" => cfg.refine.window.linear_m = v,
+            "refine_window_deg" => cfg.refine.window.angular_rad = v.to_radians(),
+            "refine_min_score" => cfg.refine.min_score = v,
+            "refine_every" => cfg.refine.every = v as usize,
+            "refine_phi" => cfg.refine.dcs_phi = v,
+            "refine_icp" => cfg.refine.icp = v != 0.0,
+            "refine_min_weak" => cfg.refine.icp_min_weak = v,
             _ => panic!("SLAMLAB_LOG_SLAM: unknown setting {key}"),
         }
     }

@@ -74,6 +74,7 @@
 
 use super::grid::{GridConfig, OccupancyGrid};
 use super::likelihood::LikelihoodField;
+use super::log_refine::{refine, RefineConfig};
 use super::loop_closure::{closures_agree, find_closure_among, Closure, LoopConfig};
 use super::match_covariance::{edge_information, response_covariance, ResponseWindow};
 use super::multires::{field_from_points, match_scan, ScanMatch, Window};
@@ -154,6 +155,8 @@ pub struct LogSlamConfig {
     /// window (the best pose inside the window is then not a peak of the
     /// response: the true one may lie outside, as for the local match).
     pub loop_edge_reject: bool,
+    /// The closing refinement after the replay ([`super::log_refine`]).
+    pub refine: RefineConfig,
 }
 
 impl Default for LogSlamConfig {
@@ -200,6 +203,7 @@ impl Default for LogSlamConfig {
             chain_min_score: 0.5,
             loop_visits: 1,
             loop_edge_reject: true,
+            refine: RefineConfig::default(),
         }
     }
 }
@@ -243,6 +247,8 @@ pub struct LogSlamStats {
     pub chain_edges: usize,
     /// Closures refused for lying on the search window's edge.
     pub closures_on_edge: usize,
+    /// Links the closing refinement added ([`super::log_refine`]).
+    pub refine_links: usize,
 }
 
 /// The SLAM state of one log replay.
@@ -606,7 +612,16 @@ impl LogSlam {
         if self.closures.is_empty() {
             return Ok(());
         }
-        self.graph.optimise_robust(20, self.dcs()).map(|_| ())
+        self.graph.optimise_robust(20, self.dcs())?;
+        let cfg = &self.config;
+        self.stats.refine_links = refine(
+            &mut self.graph,
+            &self.key_points,
+            cfg.resolution_m,
+            &cfg.loops,
+            &cfg.refine,
+        )?;
+        Ok(())
     }
 
     /// Φ of Dynamic Covariance Scaling, if on.

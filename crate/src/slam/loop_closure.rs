@@ -107,13 +107,13 @@ pub fn find_closure_among(
     visit_centres(nodes, i, cfg)
         .into_iter()
         .take(visits.max(1))
-        .filter_map(|c| match_closure(nodes, key_points, i, c, resolution_m, cfg, response))
+        .filter_map(|c| match_visit(nodes, key_points, i, c, resolution_m, cfg, response))
         .max_by(|a, b| a.score.total_cmp(&b.score))
 }
 
 /// The nearest key of each visit to key `i`'s place (see
 /// [`find_closure_among`]), nearest first.
-fn visit_centres(nodes: &[Pose2], i: usize, cfg: &LoopConfig) -> Vec<usize> {
+pub(super) fn visit_centres(nodes: &[Pose2], i: usize, cfg: &LoopConfig) -> Vec<usize> {
     if i < cfg.min_key_gap {
         return Vec::new();
     }
@@ -141,7 +141,7 @@ fn visit_centres(nodes: &[Pose2], i: usize, cfg: &LoopConfig) -> Vec<usize> {
 }
 
 /// Matches key `i` against the key scans around `centre`.
-fn match_closure(
+pub(super) fn match_visit(
     nodes: &[Pose2],
     key_points: &[Vec<DVec2>],
     i: usize,

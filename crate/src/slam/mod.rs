@@ -24,6 +24,7 @@
 //! | pose graph, sparse least squares | [`posegraph`] | Lu & Milios 1997; Grisetti et al. 2010 |
 //! | loop closure by correlative matching | [`loop_closure`] | Konolige et al. 2010; Hess et al. 2016 |
 //! | SLAM for real laser logs | [`logslam`] | Karto / slam_toolbox, Cartographer |
+//! | its closing refinement, every revisit linked | [`log_refine`] | Konolige et al. 2010; Agarwal et al. 2013 |
 //! | the simulated robots' loop-closing back end | [`robot_graph`] | Konolige et al. 2010; Hess et al. 2016 |
 //! | its key edges' compounded covariance | [`key_chain`] | Smith, Self, Cheeseman 1990; Konolige et al. 2010 |
 //! | relation errors against a reference | [`relations`] | Kümmerle et al., Auton. Robots 2009 |
@@ -40,6 +41,7 @@ pub mod grid;
 pub mod icp;
 pub mod key_chain;
 pub mod likelihood;
+pub mod log_refine;
 pub mod log_replay;
 pub mod logslam;
 pub mod loop_closure;
