@@ -14,6 +14,9 @@
 // by part, and the slowest frames with their parts). Needs ./build.sh build
 // and Chromium. `--scroll` scrolls an element into view before the run (e.g.
 // `--scroll '#maps'`: the Maps panel on screen instead of the robot cards).
+// `--slow-steps` lists every Lab step over 50 ms with its simulated time and
+// the JS heap before and after it (a heap that shrinks inside a step is a
+// garbage collection that ran there).
 import path from 'node:path';
 import { chromium } from 'playwright-core';
 import { CHROMIUM_FLAGS, serveRoot, waitReady } from '../support/browser.mjs';
@@ -45,6 +48,21 @@ try {
     };
     requestAnimationFrame(tick);
   });
+  if (args.includes('--slow-steps')) {
+    await page.evaluate(() => {
+      const lab = window.slamlab.lab;
+      const step = lab.step.bind(lab);
+      window.__perf.slow = [];
+      const heap = () => Math.round(performance.memory.usedJSHeapSize / 2 ** 20);
+      lab.step = (n) => {
+        const [h0, t0] = [heap(), performance.now()];
+        const k = step(n);
+        const ms = performance.now() - t0;
+        if (ms > 50) window.__perf.slow.push({ ms: Math.round(ms), t: lab.timeS(), heap_mb: [h0, heap()] });
+        return k;
+      };
+    });
+  }
   const t0 = await page.evaluate(() => window.slamlab.state().time_s ?? window.slamlab.lab.timeS());
   const scroll = args.indexOf('--scroll');
   if (scroll >= 0) await page.evaluate((sel) => document.querySelector(sel).scrollIntoView({ block: 'start' }), args[scroll + 1]);
@@ -60,6 +78,7 @@ try {
     long: window.__perf.long,
     t: window.slamlab.lab.timeS(),
     parts: window.slamlab.frameTimes?.(),
+    slow: window.__perf.slow,
   }));
   const wall = (Date.now() - w0) / 1000;
   const shot = args.indexOf('--shot');
@@ -76,6 +95,7 @@ try {
       over100: out.long.filter((d) => d > 100).length,
       sim_rate: +((out.t - t0) / wall).toFixed(1),
       ...(args.includes('--parts') ? { parts: out.parts } : {}),
+      ...(out.slow ? { slow_steps: out.slow } : {}),
     }),
   );
 } finally {
