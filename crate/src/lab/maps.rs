@@ -124,9 +124,16 @@ impl Lab {
         Ok((sim, r))
     }
 
-    /// One robot's map (`which` = slam or odometry).
-    pub fn robot_map(&self, robot: usize, which: MapperKind) -> Result<&OccupancyGrid, String> {
-        Ok(self.robot_sim(robot)?.1.mapping.map(which))
+    /// One robot's map (`which` = slam or odometry), whole: while the
+    /// back end is redrawing it after a loop closure, a completed copy
+    /// ([`crate::slam::RobotMapping::settled_map`]), so that a map exported
+    /// from a paused run has every scan in it.
+    pub fn robot_map(
+        &self,
+        robot: usize,
+        which: MapperKind,
+    ) -> Result<std::borrow::Cow<'_, OccupancyGrid>, String> {
+        Ok(self.robot_sim(robot)?.1.mapping.settled_map(which))
     }
 
     /// Index of the robot called `name`.
@@ -139,19 +146,19 @@ impl Lab {
     }
 
     pub fn map_pgm(&self, robot: usize, which: MapperKind) -> Result<Vec<u8>, String> {
-        Ok(to_pgm(self.robot_map(robot, which)?))
+        Ok(to_pgm(&*self.robot_map(robot, which)?))
     }
 
     pub fn map_png(&self, robot: usize, which: MapperKind) -> Result<Vec<u8>, String> {
-        to_png(self.robot_map(robot, which)?)
+        to_png(&*self.robot_map(robot, which)?)
     }
 
     pub fn map_yaml(&self, robot: usize, which: MapperKind, image: &str) -> Result<String, String> {
-        Ok(to_yaml(self.robot_map(robot, which)?, image))
+        Ok(to_yaml(&*self.robot_map(robot, which)?, image))
     }
 
     pub fn map_info(&self, robot: usize, which: MapperKind) -> Result<MapInfo, String> {
-        Ok(MapInfo::of(self.robot_map(robot, which)?))
+        Ok(MapInfo::of(&*self.robot_map(robot, which)?))
     }
 
     pub fn slam_figures(&self, robot: usize) -> Result<SlamFigures, String> {

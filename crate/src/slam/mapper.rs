@@ -537,6 +537,22 @@ impl RobotMapping {
         }
     }
 
+    /// The map of one mapper as it will be once a redraw the back end
+    /// spreads over the next scans is done ([`RobotGraph::draw_remaining`]):
+    /// the map itself, or a completed copy while a redraw is under way. For
+    /// readers of a paused run (a map downloaded or exported), which must
+    /// not settle the map themselves: the run would then go on differently.
+    pub fn settled_map(&self, which: MapperKind) -> std::borrow::Cow<'_, OccupancyGrid> {
+        match (&self.graph, which) {
+            (Some(g), MapperKind::Slam) if g.redrawing() => {
+                let mut map = self.slam_map.clone();
+                g.draw_remaining(&mut map);
+                std::borrow::Cow::Owned(map)
+            }
+            _ => std::borrow::Cow::Borrowed(self.map(which)),
+        }
+    }
+
     /// The map of one mapper.
     pub fn map(&self, which: MapperKind) -> &OccupancyGrid {
         match which {

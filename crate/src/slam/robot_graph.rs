@@ -837,6 +837,16 @@ impl RobotGraph {
         self.draw_pending(map, usize::MAX);
     }
 
+    /// Draws the keys a redraw left into `map` (a copy of the map being
+    /// redrawn), in the order [`RobotGraph::settle`] would, leaving the
+    /// redraw itself as it is: a paused run's map, whole, for a reader,
+    /// without changing what the run does next.
+    pub fn draw_remaining(&self, map: &mut OccupancyGrid) {
+        for &k in self.redraw.iter().rev() {
+            map.integrate_scan(&self.graph.nodes[k], &self.keys[k].unpack());
+        }
+    }
+
     /// Whether a redrawn map still lacks some key scans.
     pub fn redrawing(&self) -> bool {
         !self.redraw.is_empty()
@@ -1051,8 +1061,17 @@ mod tests {
         d.estimates.push(Pose2::new(49.6, 0.1, 0.0));
         d.hand_over();
         assert_eq!(d.map.scans(), 27);
+        // A reader's completed copy is the map settling would make, and
+        // leaves the redraw as it was.
+        let mut copy = d.map.clone();
+        d.g.draw_remaining(&mut copy);
+        assert!(d.g.redrawing());
+        assert_eq!(d.map.scans(), 27);
         d.g.settle(&mut d.map);
         assert_eq!(d.map.scans(), 100);
         assert!(!d.g.redrawing());
+        assert_eq!(copy.scans(), 100);
+        assert_eq!(copy.raw_units(), d.map.raw_units());
+        assert_eq!(copy.origin_cell(), d.map.origin_cell());
     }
 }
