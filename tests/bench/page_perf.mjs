@@ -8,7 +8,8 @@
 // frames, records every long task (PerformanceObserver 'longtask') and reads
 // the simulated clock. Prints one JSON line:
 // {walls, robots, fps, frames, longtasks, longest_ms, sim_rate}, sim_rate =
-// simulated seconds per wall second, over100 = long tasks over 100 ms. `--shot`
+// simulated seconds per wall second (until the run finished, if it did:
+// finished_after_s), over100 = long tasks over 100 ms. `--shot`
 // saves a screenshot of the page at the end of the run. `--parts` adds where
 // the page's frames spent their time (web/page/frame-times.js: totals in ms
 // by part, and the slowest frames with their parts). Needs ./build.sh build
@@ -40,10 +41,11 @@ try {
   await page.evaluate(() => {
     window.__perf = { frames: 0, long: [] };
     new PerformanceObserver((list) => {
-      for (const e of list.getEntries()) window.__perf.long.push(e.duration);
+      for (const e of list.getEntries()) window.__perf.long.push([e.duration, e.startTime]);
     }).observe({ type: 'longtask' });
     const tick = () => {
       window.__perf.frames++;
+      if (window.__perf.finishedMs === undefined && window.slamlab.state().finished) window.__perf.finishedMs = performance.now();
       requestAnimationFrame(tick);
     };
     requestAnimationFrame(tick);
@@ -70,15 +72,19 @@ try {
   const w0 = Date.now();
   await page.evaluate(() => {
     window.__perf.frames = 0;
+    window.__perf.startMs = performance.now();
     window.slamlab.frameTimes?.(true);
   });
   await page.waitForTimeout(seconds * 1000);
   const out = await page.evaluate(() => ({
     frames: window.__perf.frames,
-    long: window.__perf.long,
+    long: window.__perf.long.map(([d]) => d),
+    // Long tasks over 100 ms that began after the run finished (the panels catching up).
+    over100_after_finish: window.__perf.long.filter(([d, t]) => d > 100 && window.__perf.finishedMs !== undefined && t >= window.__perf.finishedMs - 1).length,
     t: window.slamlab.lab.timeS(),
     parts: window.slamlab.frameTimes?.(),
     slow: window.__perf.slow,
+    finished_s: window.__perf.finishedMs === undefined ? null : (window.__perf.finishedMs - window.__perf.startMs) / 1000,
   }));
   const wall = (Date.now() - w0) / 1000;
   const shot = args.indexOf('--shot');
@@ -93,7 +99,9 @@ try {
       longtasks: out.long.length,
       longest_ms: Math.round(Math.max(0, ...out.long)),
       over100: out.long.filter((d) => d > 100).length,
-      sim_rate: +((out.t - t0) / wall).toFixed(1),
+      sim_rate: +((out.t - t0) / (out.finished_s ?? wall)).toFixed(1),
+      finished_after_s: out.finished_s === null ? null : +out.finished_s.toFixed(1),
+      over100_after_finish: out.over100_after_finish,
       ...(args.includes('--parts') ? { parts: out.parts } : {}),
       ...(out.slow ? { slow_steps: out.slow } : {}),
     }),

@@ -34,7 +34,7 @@ const LIVE_SHARE = [4, 12]; // ... and at most every 4 times what one took (12 w
 const STRIP_INTERVAL_MS = 500; // strips grow at most twice a second while running
 const THUMB_W = 64;
 const THUMB_SLICE_MS = 6; // thumbnails drawn a frame: until this much time is spent (at least one)
-const FINAL_BUDGET_MS = 16; // a pause's refresh of off-screen blocks, per frame
+const FINAL_BUDGET_MS = 16; // a pause's refresh of the blocks, per frame
 
 export class CameraPanel {
   /**
@@ -55,7 +55,7 @@ export class CameraPanel {
     this.liveDraws = [];
     /** Thumbnails on screen not drawn yet (canvas → [robot, index]). */
     this.pending = new Map();
-    /** Off-screen blocks a pause or the run's end left to later frames. */
+    /** Blocks a pause or the run's end left to later frames. */
     this.stale = [];
     this.thumbSeen = typeof IntersectionObserver === 'undefined' ? null : new IntersectionObserver((entries) => {
       for (const e of entries) {
@@ -243,16 +243,18 @@ export class CameraPanel {
   }
 
   /** Redraws the live views and grows the strips: every block when
-   *  `force`, else only those on screen. */
+   *  `force` (from the next frame on, those on screen first, within a
+   *  frame's budget each), else only those on screen now. */
   refresh(force) {
     const lab = this.hooks.lab();
     this.stale = [];
     if (!lab) return;
-    for (const b of this.blocks) if (b.visible) this.refreshBlock(b, force);
-    if (force) this.refreshStale(this.blocks.filter((b) => !b.visible));
+    const shown = this.blocks.filter((b) => b.visible);
+    if (!force) for (const b of shown) this.refreshBlock(b, false);
+    else this.stale = [...shown, ...this.blocks.filter((b) => !b.visible)]; // from the next frame on
   }
 
-  /** Brings off-screen `blocks` up to date (a pause, the run's end) until
+  /** Brings `blocks` up to date (a pause, the run's end), in order, until
    *  FINAL_BUDGET_MS is spent, at least one; the rest wait in `stale` for
    *  the next frames (sixteen robots' views and strips at once were most of
    *  a 480 ms task at a pause, tests/bench/page_pause.mjs). */

@@ -68,7 +68,9 @@ export class FramePacer {
       }
       this.camerasNext = running && changed;
       const cameras = !this.camerasNext && t.time('cameras', () => cameraPanel.update(now, changed || running, strain));
-      if (!running || !(changed || cameras)) t.time('maps', () => mapsPanel.update(now, changed || running));
+      // Not in a frame the cameras drew in: after a pause both panels catch
+      // up a block at a time, and one of each a frame made it long.
+      if (!cameras && (!running || !changed)) t.time('maps', () => mapsPanel.update(now, changed || running));
       t.time('merge', () => mergePanel.update(now));
       t.time('guide', () => guide.update(now));
       if (running) t.time('readouts', () => toolbar.readouts(false));

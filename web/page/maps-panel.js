@@ -11,9 +11,9 @@
 // So while a run goes the panel refreshes at most every REFRESH_MS and
 // only the blocks on screen (an IntersectionObserver tells which); when the
 // run pauses, steps or ends, `refresh()` redraws and scores every block, so
-// the figures shown are the final ones: the blocks on screen at once, the
-// others within FINAL_BUDGET_MS, and what is left over in the next frames
-// (sixteen robots' maps of a 60 x 60 m maze took one 480 ms task at a
+// the figures shown are the final ones: from the next frame on, the blocks
+// on screen first, as many a frame as FINAL_BUDGET_MS allows (at least
+// one) (sixteen robots' maps of a 60 x 60 m maze took one 480 ms task at a
 // pause, tests/bench/page_pause.mjs).
 
 import { robotColour } from './palette.js';
@@ -23,7 +23,7 @@ const REFRESH_MS = 500;
 const MAP_W = 300;
 const MAP_H = 210;
 const PLOT_H = 70;
-const FINAL_BUDGET_MS = 16; // a pause's redraw of off-screen blocks, per frame
+const FINAL_BUDGET_MS = 16; // a pause's redraw of the blocks, per frame
 
 export class MapsPanel {
   /**
@@ -39,7 +39,7 @@ export class MapsPanel {
     this.lastMs = 0;
     this.turn = -1; // the on-screen block refreshed last while running
     this.blocks = [];
-    /** Off-screen blocks a pause or the run's end left to later frames. */
+    /** Blocks a pause or the run's end left to later frames. */
     this.pending = [];
     /** Maps scored so far (for the page tests: bounded while running). */
     this.scored = 0;
@@ -158,8 +158,8 @@ export class MapsPanel {
 
   /** Redraws every map, figure and plot: called when a run finishes,
    *  pauses or steps, so the panel shows the final state, not the one of
-   *  up to REFRESH_MS ago — the blocks on screen now, the others within
-   *  FINAL_BUDGET_MS and the next frames. `all === false` (while running):
+   *  up to REFRESH_MS ago — from the next frame on, the blocks on screen
+   *  first, within FINAL_BUDGET_MS a frame. `all === false` (while running):
    *  only the blocks on screen, or only block `only`. */
   refresh(all = true, only = null) {
     const lab = this.hooks.lab();
@@ -173,11 +173,9 @@ export class MapsPanel {
       for (const b of this.blocks) if (b.visible && (!only || b === only)) this.drawBlock(lab, b);
       return;
     }
-    // On screen first and at once; the rest within the budget, then later.
-    const order = [...this.blocks.filter((b) => b.visible), ...this.blocks.filter((b) => !b.visible)];
-    const onScreen = this.blocks.filter((b) => b.visible).length;
-    for (const b of order.slice(0, onScreen)) this.drawBlock(lab, b);
-    this.drawAll(order.slice(onScreen));
+    // From the next frame on (the one that paused or ended the run has its
+    // own work), on screen first, within the budget a frame.
+    this.pending = [...this.blocks.filter((b) => b.visible), ...this.blocks.filter((b) => !b.visible)];
   }
 
   /** Draws `blocks` in order until FINAL_BUDGET_MS is spent (at least one);
