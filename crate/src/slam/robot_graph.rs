@@ -606,6 +606,7 @@ impl RobotGraph {
         if refined {
             found.edge.measurement = self.graph.nodes[found.edge.from].between(&fit.pose);
         }
+        let plausible = self.plausible(&found);
         if self.config.record_trials {
             let n = &self.graph.nodes;
             let (f, t) = (found.edge.from, found.edge.to);
@@ -622,7 +623,7 @@ impl RobotGraph {
                 refined,
                 correction: n[f].between(&n[t]).between(&found.edge.measurement),
                 path_m: self.key_path_m[t] - self.key_path_m[f],
-                plausible: self.plausible(&found),
+                plausible,
             });
         }
         if !refined {
@@ -633,7 +634,7 @@ impl RobotGraph {
             self.stats.closures_sliding += 1;
             return None;
         }
-        if !self.plausible(&found) {
+        if !plausible {
             self.stats.closures_implausible += 1;
             return None;
         }
