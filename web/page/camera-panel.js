@@ -28,6 +28,7 @@
 // move from frame to frame and show each, Home and End go to the ends.
 
 import { robotColour } from './palette.js';
+import { spendFrame } from './budget.js';
 
 const LIVE_INTERVAL_MS = 120; // live views refresh at about 8 per second
 const LIVE_SHARE = [4, 12]; // ... and at most every 4 times what one took (12 when the run strains)
@@ -259,12 +260,7 @@ export class CameraPanel {
    *  the next frames (sixteen robots' views and strips at once were most of
    *  a 480 ms task at a pause, tests/bench/page_pause.mjs). */
   refreshStale(blocks) {
-    const t0 = performance.now();
-    let k = 0;
-    while (k < blocks.length && (k === 0 || performance.now() - t0 < FINAL_BUDGET_MS)) {
-      this.refreshBlock(blocks[k++], true);
-    }
-    this.stale = blocks.slice(k);
+    this.stale = spendFrame(blocks, FINAL_BUDGET_MS, (b) => this.refreshBlock(b, true));
   }
 
   /** Robot `b`'s live view (unless a frame is picked) and strip. */

@@ -18,6 +18,7 @@
 
 import { robotColour } from './palette.js';
 import { fitCanvas } from './hidpi.js';
+import { spendFrame } from './budget.js';
 
 const REFRESH_MS = 500;
 const MAP_W = 300;
@@ -182,12 +183,7 @@ export class MapsPanel {
    *  the rest wait in `pending` for the next frame's `update`. */
   drawAll(blocks) {
     const lab = this.hooks.lab();
-    const t0 = performance.now();
-    let k = 0;
-    while (lab && k < blocks.length && (k === 0 || performance.now() - t0 < FINAL_BUDGET_MS)) {
-      this.drawBlock(lab, blocks[k++]);
-    }
-    this.pending = lab ? blocks.slice(k) : [];
+    this.pending = lab ? spendFrame(blocks, FINAL_BUDGET_MS, (b) => this.drawBlock(lab, b)) : [];
   }
 
   /** Robot `b`'s map, figures and plot at the lab's state now. */
