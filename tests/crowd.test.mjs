@@ -3,6 +3,8 @@
 // - the frame store thins its frames at a tiny budget while worker threads
 //   hold some of them: the run completes and reports what it reports with
 //   no workers;
+// - robots whose mapping runs on worker threads report what they report
+//   with no workers;
 // - in a crowded maze (tests/bench/crowd_maze.mjs), every pair of robots
 //   whose true paths overlap by at least 50 m^2 ends up in one of the
 //   report's merge.groups[], and every transform in every group is right,
@@ -48,6 +50,21 @@ test('frames thinned while workers hold them: the run completes with the report 
   const bad = run('run', 'scenarios/thesis.json', '--json', '--frame-budget-mb', 'x');
   assert.equal(bad.code, 2);
   assert.match(bad.stderr, /--frame-budget-mb: 'x' is not a number of megabytes/);
+});
+
+test('robots mapped on worker threads: the report, loop closures and all, is that of no workers', () => {
+  // The thesis's maze for 600 s, where both robots close loops: with one
+  // worker, the second robot maps on it (crate/src/slam/handoff.rs,
+  // web/cli/slam-pool.mjs).
+  const args = ['run', 'scenarios/thesis.json', '--json', '--duration', '600'];
+  const [alone, helped] = ['0', '1'].map((w) => run(...args, '--workers', w));
+  assert.equal(alone.code, 0, alone.stderr);
+  assert.equal(helped.code, 0, helped.stderr);
+  const [a, b] = [strip(alone.stdout), strip(helped.stdout)];
+  const closures = a.robots.map((r) => r.slam.loop_closures);
+  assert.ok(closures[1] >= 1, `loop closures by robot: ${closures}`);
+  assert.deepEqual(b, a);
+  assert.ok(JSON.parse(helped.stdout).timings_ms.slam > 0, 'the mapping time on worker threads is counted');
 });
 
 /** The pose of frame `b` in frame `a` (both [x, y, theta] in one frame). */

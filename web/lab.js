@@ -333,6 +333,23 @@ export class Lab {
   storeDescribed(robot, index, method, packed) {
     return this.raw.storeDescribed(robot, index, method, packed);
   }
+
+  // --- Mapping in other threads (web/cli/slam-pool.mjs) ---------------------------------
+
+  /** A robot's mapping as bytes for a worker's `SlamAway`; its steps then wait here. */
+  sendMappingAway(robot) {
+    return this.raw.sendMappingAway(robot);
+  }
+
+  /** The steps an away robot made since they were last taken (bytes; empty when none). */
+  takeMappingSteps(robot) {
+    return this.raw.takeMappingSteps(robot);
+  }
+
+  /** Takes a robot's mapping back (`SlamAway.finish()`'s bytes). */
+  bringMappingHome(robot, bytes) {
+    this.raw.bringMappingHome(robot, bytes);
+  }
 }
 
 /** What the loaded build is: `{version, simd, colours}` (colours: `[[r, g, b], ...]` by robot index). */

@@ -48,6 +48,7 @@ use crate::rng::{Rng, Stream};
 use crate::scenario::{RobotSpec, Scenario, ScenarioError};
 use crate::sensors::sonar::SONAR_POSITIONS_M;
 use crate::sensors::{Laser, LaserScan, RangeScene, Sonar, SonarReading, LASER_BEAMS, SONAR_COUNT};
+use crate::slam::handoff::{mapping_from_bytes, mapping_to_bytes, pack_step};
 use crate::world::World;
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -129,6 +130,10 @@ pub struct RobotSim {
     pub log: RobotLog,
     /// The robot's two mappers (odometry-only and SLAM), fed each step.
     pub mapping: crate::slam::RobotMapping,
+    /// While the mapping is away on another thread
+    /// ([`Simulation::send_mapping_away`]): the steps it has yet to be
+    /// sent, packed ([`crate::slam::handoff::pack_step`]).
+    slam_outbox: Option<Vec<u8>>,
     /// Frames captured by the camera.
     pub frames: FrameStore,
     camera_rng: Rng,
@@ -331,6 +336,7 @@ impl Simulation {
                     last_command: Command::default(),
                     log: RobotLog::for_steps(scenario_steps(scenario)),
                     mapping: crate::slam::RobotMapping::default(),
+                    slam_outbox: None,
                     frames: FrameStore::new(frame_bytes, n_robots, period_steps),
                     camera_rng: Rng::stream(seed, i, Stream::Camera),
                 }
@@ -520,7 +526,10 @@ impl Simulation {
         let t0 = self.clock.map_or(0.0, |now| now());
         if self.mapping {
             for r in &mut self.robots {
-                r.mapping.observe(&r.odometry.pose(), &r.last_scan);
+                match &mut r.slam_outbox {
+                    Some(out) => pack_step(&r.odometry.pose(), &r.last_scan, out),
+                    None => r.mapping.observe(&r.odometry.pose(), &r.last_scan),
+                }
             }
             if self.finished() {
                 self.settle_maps();
@@ -582,6 +591,68 @@ impl Simulation {
     /// Turns the robots' mappers off or on (see [`Simulation::set_capture`]).
     pub fn set_mapping(&mut self, on: bool) {
         self.mapping = on;
+    }
+
+    /// Hands robot `i`'s mapping to another thread: returns it as bytes
+    /// ([`crate::slam::handoff`]); from now on its steps wait, packed, for
+    /// [`Simulation::take_mapping_steps`] instead of being observed here,
+    /// and the robot's mapping here stays as it was until
+    /// [`Simulation::bring_mapping_home`]. Nothing of the run reads it
+    /// meanwhile but a frame's SLAM pose, which falls back on odometry's.
+    pub fn send_mapping_away(&mut self, i: usize) -> Result<Vec<u8>, String> {
+        let r = self
+            .robots
+            .get_mut(i)
+            .ok_or_else(|| format!("no robot {i}"))?;
+        if r.slam_outbox.is_some() {
+            return Err(format!("robot {i}'s mapping is away already"));
+        }
+        let bytes = mapping_to_bytes(&r.mapping)?;
+        r.mapping = crate::slam::RobotMapping::new(r.mapping.config.clone());
+        r.slam_outbox = Some(Vec::new());
+        Ok(bytes)
+    }
+
+    /// The steps robot `i`'s mapping, away, has not been sent yet (packed,
+    /// oldest first; empty when its mapping is at home).
+    pub fn take_mapping_steps(&mut self, i: usize) -> Vec<u8> {
+        self.robots
+            .get_mut(i)
+            .and_then(|r| r.slam_outbox.as_mut())
+            .map(std::mem::take)
+            .unwrap_or_default()
+    }
+
+    /// Takes robot `i`'s mapping back (the bytes of the mapping it was sent
+    /// away as, fed every step since): it must have seen every step of the
+    /// run so far, one estimate per step.
+    pub fn bring_mapping_home(&mut self, i: usize, bytes: &[u8]) -> Result<(), String> {
+        let (steps, settle) = (self.steps, self.finished() && self.mapping);
+        let r = self
+            .robots
+            .get_mut(i)
+            .ok_or_else(|| format!("no robot {i}"))?;
+        let outbox = r
+            .slam_outbox
+            .as_ref()
+            .ok_or_else(|| format!("robot {i}'s mapping is not away"))?;
+        if !outbox.is_empty() {
+            return Err(format!("robot {i}'s mapping has steps it was not sent"));
+        }
+        let mapping = mapping_from_bytes(bytes)?;
+        let seen = mapping.estimates().len().saturating_sub(1);
+        if self.mapping && seen != steps {
+            return Err(format!(
+                "robot {i}'s mapping came back having seen {seen} steps of {steps}"
+            ));
+        }
+        r.mapping = mapping;
+        r.slam_outbox = None;
+        if settle {
+            // As the last step does at home (idempotent).
+            r.mapping.settle();
+        }
+        Ok(())
     }
 
     fn capture_due_frames(&mut self) {

@@ -43,9 +43,10 @@ async function merge(argv, wasm) {
   if (options.out === undefined) throw new UsageError('merge: --out FILE.yaml is required');
   if (!/\.ya?ml$/i.test(options.out)) throw new UsageError(`--out: '${options.out}' should end in .yaml`);
   const method = methodOf(options);
-  const workers = method === 'map-only' ? 0 : workersOf(options);
+  const mappers = workersOf(options);
+  const workers = method === 'map-only' ? 0 : mappers;
   const lab = await openScenario(positional[0], options, wasm);
-  await simulate(lab, { method, workers, progress: false });
+  await simulate(lab, { method, workers, mappers, progress: false });
   const view = mergeMaps(lab, method);
   const report = view.report;
   console.log(describeMerge(report));

@@ -4,13 +4,15 @@
 // web/lab.js.
 //
 // simulate() steps the lab to the end of its scenario in slices; with
-// worker threads (web/cli/describe-pool.mjs) it keeps them fed between
-// slices with the camera frames a merge will describe, so that the report
-// is the same for any number of workers. mergeMaps() then runs the merge in
+// worker threads it keeps them fed between slices: some map some of the
+// robots (web/cli/slam-pool.mjs), others describe the camera frames a
+// merge will describe (web/cli/describe-pool.mjs), so that the report is
+// the same for any number of workers. mergeMaps() then runs the merge in
 // small units of work, reporting its stage on stderr.
 import { performance } from 'node:perf_hooks';
 import { wasmCall } from './args.mjs';
 import { DescribePool } from './describe-pool.mjs';
+import { SlamPool, robotsAway } from './slam-pool.mjs';
 
 /** Control steps per slice: small ones keep workers fed; without them, large ones. */
 const SLICE_WITH_WORKERS = 100;
@@ -19,22 +21,30 @@ const SLICE_ALONE = 500;
 /**
  * Runs `lab` (a web/lab.js Lab) to the end of its scenario. With
  * `workers` > 0, that many worker threads describe, meanwhile, the frames a
- * merge with `method` will use. Progress goes to stderr once a second and
- * at the end when `progress` is set. Returns the run's time and the wait
- * for the last frames after it (ms).
+ * merge with `method` will use, and with `mappers` > 0 that many map some
+ * of the robots (robotsAway). Progress goes to stderr once a second and at
+ * the end when `progress` is set. Returns the run's time (until every
+ * mapping is home), the wait for the last frames after it, and the time
+ * the mapping threads mapped (ms).
  */
-export async function simulate(lab, { method = 'auto', workers = 0, progress = true } = {}) {
+export async function simulate(lab, { method = 'auto', workers = 0, mappers = 0, progress = true } = {}) {
   const total = lab.state().total_steps;
+  const away = robotsAway(lab.scenario().robots.length, mappers);
+  const slam = away.length > 0 ? new SlamPool(lab, away, mappers) : null;
   const pool = workers > 0 ? new DescribePool(lab, method, workers) : null;
   try {
     const tSim = performance.now();
     let done = 0;
     let lastReport = tSim;
-    const slice = pool ? SLICE_WITH_WORKERS : SLICE_ALONE;
+    const slice = pool || slam ? SLICE_WITH_WORKERS : SLICE_ALONE;
     while (done < total) {
       const n = wasmCall(() => lab.step(Math.min(slice, total - done)));
       if (n === 0) break;
       done += n;
+      if (slam) {
+        wasmCall(() => slam.send(lab));
+        await slam.pace();
+      }
       if (pool) {
         pool.collect(lab);
         pool.pace(done, total);
@@ -47,13 +57,15 @@ export async function simulate(lab, { method = 'auto', workers = 0, progress = t
         lastReport = now;
       }
     }
+    const mappingMs = slam ? await slam.finish(lab) : 0;
     const simulateMs = performance.now() - tSim;
     const tWait = performance.now();
     if (pool) await pool.finish(lab);
-    return { simulateMs, waitMs: pool ? performance.now() - tWait : 0 };
+    return { simulateMs, waitMs: pool ? performance.now() - tWait : 0, mappingMs };
   } finally {
     // Also when the run throws: live workers would keep node from exiting.
     pool?.close();
+    slam?.close();
   }
 }
 

@@ -13,7 +13,7 @@ export const usage = `usage:
       run the scenario headless, merge the robots' maps (default method: auto)
       and print a report (JSON with --json); N worker threads (default: one
       per core but the main thread's, at most 4) describe camera frames while
-      the robots run; MB: memory all robots' stored frames may take with the
+      the robots run, and as many map some of the robots; MB: memory all robots' stored frames may take with the
       features a merge describes in them (default 384, about 45 kB a frame;
       the store thins its frames beyond it)`;
 
@@ -24,15 +24,16 @@ async function run(argv, wasm) {
   });
   if (positional.length !== 1) throw new UsageError('run: expected exactly one SCENARIO.json');
   const method = methodOf(options);
-  const workers = method === 'map-only' ? 0 : workersOf(options);
+  const mappers = workersOf(options);
+  const workers = method === 'map-only' ? 0 : mappers;
   const t0 = performance.now();
   const lab = await openScenario(positional[0], options, wasm);
   const budget = frameBudgetOf(options);
   if (budget !== undefined) wasmCall(() => lab.setFrameBudget(budget));
-  const { simulateMs, waitMs } = await simulate(lab, { method, workers, progress: true });
+  const { simulateMs, waitMs, mappingMs } = await simulate(lab, { method, workers, mappers, progress: true });
   mergeMaps(lab, method);
   const totalMs = performance.now() - t0;
-  const timings = { simulate: simulateMs, features: waitMs, total: totalMs };
+  const timings = { simulate: simulateMs, features: waitMs, slam: mappingMs, total: totalMs };
   if (options.json) {
     // In chunks as the binding makes them: the text of a long, crowded run
     // (75 MB for sixteen robots over an hour) is never held whole.

@@ -101,4 +101,65 @@ impl Lab {
         let pose = self.inner.bench_match_scan(robot as usize).map_err(err)?;
         Ok(vec![pose.x, pose.y, pose.theta])
     }
+
+    /// Hands robot `robot`'s mapping to another thread: its bytes, for a
+    /// `SlamAway` there. From now on the robot's steps wait for
+    /// `takeMappingSteps` instead of being mapped here, until
+    /// `bringMappingHome`.
+    #[wasm_bindgen(js_name = sendMappingAway)]
+    pub fn send_mapping_away(&mut self, robot: u32) -> Result<Vec<u8>, JsError> {
+        self.inner.send_mapping_away(robot as usize).map_err(err)
+    }
+
+    /// The steps robot `robot`'s mapping, away, has yet to be sent, packed
+    /// for `SlamAway.observe` (empty when its mapping is here).
+    #[wasm_bindgen(js_name = takeMappingSteps)]
+    pub fn take_mapping_steps(&mut self, robot: u32) -> Vec<u8> {
+        self.inner.take_mapping_steps(robot as usize)
+    }
+
+    /// Takes robot `robot`'s mapping back (`SlamAway.finish`'s bytes); it
+    /// must have been sent every step of the run so far.
+    #[wasm_bindgen(js_name = bringMappingHome)]
+    pub fn bring_mapping_home(&mut self, robot: u32, bytes: &[u8]) -> Result<(), JsError> {
+        self.inner
+            .bring_mapping_home(robot as usize, bytes)
+            .map_err(err)
+    }
+}
+
+/// A robot's mapping on another thread (`web/cli/slam-pool.mjs`): made
+/// from `Lab.sendMappingAway`'s bytes, fed `Lab.takeMappingSteps`'s
+/// batches in order, and sent home as bytes for `Lab.bringMappingHome`.
+/// It maps exactly as the lab would have (see `crate::slam::handoff`).
+#[wasm_bindgen]
+pub struct SlamAway {
+    mapping: crate::slam::RobotMapping,
+}
+
+#[wasm_bindgen]
+impl SlamAway {
+    #[wasm_bindgen(constructor)]
+    pub fn new(bytes: &[u8]) -> Result<SlamAway, JsError> {
+        Ok(SlamAway {
+            mapping: crate::slam::handoff::mapping_from_bytes(bytes).map_err(err)?,
+        })
+    }
+
+    /// Maps a batch of steps; returns how many it held. A batch cut short
+    /// throws and maps none of its steps.
+    pub fn observe(&mut self, steps: &[u8]) -> Result<u32, JsError> {
+        let n = crate::slam::handoff::observe_packed(&mut self.mapping, steps).map_err(err)?;
+        Ok(n as u32)
+    }
+
+    /// Steps mapped so far (the run's, from its start).
+    pub fn steps(&self) -> u32 {
+        self.mapping.estimates().len().saturating_sub(1) as u32
+    }
+
+    /// The mapping as bytes, for `Lab.bringMappingHome`.
+    pub fn finish(&self) -> Result<Vec<u8>, JsError> {
+        crate::slam::handoff::mapping_to_bytes(&self.mapping).map_err(err)
+    }
 }

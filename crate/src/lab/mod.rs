@@ -380,9 +380,10 @@ impl Lab {
             .as_ref()
             .ok_or("nothing has run yet: run the scenario first")?;
         let mut timings = timings;
-        if timings.camera == 0.0 && timings.slam == 0.0 {
+        if timings.camera == 0.0 {
+            // The caller's `slam` is mapping done on other threads, if any.
             timings.camera = sim.stage_times.camera_ms + sim.render_ms();
-            timings.slam = sim.stage_times.slam_ms;
+            timings.slam += sim.stage_times.slam_ms;
         }
         if let Some(t) = self.merge.as_ref().map(|j| j.times_ms) {
             if timings.matching == 0.0 && timings.merge == 0.0 {

@@ -87,7 +87,9 @@ pub struct Timings {
     /// looked at: a frame is stored as pose and noise seed and rendered
     /// when first needed, mostly by the merge (inside `features`).
     pub camera: f64,
-    /// Both mappers, inside `simulate`.
+    /// Both mappers, inside `simulate`; with mappings handed to other
+    /// threads (the command line's `--workers`), also their time there,
+    /// which the run overlaps.
     pub slam: f64,
     /// SURF on the frames that take part in the merge: the merge's
     /// features stage, plus the wait after the run for frames that worker

@@ -32,7 +32,7 @@ use crate::geom::{wrap_angle, Pose2};
 use glam::DVec2;
 
 /// The search window.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CorrelativeConfig {
     pub linear_window_m: f64,
     pub angular_window_rad: f64,

@@ -32,7 +32,7 @@
 use glam::DVec2;
 
 /// How well a scan pins the robot's position, in its own frame.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ScanConstraint {
     /// Points with a usable normal.
     pub normals: usize,

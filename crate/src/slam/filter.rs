@@ -45,7 +45,7 @@ type Mat3 = [[f64; 3]; 3];
 /// deviations; generous on purpose: over-trusting odometry leaks its drift
 /// into the map, over-trusting a good match costs nothing), and the prior
 /// on its systematic errors.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct OdometryNoise {
     /// Position error per metre driven.
     pub metres_per_metre: f64,
@@ -83,7 +83,7 @@ impl Default for OdometryNoise {
 const MAX_BIAS: [f64; 2] = [0.1, 0.2];
 
 /// The filter's state and covariance.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PoseFilter {
     pub pose: Pose2,
     /// Heading bias per metre driven and per radian turned.

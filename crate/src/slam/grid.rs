@@ -94,7 +94,7 @@ pub const LOG_ODDS_UNIT: f32 = 0.05;
 pub const GROW_STEP_CELLS: i64 = 64;
 
 /// Settings of a grid and its beam model.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct GridConfig {
     pub resolution_m: f64,
     /// Log-odds added to a cell where a beam ends on a surface (units of
@@ -157,9 +157,10 @@ pub struct SurfacePoint {
 const SURFACE_SCALE: f64 = 65536.0;
 
 /// A log-odds occupancy grid in one robot's odometry frame.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct OccupancyGrid {
     pub config: GridConfig,
+    #[serde(with = "super::handoff::keep_capacity")]
     cells: Vec<i8>,
     /// Per-cell surface means where hits are, by blocks (empty unless
     /// [`GridConfig::surface_points`]).

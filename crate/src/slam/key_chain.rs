@@ -65,14 +65,14 @@ type Mat3 = [[f64; 3]; 3];
 /// What one matched scan told the front end: the match's information
 /// (world frame, over x, y, θ) and, when the match was degenerate, the weak
 /// direction (world frame, unit) along which odometry's word was kept.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct StepMatch {
     pub information: Mat3,
     pub weak_direction: Option<DVec2>,
 }
 
 /// The pose relative to the last key and its covariance (key frame).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct KeyChain {
     key: Pose2,
     last: Pose2,

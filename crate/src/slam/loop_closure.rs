@@ -38,7 +38,7 @@ use crate::geom::Pose2;
 use glam::DVec2;
 
 /// Settings of the loop-closure search.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct LoopConfig {
     pub search_radius_m: f64,
     pub min_key_gap: usize,
@@ -68,7 +68,7 @@ impl Default for LoopConfig {
 }
 
 /// A loop closure found: the edge and its match score.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Closure {
     pub edge: Edge,
     pub score: f64,

@@ -122,7 +122,7 @@ use crate::sensors::LaserScan;
 use glam::DVec2;
 
 /// Settings of the SLAM mapper.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SlamConfig {
     pub grid: GridConfig,
     pub search: CorrelativeConfig,
@@ -176,7 +176,7 @@ impl Default for SlamConfig {
 /// moved `min_distance_m` or turned `min_angle_rad` since the last scan
 /// that was, or after `max_interval_s` whatever the motion (see the
 /// module's "Motion filter" section for how the values were chosen).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct MotionFilter {
     pub min_distance_m: f64,
     pub min_angle_rad: f64,
@@ -216,7 +216,7 @@ impl MotionFilter {
 }
 
 /// What the matcher did with a scan.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum MatchStatus {
     /// Corrected in every direction.
@@ -228,7 +228,7 @@ pub enum MatchStatus {
 }
 
 /// The outcome of matching one scan.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct MatchOutcome {
     pub pose: Pose2,
     pub status: MatchStatus,
@@ -376,7 +376,7 @@ fn coarse_search(
 }
 
 /// How often each outcome happened.
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct MatchCounts {
     pub matched: usize,
     pub degenerate: usize,
@@ -387,7 +387,7 @@ pub struct MatchCounts {
 }
 
 /// One robot's two mappers, run online inside the simulation.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct RobotMapping {
     pub config: SlamConfig,
     /// The thesis's baseline: scans at raw odometry poses.

@@ -28,6 +28,7 @@
 //! | the simulated robots' loop-closing back end | [`robot_graph`] | Konolige et al. 2010; Hess et al. 2016 |
 //! | its key edges' compounded covariance | [`key_chain`] | Smith, Self, Cheeseman 1990; Konolige et al. 2010 |
 //! | relation errors against a reference | [`relations`] | Kümmerle et al., Auton. Robots 2009 |
+//! | a robot's mapping handed to another thread and back | [`handoff`] | — |
 //!
 //! The simulation feeds every robot's [`RobotMapping`] once per step with
 //! the odometry pose and the laser scan (never the truth).
@@ -38,6 +39,7 @@ pub mod export;
 pub mod filter;
 pub mod gauss_newton;
 pub mod grid;
+pub mod handoff;
 pub mod icp;
 pub mod key_chain;
 pub mod likelihood;

@@ -131,7 +131,7 @@ fn stamp(table: &mut [f32], width: usize, x: usize, y: usize, w: &[f32]) {
 }
 
 /// A search window for [`match_scan`].
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Window {
     pub linear_m: f64,
     pub angular_rad: f64,

@@ -39,7 +39,7 @@ use faer::{Mat, Side};
 use std::collections::BTreeMap;
 
 /// A measured relative pose between two nodes.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Edge {
     pub from: usize,
     pub to: usize,
@@ -67,9 +67,11 @@ impl Edge {
 }
 
 /// Nodes (poses) and edges.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PoseGraph {
+    #[serde(with = "super::handoff::keep_capacity")]
     pub nodes: Vec<Pose2>,
+    #[serde(with = "super::handoff::keep_capacity")]
     pub edges: Vec<Edge>,
 }
 

@@ -185,7 +185,7 @@ use crate::sensors::LaserScan;
 use glam::DVec2;
 
 /// Settings of the back end.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RobotGraphConfig {
     pub key_distance_m: f64,
     pub key_angle_rad: f64,
@@ -290,8 +290,9 @@ impl Default for RobotGraphConfig {
 
 /// A key scan: ranges in millimetres ([`NO_RETURN`] for none, the top bit
 /// set for a reflective return) and the step it was taken at.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 struct KeyScan {
+    #[serde(with = "super::handoff::keep_capacity")]
     ranges_mm: Vec<u16>,
     range_max_m: f64,
 }
@@ -353,7 +354,7 @@ impl KeyScan {
 }
 
 /// Counts of what the back end did.
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RobotGraphStats {
     pub keys: usize,
     pub closures_tried: usize,
@@ -376,7 +377,7 @@ pub struct RobotGraphStats {
 
 /// An accepted loop closure: its keys, the steps they were taken at, the
 /// measured relative pose and the match score.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ClosureRecord {
     pub from_key: usize,
     pub to_key: usize,
@@ -387,7 +388,7 @@ pub struct ClosureRecord {
 }
 
 /// What refining a closure said ([`RobotGraph::refine_closure`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ClosureFit {
     /// The new key's refined pose (world).
     pub pose: Pose2,
@@ -408,7 +409,7 @@ pub struct ClosureFit {
 /// A closure found by the search, as the experiments see it: the match,
 /// what its refinement said, the correction it asks of the graph and the
 /// gates it met.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ClosureTrial {
     /// Its keys, steps, score and measurement: the refined one if the
     /// refinement stood, else the search's.
@@ -443,16 +444,20 @@ pub struct FrontEnd<'a> {
 }
 
 /// One robot's pose graph of key scans.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct RobotGraph {
     pub config: RobotGraphConfig,
     pub graph: PoseGraph,
+    #[serde(with = "super::handoff::keep_capacity")]
     keys: Vec<KeyScan>,
     /// The step (index into the estimates) each key was taken at.
+    #[serde(with = "super::handoff::keep_capacity")]
     key_step: Vec<usize>,
     /// The path driven up to each key (m, along the key edges).
+    #[serde(with = "super::handoff::keep_capacity")]
     key_path_m: Vec<f64>,
     /// The key each step's estimate follows (the last key at or before it).
+    #[serde(with = "super::handoff::keep_capacity")]
     step_key: Vec<u32>,
     /// The pose since the last key and its covariance (`None` before the
     /// first key).
@@ -460,11 +465,14 @@ pub struct RobotGraph {
     pending: Vec<Closure>,
     /// The key of the last accepted pair (for the cool-down).
     last_accepted: Option<usize>,
+    #[serde(with = "super::handoff::keep_capacity")]
     pub closures: Vec<ClosureRecord>,
     /// Keys still to be drawn into the SLAM map after a correction moved
     /// them, the nearest to the robot last (they are popped).
+    #[serde(with = "super::handoff::keep_capacity")]
     redraw: Vec<usize>,
     /// Every closure found, with `config.record_trials`.
+    #[serde(with = "super::handoff::keep_capacity")]
     pub trials: Vec<ClosureTrial>,
     pub stats: RobotGraphStats,
 }

@@ -60,7 +60,7 @@ use crate::geom::{wrap_angle, Pose2};
 use glam::DVec2;
 
 /// Settings of the refinement.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RefineConfig {
     /// Gauss–Newton steps at most.
     pub iterations: usize,

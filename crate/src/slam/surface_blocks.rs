@@ -37,7 +37,7 @@ const NONE: u32 = u32::MAX;
 /// that ended in it, as an offset from the cell's centre in units of
 /// 1/65536 of a cell, over the last [`super::grid::SURFACE_WINDOW`] hits,
 /// and how many hits it has had in all.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct SurfaceCell {
     pub hits: u16,
     pub offset: [i16; 2],
@@ -45,12 +45,14 @@ pub struct SurfaceCell {
 
 /// The surface cells of a grid `width` × `height` cells (local indices),
 /// allocated by blocks where hits are.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct SurfaceBlocks {
     /// Blocks a row of the index.
     cols: usize,
     /// Pool position of each block, row by row (`NONE`: no cells).
+    #[serde(with = "super::handoff::keep_capacity")]
     index: Vec<u32>,
+    #[serde(with = "super::handoff::keep_capacity")]
     pool: Vec<[SurfaceCell; CELLS]>,
 }
 

@@ -1,0 +1,134 @@
+// Worker threads that map some of the robots while the main thread runs the
+// simulation (crate/src/slam/handoff.rs says why the run is the same bits).
+//
+// At the start, each robot chosen to map away hands its mapping over as
+// bytes (Lab.sendMappingAway) to one worker, which keeps it as a SlamAway.
+// After every slice of the run, send() takes the steps each away robot
+// has made since (Lab.takeMappingSteps, its odometry poses and laser scans
+// packed) and posts them to its worker, the buffer transferred; the worker
+// maps them in order and says when it has. pace() keeps the main thread at
+// most a few batches ahead of a worker, so the packed steps waiting never
+// take much memory. finish() asks every worker for its mappings back and
+// hands them to the lab (Lab.bringMappingHome), which checks that each has
+// seen every step. A worker that fails loses the mapping it held: the run
+// then fails with its message (nothing else can rebuild it).
+import { Worker } from 'node:worker_threads';
+import path from 'node:path';
+import { compiledModule, pkgDir } from './wasm.mjs';
+
+/** Batches a worker may have waiting before the main thread waits for it. */
+const MAX_BATCHES_AHEAD = 6;
+
+/**
+ * The robots (indices of `robots` robots) that map away when `threads`
+ * threads map: all but every (threads + 1)-th, so that the main thread,
+ * which also runs the world, keeps a share of the mapping like each worker.
+ */
+export function robotsAway(robots, threads) {
+  if (threads <= 0) return [];
+  return Array.from({ length: robots }, (_, i) => i).filter((i) => i % (threads + 1) !== 0);
+}
+
+export class SlamPool {
+  /**
+   * Starts `count` workers and hands them the mappings of `robots`, in
+   * turn. A worker's port queues messages until it has loaded.
+   */
+  constructor(lab, robots, count) {
+    this.errors = [];
+    this.waiting = null;
+    this.mappingMs = 0;
+    const workerData = { module: compiledModule(), pkgJs: path.join(pkgDir(), 'slamlab.js') };
+    this.workers = Array.from({ length: Math.min(count, robots.length) }, () => {
+      const thread = new Worker(new URL('./slam-worker.mjs', import.meta.url), { workerData });
+      const w = { thread, batches: 0, alive: true, home: new Map() };
+      thread.on('message', (msg) => {
+        if (msg.error) this.errors.push(msg.error);
+        else if (msg.mapped) w.batches -= 1;
+        else if (msg.bytes) w.home.set(msg.robot, msg.bytes);
+        else if (msg.finished) {
+          w.finished = true;
+          this.mappingMs += msg.ms;
+        }
+        this.wake();
+      });
+      thread.on('error', (e) => {
+        w.alive = false;
+        this.errors.push(`a mapping worker stopped: ${e?.message ?? e}`);
+        this.wake();
+      });
+      return w;
+    });
+    this.away = robots.map((robot, k) => ({ robot, worker: this.workers[k % this.workers.length] }));
+    for (const { robot, worker } of this.away) {
+      const start = lab.sendMappingAway(robot);
+      worker.thread.postMessage({ robot, start }, [start.buffer]);
+    }
+  }
+
+  wake() {
+    if (this.waiting) {
+      const resolve = this.waiting;
+      this.waiting = null;
+      resolve();
+    }
+  }
+
+  /** Resolves at the next message from a worker. */
+  message() {
+    return new Promise((resolve) => {
+      this.waiting = resolve;
+    });
+  }
+
+  /** Throws what went wrong in a worker, if anything did. */
+  check() {
+    if (this.errors.length > 0) throw new Error(`mapping on a worker thread: ${this.errors.join('; ')}`);
+  }
+
+  /** Posts every away robot's new steps to its worker. */
+  send(lab) {
+    this.check();
+    const batched = new Set();
+    for (const { robot, worker } of this.away) {
+      const steps = lab.takeMappingSteps(robot);
+      if (steps.length === 0) continue;
+      worker.thread.postMessage({ robot, steps }, [steps.buffer]);
+      batched.add(worker);
+    }
+    for (const w of batched) w.batches += 1;
+  }
+
+  /** Waits while a worker has too many batches still to map. */
+  async pace() {
+    while (this.workers.some((w) => w.alive && w.batches > MAX_BATCHES_AHEAD)) {
+      await this.message();
+      this.check();
+    }
+  }
+
+  /**
+   * After the run: takes every mapping home. Returns the time the workers
+   * spent mapping (ms, summed over workers).
+   */
+  async finish(lab) {
+    this.send(lab);
+    for (const w of this.workers) w.thread.postMessage({ finish: true });
+    while (this.workers.some((w) => w.alive && !w.finished)) {
+      await this.message();
+      this.check();
+    }
+    this.check();
+    for (const { robot, worker } of this.away) {
+      const bytes = worker.home.get(robot);
+      if (!bytes) throw new Error(`mapping on a worker thread: robot ${robot}'s mapping did not come back`);
+      lab.bringMappingHome(robot, bytes);
+      worker.home.delete(robot);
+    }
+    return this.mappingMs;
+  }
+
+  close() {
+    for (const w of this.workers) w.thread.terminate();
+  }
+}
