@@ -31,10 +31,9 @@
 
 use super::degeneracy::scan_normals_within;
 use super::icp::IcpTarget;
-use super::loop_closure::{match_visit, visit_centres, LoopConfig};
+use super::loop_closure::{match_visit, on_window_edge, visit_centres, visit_keys, LoopConfig};
 use super::multires::Window;
 use super::posegraph::PoseGraph;
-use crate::geom::wrap_angle;
 use glam::DVec2;
 use std::collections::BTreeSet;
 
@@ -124,15 +123,11 @@ pub fn refine(
                 else {
                     continue;
                 };
-                let found = nodes[c.edge.from].compose(&c.edge.measurement);
-                let d = nodes[i].between(&found);
-                let w = &cfg.window;
-                if d.x.abs() > w.linear_m - 2.0 * resolution_m
-                    || d.y.abs() > w.linear_m - 2.0 * resolution_m
-                    || wrap_angle(d.theta).abs() > w.angular_rad - 0.25f64.to_radians()
-                {
+                let edge_m = 2.0 * resolution_m;
+                if on_window_edge(&nodes, &c, &cfg.window, edge_m, 0.25f64.to_radians()) {
                     continue;
                 }
+                let found = nodes[c.edge.from].compose(&c.edge.measurement);
                 let mut edge = c.edge;
                 if cfg.icp {
                     let Some(pose) = icp_link(
@@ -175,10 +170,8 @@ fn icp_link(
     found: &crate::geom::Pose2,
     cfg: &RefineConfig,
 ) -> Option<crate::geom::Pose2> {
-    let lo = centre.saturating_sub(search.submap_half);
-    let hi = (centre + search.submap_half).min(i - search.min_key_gap);
     let (mut points, mut dirs) = (Vec::new(), Vec::new());
-    for j in lo..=hi {
+    for j in visit_keys(i, centre, search) {
         let f = nodes[j].frame();
         points.extend(key_points[j].iter().map(|&p| f.to_parent(p)));
         dirs.extend(normals[j].iter().map(|n| n.map(|n| f.rotate(n))));

@@ -84,7 +84,9 @@
 use super::grid::{GridConfig, OccupancyGrid};
 use super::likelihood::LikelihoodField;
 use super::log_refine::{refine, RefineConfig};
-use super::loop_closure::{closures_agree, find_closure_among, Closure, LoopConfig};
+use super::loop_closure::{
+    closures_agree, find_closure_among, on_window_edge, Closure, LoopConfig,
+};
 use super::match_covariance::{edge_information, response_covariance, ResponseWindow};
 use super::multires::{field_from_points, match_scan, ScanMatch, Window};
 use super::posegraph::{Edge, PoseGraph};
@@ -575,16 +577,11 @@ impl LogSlam {
     }
 
     /// Whether closure `c`'s match lies on the edge of the search window
-    /// (a world-frame box and heading range around the new key's estimate).
+    /// (within two cells of a side, half a degree of the heading range).
     fn on_window_edge(&self, c: &Closure) -> bool {
-        let (w, res) = (&self.config.loops.window, self.config.resolution_m);
-        let nodes = &self.graph.nodes;
-        let found = nodes[c.edge.from].compose(&c.edge.measurement);
-        let here = &nodes[c.edge.to];
-        let d = found.position() - here.position();
-        d.x.abs() > w.linear_m - 2.0 * res
-            || d.y.abs() > w.linear_m - 2.0 * res
-            || wrap_angle(found.theta - here.theta).abs() > w.angular_rad - 0.5f64.to_radians()
+        let res = self.config.resolution_m;
+        let window = &self.config.loops.window;
+        on_window_edge(&self.graph.nodes, c, window, 2.0 * res, 0.5f64.to_radians())
     }
 
     /// Adds confirmed closures, optimises, and undoes it all if a closure

@@ -34,8 +34,9 @@
 use super::match_covariance::{edge_information, response_covariance, ResponseWindow};
 use super::multires::{field_from_points, match_scan, Window};
 use super::posegraph::Edge;
-use crate::geom::Pose2;
+use crate::geom::{wrap_angle, Pose2};
 use glam::DVec2;
+use std::ops::RangeInclusive;
 
 /// Settings of the loop-closure search.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -140,6 +141,33 @@ pub(super) fn visit_centres(nodes: &[Pose2], i: usize, cfg: &LoopConfig) -> Vec<
     centres.into_iter().map(|c| c.0).collect()
 }
 
+/// The keys of the visit around `centre` that key `i` is matched against:
+/// `submap_half` either side, none of the last `min_key_gap` before `i`.
+pub(super) fn visit_keys(i: usize, centre: usize, cfg: &LoopConfig) -> RangeInclusive<usize> {
+    let lo = centre.saturating_sub(cfg.submap_half);
+    let hi = (centre + cfg.submap_half).min(i.saturating_sub(cfg.min_key_gap));
+    lo..=hi
+}
+
+/// Whether closure `c`'s match lies on the edge of the search `window`: a
+/// box in the world frame and a heading range around the new key's pose in
+/// `nodes`, less `margin_m` and `margin_rad`. A match pressed against the
+/// edge is where the search ran out, not where the scan fits.
+pub(super) fn on_window_edge(
+    nodes: &[Pose2],
+    c: &Closure,
+    window: &Window,
+    margin_m: f64,
+    margin_rad: f64,
+) -> bool {
+    let found = nodes[c.edge.from].compose(&c.edge.measurement);
+    let here = &nodes[c.edge.to];
+    let d = found.position() - here.position();
+    d.x.abs() > window.linear_m - margin_m
+        || d.y.abs() > window.linear_m - margin_m
+        || wrap_angle(found.theta - here.theta).abs() > window.angular_rad - margin_rad
+}
+
 /// Matches key `i` against the key scans around `centre`.
 pub(super) fn match_visit(
     nodes: &[Pose2],
@@ -150,10 +178,8 @@ pub(super) fn match_visit(
     cfg: &LoopConfig,
     response: Option<&ResponseWindow>,
 ) -> Option<Closure> {
-    let lo = centre.saturating_sub(cfg.submap_half);
-    let hi = (centre + cfg.submap_half).min(i - cfg.min_key_gap);
     let mut world = Vec::new();
-    for j in lo..=hi {
+    for j in visit_keys(i, centre, cfg) {
         let f = nodes[j].frame();
         world.extend(key_points[j].iter().map(|&p| f.to_parent(p)));
     }
