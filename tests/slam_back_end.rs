@@ -61,3 +61,60 @@ fn the_back_end_undoes_an_outer_wall_drift() {
     assert!(closures >= 2, "the lap should close: {closures} closures");
     assert!(with < 0.1, "with the back end: ATE {with:.3} m");
 }
+
+/// A robot's mapping handed to "another thread" (here, a value beside the
+/// simulation: `slam/handoff.rs`) for the middle of a run and brought home
+/// ends as the one that stayed, bit for bit; the simulation refuses a
+/// mapping that missed steps, estimates it never made, a second hand-off.
+#[test]
+fn a_mapping_sent_away_and_brought_home_is_the_one_that_stayed() {
+    use slamlab::slam::handoff::{mapping_from_bytes, mapping_to_bytes, observe_packed};
+    let scenario = Scenario::parse(include_str!("../scenarios/thesis.json")).expect("thesis");
+    let mut stayed = Simulation::new(&scenario).expect("simulates");
+    let mut went = Simulation::new(&scenario).expect("simulates");
+    for sim in [&mut stayed, &mut went] {
+        sim.set_capture(false);
+    }
+    for _ in 0..200 {
+        stayed.step();
+        went.step();
+    }
+    let mut away = mapping_from_bytes(&went.send_mapping_away(1).expect("away")).expect("bytes");
+    assert!(went.send_mapping_away(1).is_err(), "away already");
+    assert_eq!(
+        went.robots[1].slam_estimates().len(),
+        201,
+        "the estimates so far stay"
+    );
+    for slice in 0..30 {
+        for _ in 0..(17 + slice % 5) {
+            stayed.step();
+            went.step();
+        }
+        let from = away.estimates().len();
+        observe_packed(&mut away, &went.take_mapping_steps(1)).expect("a batch");
+        let reported: Vec<f64> = away.estimates()[from..]
+            .iter()
+            .flat_map(|p| [p.x, p.y, p.theta])
+            .collect();
+        went.note_away_estimates(1, &reported).expect("estimates");
+    }
+    assert_eq!(went.robots[1].slam_estimates().len(), went.steps() + 1);
+    assert!(
+        went.note_away_estimates(1, &[0.0; 3]).is_err(),
+        "a step not made"
+    );
+    went.step();
+    stayed.step();
+    let bytes = mapping_to_bytes(&away).expect("bytes");
+    let refused = went.bring_mapping_home(1, &bytes).unwrap_err();
+    assert!(refused.contains("steps it was not sent"), "{refused}");
+    observe_packed(&mut away, &went.take_mapping_steps(1)).expect("the last step");
+    went.bring_mapping_home(1, &mapping_to_bytes(&away).expect("bytes"))
+        .expect("home");
+    let (a, b) = (&stayed.robots[1].mapping, &went.robots[1].mapping);
+    assert_eq!(a.estimates(), b.estimates());
+    assert_eq!(mapping_to_bytes(a).unwrap(), mapping_to_bytes(b).unwrap());
+    assert_eq!(a.slam_map.memory_bytes(), b.slam_map.memory_bytes());
+    assert!(went.note_away_estimates(1, &[]).is_err(), "home again");
+}

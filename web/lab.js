@@ -346,6 +346,11 @@ export class Lab {
     return this.raw.takeMappingSteps(robot);
   }
 
+  /** The SLAM poses an away robot's worker reported for its newest steps (flat x, y, theta). */
+  noteAwayEstimates(robot, flat) {
+    this.raw.noteAwayEstimates(robot, flat);
+  }
+
   /** Takes a robot's mapping back (`SlamAway.finish()`'s bytes). */
   bringMappingHome(robot, bytes) {
     this.raw.bringMappingHome(robot, bytes);

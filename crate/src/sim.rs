@@ -134,12 +134,26 @@ pub struct RobotSim {
     /// ([`Simulation::send_mapping_away`]): the steps it has yet to be
     /// sent, packed ([`crate::slam::handoff::pack_step`]).
     slam_outbox: Option<Vec<u8>>,
+    /// While the mapping is away: its estimates as the other thread last
+    /// reported them ([`Simulation::note_away_estimates`]; closures found
+    /// since may have moved them), for guesses made during the run.
+    away_estimates: Vec<Pose2>,
     /// Frames captured by the camera.
     pub frames: FrameStore,
     camera_rng: Rng,
 }
 
 impl RobotSim {
+    /// SLAM poses so far, one per step from the start: the mapping's, or
+    /// while it is away, what the other thread last reported (fewer rows
+    /// than steps when it lags).
+    pub fn slam_estimates(&self) -> &[Pose2] {
+        match self.slam_outbox {
+            Some(_) => &self.away_estimates,
+            None => self.mapping.estimates(),
+        }
+    }
+
     pub fn body(&self) -> ConvexPolygon {
         P2dx::body(&self.truth)
     }
@@ -337,6 +351,7 @@ impl Simulation {
                     log: RobotLog::for_steps(scenario_steps(scenario)),
                     mapping: crate::slam::RobotMapping::default(),
                     slam_outbox: None,
+                    away_estimates: Vec::new(),
                     frames: FrameStore::new(frame_bytes, n_robots, period_steps),
                     camera_rng: Rng::stream(seed, i, Stream::Camera),
                 }
@@ -608,6 +623,7 @@ impl Simulation {
             return Err(format!("robot {i}'s mapping is away already"));
         }
         let bytes = mapping_to_bytes(&r.mapping)?;
+        r.away_estimates = r.mapping.estimates().to_vec();
         r.mapping = crate::slam::RobotMapping::new(r.mapping.config.clone());
         r.slam_outbox = Some(Vec::new());
         Ok(bytes)
@@ -621,6 +637,28 @@ impl Simulation {
             .and_then(|r| r.slam_outbox.as_mut())
             .map(std::mem::take)
             .unwrap_or_default()
+    }
+
+    /// Appends the estimates robot `i`'s mapping, away, reports for its
+    /// newest steps (`[x, y, θ]` a step, in order).
+    pub fn note_away_estimates(&mut self, i: usize, flat: &[f64]) -> Result<(), String> {
+        let r = self
+            .robots
+            .get_mut(i)
+            .ok_or_else(|| format!("no robot {i}"))?;
+        if r.slam_outbox.is_none() {
+            return Err(format!("robot {i}'s mapping is not away"));
+        }
+        if !flat.len().is_multiple_of(3) || r.away_estimates.len() + flat.len() / 3 > self.steps + 1
+        {
+            return Err(format!(
+                "robot {i}: {} numbers are not the estimates of steps it made",
+                flat.len()
+            ));
+        }
+        let poses = flat.chunks_exact(3).map(|p| Pose2::new(p[0], p[1], p[2]));
+        r.away_estimates.extend(poses);
+        Ok(())
     }
 
     /// Takes robot `i`'s mapping back (the bytes of the mapping it was sent
@@ -648,6 +686,7 @@ impl Simulation {
         }
         r.mapping = mapping;
         r.slam_outbox = None;
+        r.away_estimates = Vec::new();
         if settle {
             // As the last step does at home (idempotent).
             r.mapping.settle();

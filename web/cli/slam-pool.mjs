@@ -6,9 +6,11 @@
 // After every slice of the run, send() takes the steps each away robot
 // has made since (Lab.takeMappingSteps, its odometry poses and laser scans
 // packed) and posts them to its worker, the buffer transferred; the worker
-// maps them in order and says when it has. pace() keeps the main thread at
-// most a few batches ahead of a worker, so the packed steps waiting never
-// take much memory. finish() asks every worker for its mappings back and
+// maps them in order and answers with their SLAM poses, which the lab keeps
+// for the frames it picks to describe meanwhile (picked by odometry's poses,
+// they would mostly be frames the merge never asks for). pace() keeps the
+// main thread at most a few slices ahead of a worker, so the packed steps
+// waiting never take much memory. finish() asks every worker for its mappings back and
 // hands them to the lab (Lab.bringMappingHome), which checks that each has
 // seen every step. A worker that fails loses the mapping it held: the run
 // then fails with its message (nothing else can rebuild it).
@@ -16,8 +18,8 @@ import { Worker } from 'node:worker_threads';
 import path from 'node:path';
 import { compiledModule, pkgDir } from './wasm.mjs';
 
-/** Batches a worker may have waiting before the main thread waits for it. */
-const MAX_BATCHES_AHEAD = 6;
+/** Slices of the run a worker may have waiting before the main thread waits for it. */
+const MAX_SLICES_AHEAD = 6;
 
 /**
  * The robots (indices of `robots` robots) that map away when `threads`
@@ -38,13 +40,18 @@ export class SlamPool {
     this.errors = [];
     this.waiting = null;
     this.mappingMs = 0;
+    this.estimates = [];
     const workerData = { module: compiledModule(), pkgJs: path.join(pkgDir(), 'slamlab.js') };
     this.workers = Array.from({ length: Math.min(count, robots.length) }, () => {
       const thread = new Worker(new URL('./slam-worker.mjs', import.meta.url), { workerData });
-      const w = { thread, batches: 0, alive: true, home: new Map() };
+      // waiting: batches posted and not yet mapped (one per robot a slice).
+      const w = { thread, robots: 0, waiting: 0, alive: true, home: new Map() };
       thread.on('message', (msg) => {
         if (msg.error) this.errors.push(msg.error);
-        else if (msg.mapped) w.batches -= 1;
+        else if (msg.mapped) {
+          w.waiting -= 1;
+          this.estimates.push(msg);
+        }
         else if (msg.bytes) w.home.set(msg.robot, msg.bytes);
         else if (msg.finished) {
           w.finished = true;
@@ -61,6 +68,7 @@ export class SlamPool {
     });
     this.away = robots.map((robot, k) => ({ robot, worker: this.workers[k % this.workers.length] }));
     for (const { robot, worker } of this.away) {
+      worker.robots += 1;
       const start = lab.sendMappingAway(robot);
       worker.thread.postMessage({ robot, start }, [start.buffer]);
     }
@@ -86,22 +94,25 @@ export class SlamPool {
     if (this.errors.length > 0) throw new Error(`mapping on a worker thread: ${this.errors.join('; ')}`);
   }
 
-  /** Posts every away robot's new steps to its worker. */
+  /**
+   * Hands the lab the SLAM poses the workers reported, then posts every
+   * away robot's new steps to its worker.
+   */
   send(lab) {
     this.check();
-    const batched = new Set();
+    for (const { robot, estimates } of this.estimates) lab.noteAwayEstimates(robot, estimates);
+    this.estimates = [];
     for (const { robot, worker } of this.away) {
       const steps = lab.takeMappingSteps(robot);
       if (steps.length === 0) continue;
       worker.thread.postMessage({ robot, steps }, [steps.buffer]);
-      batched.add(worker);
+      worker.waiting += 1;
     }
-    for (const w of batched) w.batches += 1;
   }
 
-  /** Waits while a worker has too many batches still to map. */
+  /** Waits while a worker has more than a few slices of its robots' steps still to map. */
   async pace() {
-    while (this.workers.some((w) => w.alive && w.batches > MAX_BATCHES_AHEAD)) {
+    while (this.workers.some((w) => w.alive && w.waiting > MAX_SLICES_AHEAD * w.robots)) {
       await this.message();
       this.check();
     }

@@ -2,7 +2,8 @@
 // thread (web/cli/slam-pool.mjs): its own instance of the wasm build, one
 // SlamAway per robot it was handed. Messages in: {robot, start} (the
 // mapping's bytes), {robot, steps} (a packed batch), {finish}; out:
-// {robot, mapped} per batch, then at the finish {robot, bytes} per robot
+// {robot, mapped, estimates} per batch (the SLAM poses of its steps), then
+// at the finish {robot, bytes} per robot
 // (buffers transferred) and {finished, ms}; or {error}.
 import { parentPort, workerData } from 'node:worker_threads';
 import { pathToFileURL } from 'node:url';
@@ -25,9 +26,12 @@ parentPort.on('message', ({ robot, start, steps, finish }) => {
     if (start) {
       mappings.set(robot, new wasm.SlamAway(start));
     } else if (steps) {
-      mapping(robot).observe(steps);
+      const m = mapping(robot);
+      const from = m.steps() + 1;
+      m.observe(steps);
+      const estimates = m.estimatesFrom(from);
       ms += performance.now() - t0;
-      parentPort.postMessage({ robot, mapped: true });
+      parentPort.postMessage({ robot, mapped: true, estimates }, [estimates.buffer]);
     } else if (finish) {
       for (const [r, m] of mappings) {
         const bytes = m.finish();

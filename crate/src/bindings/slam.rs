@@ -118,6 +118,16 @@ impl Lab {
         self.inner.take_mapping_steps(robot as usize)
     }
 
+    /// Appends the SLAM poses robot `robot`'s mapping, away, reports for
+    /// its newest steps (`SlamAway.estimatesFrom`), which the choice of
+    /// frames to describe meanwhile reads.
+    #[wasm_bindgen(js_name = noteAwayEstimates)]
+    pub fn note_away_estimates(&mut self, robot: u32, flat: &[f64]) -> Result<(), JsError> {
+        self.inner
+            .note_away_estimates(robot as usize, flat)
+            .map_err(err)
+    }
+
     /// Takes robot `robot`'s mapping back (`SlamAway.finish`'s bytes); it
     /// must have been sent every step of the run so far.
     #[wasm_bindgen(js_name = bringMappingHome)]
@@ -156,6 +166,18 @@ impl SlamAway {
     /// Steps mapped so far (the run's, from its start).
     pub fn steps(&self) -> u32 {
         self.mapping.estimates().len().saturating_sub(1) as u32
+    }
+
+    /// The estimates from row `row` on (row 0 is the start), flat
+    /// `[x, y, theta, …]`, for `Lab.noteAwayEstimates`.
+    #[wasm_bindgen(js_name = estimatesFrom)]
+    pub fn estimates_from(&self, row: u32) -> Vec<f64> {
+        let e = self.mapping.estimates();
+        e.get(row as usize..)
+            .unwrap_or_default()
+            .iter()
+            .flat_map(|p| [p.x, p.y, p.theta])
+            .collect()
     }
 
     /// The mapping as bytes, for `Lab.bringMappingHome`.

@@ -152,6 +152,13 @@ impl Lab {
             .unwrap_or_default()
     }
 
+    /// Appends the estimates robot `robot`'s mapping, away, reports
+    /// ([`Simulation::note_away_estimates`]).
+    pub fn note_away_estimates(&mut self, robot: usize, flat: &[f64]) -> Result<(), String> {
+        let sim = self.sim.as_mut().ok_or("nothing has run yet")?;
+        sim.note_away_estimates(robot, flat)
+    }
+
     /// Takes robot `robot`'s mapping back from another thread
     /// ([`Simulation::bring_mapping_home`]).
     pub fn bring_mapping_home(&mut self, robot: usize, bytes: &[u8]) -> Result<(), String> {

@@ -44,11 +44,16 @@ use std::collections::HashMap;
 pub const PACKED_LEN: usize = 6 + 64;
 
 /// The frames (robot, frame index) a merge with `config` describes, in
-/// robot and capture order.
+/// robot and capture order. While a robot's mapping is away on another
+/// thread, only among the frames it has reported a SLAM pose for (a frame
+/// chosen by its odometry pose would mostly be one the merge does not ask
+/// for).
 pub fn frames_to_describe(sim: &Simulation, config: &MergeConfig) -> Vec<(usize, usize)> {
     (0..sim.robots.len())
         .flat_map(|r| {
-            let infos = frame_infos(sim, r);
+            let mut infos = frame_infos(sim, r);
+            let known = sim.robots[r].slam_estimates().len();
+            infos.retain(|f| f.step < known);
             frames_taking_part(&infos, config)
                 .into_iter()
                 .map(move |k| (r, infos[k].index))

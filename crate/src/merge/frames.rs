@@ -25,7 +25,7 @@ use crate::surf::{FastHessian, Features, GrayImage, IntegralImage, SurfConfig};
 /// What robot `i` knew at each of its frames (never the truth).
 pub fn frame_infos(sim: &Simulation, i: usize) -> Vec<FrameInfo> {
     let r = &sim.robots[i];
-    let estimates = r.mapping.estimates();
+    let estimates = r.slam_estimates();
     let odometry = &r.log.odometry;
     r.frames
         .frames
