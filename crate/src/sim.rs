@@ -611,14 +611,13 @@ impl Simulation {
     /// Hands robot `i`'s mapping to another thread: returns it as bytes
     /// ([`crate::slam::handoff`]); from now on its steps wait, packed, for
     /// [`Simulation::take_mapping_steps`] instead of being observed here,
-    /// and the robot's mapping here stays as it was until
+    /// and the robot's mapping here is an empty one until
     /// [`Simulation::bring_mapping_home`]. Nothing of the run reads it
-    /// meanwhile but a frame's SLAM pose, which falls back on odometry's.
+    /// meanwhile but the SLAM poses of the frames picked to describe, which
+    /// come from what the other thread reports
+    /// ([`Simulation::note_away_estimates`], [`RobotSim::slam_estimates`]).
     pub fn send_mapping_away(&mut self, i: usize) -> Result<Vec<u8>, String> {
-        let r = self
-            .robots
-            .get_mut(i)
-            .ok_or_else(|| format!("no robot {i}"))?;
+        let r = self.robot_mut(i)?;
         if r.slam_outbox.is_some() {
             return Err(format!("robot {i}'s mapping is away already"));
         }
@@ -627,6 +626,12 @@ impl Simulation {
         r.mapping = crate::slam::RobotMapping::new(r.mapping.config.clone());
         r.slam_outbox = Some(Vec::new());
         Ok(bytes)
+    }
+
+    fn robot_mut(&mut self, i: usize) -> Result<&mut RobotSim, String> {
+        self.robots
+            .get_mut(i)
+            .ok_or_else(|| format!("no robot {i}"))
     }
 
     /// The steps robot `i`'s mapping, away, has not been sent yet (packed,
@@ -642,15 +647,12 @@ impl Simulation {
     /// Appends the estimates robot `i`'s mapping, away, reports for its
     /// newest steps (`[x, y, θ]` a step, in order).
     pub fn note_away_estimates(&mut self, i: usize, flat: &[f64]) -> Result<(), String> {
-        let r = self
-            .robots
-            .get_mut(i)
-            .ok_or_else(|| format!("no robot {i}"))?;
+        let steps = self.steps;
+        let r = self.robot_mut(i)?;
         if r.slam_outbox.is_none() {
             return Err(format!("robot {i}'s mapping is not away"));
         }
-        if !flat.len().is_multiple_of(3) || r.away_estimates.len() + flat.len() / 3 > self.steps + 1
-        {
+        if !flat.len().is_multiple_of(3) || r.away_estimates.len() + flat.len() / 3 > steps + 1 {
             return Err(format!(
                 "robot {i}: {} numbers are not the estimates of steps it made",
                 flat.len()
@@ -665,11 +667,9 @@ impl Simulation {
     /// away as, fed every step since): it must have seen every step of the
     /// run so far, one estimate per step.
     pub fn bring_mapping_home(&mut self, i: usize, bytes: &[u8]) -> Result<(), String> {
-        let (steps, settle) = (self.steps, self.finished() && self.mapping);
-        let r = self
-            .robots
-            .get_mut(i)
-            .ok_or_else(|| format!("no robot {i}"))?;
+        let (steps, mapping_on) = (self.steps, self.mapping);
+        let settle = self.finished() && mapping_on;
+        let r = self.robot_mut(i)?;
         let outbox = r
             .slam_outbox
             .as_ref()
@@ -679,7 +679,7 @@ impl Simulation {
         }
         let mapping = mapping_from_bytes(bytes)?;
         let seen = mapping.estimates().len().saturating_sub(1);
-        if self.mapping && seen != steps {
+        if mapping_on && seen != steps {
             return Err(format!(
                 "robot {i}'s mapping came back having seen {seen} steps of {steps}"
             ));
