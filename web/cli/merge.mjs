@@ -9,7 +9,7 @@ import { simulate, mergeMaps } from './run-loop.mjs';
 export const METHODS = ['auto', 'thesis', 'map-only'];
 
 export const usage = `  node web/cli.mjs merge SCENARIO.json --out FILE.yaml [--method auto|thesis|map-only] [--seed N] [--duration S] [--workers N]
-      run the scenario (N worker threads describing frames meanwhile, as for run), merge the robots' maps, and write the merged map as ROS map_server PGM + YAML (and a PNG)`;
+      run the scenario (N worker threads describing frames and N mapping robots meanwhile, as for run), merge the robots' maps, and write the merged map as ROS map_server PGM + YAML (and a PNG)`;
 
 /** Checks a --method value (undefined means the default, auto). */
 export function methodOf(options) {
