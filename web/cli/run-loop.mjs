@@ -42,7 +42,8 @@ export async function simulate(lab, { method = 'auto', workers = 0, mappers = 0,
       if (n === 0) break;
       done += n;
       if (slam) {
-        wasmCall(() => slam.send(lab));
+        // Not through wasmCall: what fails here is the program's, not the input's.
+        slam.send(lab);
         await slam.pace();
       }
       if (pool) {
