@@ -23,6 +23,7 @@ import os from 'node:os';
 import path from 'node:path';
 import { compiledModule, pkgDir } from './wasm.mjs';
 import { UsageError } from './args.mjs';
+import { Wakeup } from './wakeup.mjs';
 
 /**
  * Workers when --workers is not given: one per core but the main thread's,
@@ -70,7 +71,7 @@ export class DescribePool {
     this.grays = [];
     this.render = false;
     this.errors = [];
-    this.waiting = null;
+    this.wakeup = new Wakeup();
     const workerData = {
       module: compiledModule(),
       pkgJs: path.join(pkgDir(), 'slamlab.js'),
@@ -86,25 +87,17 @@ export class DescribePool {
         if (msg.error) this.errors.push(`frame ${msg.index} of robot ${msg.robot}: ${msg.error}`);
         else if (msg.gray) this.grays.push(msg);
         else this.results.push(msg);
-        this.wake();
+        this.wakeup.wake();
       });
       thread.on('error', (e) => {
         // The frames it held are described by the merge itself.
         w.alive = false;
         w.pending = 0;
         this.errors.push(`a worker stopped: ${e?.message ?? e}`);
-        this.wake();
+        this.wakeup.wake();
       });
       return w;
     });
-  }
-
-  wake() {
-    if (this.waiting) {
-      const resolve = this.waiting;
-      this.waiting = null;
-      resolve();
-    }
   }
 
   /**
@@ -184,9 +177,7 @@ export class DescribePool {
         const packed = lab.describeFrameSpec(lab.frameSpec(robot, index), this.method);
         lab.storeDescribed(robot, index, this.method, packed);
       } else if (live.some((w) => w.pending > 0)) {
-        await new Promise((resolve) => {
-          this.waiting = resolve;
-        });
+        await this.wakeup.next();
         continue;
       } else {
         break;

@@ -10,13 +10,15 @@
 // for the frames it picks to describe meanwhile (picked by odometry's poses,
 // they would mostly be frames the merge never asks for). pace() keeps the
 // main thread at most a few slices ahead of a worker, so the packed steps
-// waiting never take much memory. finish() asks every worker for its mappings back and
-// hands them to the lab (Lab.bringMappingHome), which checks that each has
-// seen every step. A worker that fails loses the mapping it held: the run
-// then fails with its message (nothing else can rebuild it).
+// waiting never take much memory. finish() asks every worker for its
+// mappings back and hands them to the lab (Lab.bringMappingHome), which
+// checks that each has seen every step. A worker that fails loses the
+// mapping it held: the run then fails with its message (nothing else can
+// rebuild it).
 import { Worker } from 'node:worker_threads';
 import path from 'node:path';
 import { compiledModule, pkgDir } from './wasm.mjs';
+import { Wakeup } from './wakeup.mjs';
 
 /** Slices of the run a worker may have waiting before the main thread waits for it. */
 const MAX_SLICES_AHEAD = 6;
@@ -34,11 +36,12 @@ export function robotsAway(robots, threads) {
 export class SlamPool {
   /**
    * Starts `count` workers and hands them the mappings of `robots`, in
-   * turn. A worker's port queues messages until it has loaded.
+   * turn. A worker's port queues messages until it has loaded. If a
+   * hand-over fails, the workers started are stopped before it throws.
    */
   constructor(lab, robots, count) {
     this.errors = [];
-    this.waiting = null;
+    this.wakeup = new Wakeup();
     this.mappingMs = 0;
     this.estimates = [];
     const workerData = { module: compiledModule(), pkgJs: path.join(pkgDir(), 'slamlab.js') };
@@ -57,36 +60,26 @@ export class SlamPool {
           w.finished = true;
           this.mappingMs += msg.ms;
         }
-        this.wake();
+        this.wakeup.wake();
       });
       thread.on('error', (e) => {
         w.alive = false;
         this.errors.push(`a mapping worker stopped: ${e?.message ?? e}`);
-        this.wake();
+        this.wakeup.wake();
       });
       return w;
     });
     this.away = robots.map((robot, k) => ({ robot, worker: this.workers[k % this.workers.length] }));
-    for (const { robot, worker } of this.away) {
-      worker.robots += 1;
-      const start = lab.sendMappingAway(robot);
-      worker.thread.postMessage({ robot, start }, [start.buffer]);
+    try {
+      for (const { robot, worker } of this.away) {
+        worker.robots += 1;
+        const start = lab.sendMappingAway(robot);
+        worker.thread.postMessage({ robot, start }, [start.buffer]);
+      }
+    } catch (e) {
+      this.close();
+      throw e;
     }
-  }
-
-  wake() {
-    if (this.waiting) {
-      const resolve = this.waiting;
-      this.waiting = null;
-      resolve();
-    }
-  }
-
-  /** Resolves at the next message from a worker. */
-  message() {
-    return new Promise((resolve) => {
-      this.waiting = resolve;
-    });
   }
 
   /** Throws what went wrong in a worker, if anything did. */
@@ -113,7 +106,7 @@ export class SlamPool {
   /** Waits while a worker has more than a few slices of its robots' steps still to map. */
   async pace() {
     while (this.workers.some((w) => w.alive && w.waiting > MAX_SLICES_AHEAD * w.robots)) {
-      await this.message();
+      await this.wakeup.next();
       this.check();
     }
   }
@@ -126,7 +119,7 @@ export class SlamPool {
     this.send(lab);
     for (const w of this.workers) w.thread.postMessage({ finish: true });
     while (this.workers.some((w) => w.alive && !w.finished)) {
-      await this.message();
+      await this.wakeup.next();
       this.check();
     }
     this.check();
