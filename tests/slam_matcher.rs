@@ -203,10 +203,36 @@ fn the_filter_weighs_a_match_by_its_information() {
     // equal to the prior's: the estimate moves half way in x, not in y.
     let mut info = [[0.0; 3]; 3];
     info[0][0] = 1.0 / (sd * sd);
-    f.update(&Pose2::new(1.1, 0.3, 0.0), &info);
+    assert!(f.update(&Pose2::new(1.1, 0.3, 0.0), &info, 30.0));
     assert!((f.pose.x - 1.05).abs() < 1e-9, "x {}", f.pose.x);
     assert!(f.pose.y.abs() < 1e-12, "y {}", f.pose.y);
     assert!((f.pose_covariance()[0][0] - 0.5 * sd * sd).abs() < 1e-12);
+}
+
+#[wasm_bindgen_test(unsupported = test)]
+fn the_filter_turns_away_a_match_outside_its_gate() {
+    // The prior after a metre: variance sd² in x. A match of x alone with
+    // information 1 / sd²: the innovation's variance is sd² + sd², so its
+    // normalised square is ν² / (2 sd²): 24.4 for ν = 0.35 m, 49.8 for
+    // ν = 0.5 m. With the gate at 30 the first is fused, the second not.
+    let noise = OdometryNoise::default();
+    let sd = 0.05 + 1e-4;
+    let mut info = [[0.0; 3]; 3];
+    info[0][0] = 1.0 / (sd * sd);
+    let mut far = PoseFilter::new(Pose2::IDENTITY, &noise);
+    far.predict(&Pose2::new(1.0, 0.0, 0.0), &noise);
+    let before = far.clone();
+    assert!(!far.update(&Pose2::new(1.5, 0.0, 0.0), &info, 30.0));
+    assert_eq!(
+        far, before,
+        "a match outside the gate leaves the state as it was"
+    );
+    let mut near = before.clone();
+    assert!(near.update(&Pose2::new(1.35, 0.0, 0.0), &info, 30.0));
+    assert!((near.pose.x - 1.175).abs() < 1e-9, "x {}", near.pose.x);
+    // The same far match passes a gate of 50.
+    assert!(far.update(&Pose2::new(1.5, 0.0, 0.0), &info, 50.0));
+    assert!((far.pose.x - 1.25).abs() < 1e-9, "x {}", far.pose.x);
 }
 
 #[wasm_bindgen_test(unsupported = test)]
@@ -229,7 +255,7 @@ fn the_filter_learns_a_wheelbase_error_from_matched_turns() {
         truth = truth.compose(&true_step);
         f.predict(&Pose2::new(0.03, 0.0, turn / 1.02), &noise);
         let seen = Pose2::new(truth.x, truth.y, truth.theta + rng.normal(sd));
-        f.update(&seen, &info);
+        assert!(f.update(&seen, &info, 30.0));
     }
     let learned = f.bias[1];
     println!("learned turn bias {learned:.4} (truth {:.4})", 1.02 - 1.0);

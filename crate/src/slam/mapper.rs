@@ -141,6 +141,9 @@ pub struct SlamConfig {
     /// Standard deviation of one point's distance to its surface (m): the
     /// match's information is `JᵀJ / σ²`.
     pub match_noise_m: f64,
+    /// A match whose normalised innovation squared exceeds this is not
+    /// fused ([`super::filter`]'s validation gate).
+    pub innovation_gate: f64,
     pub odometry_noise: OdometryNoise,
     /// When a scan is worth matching and mapping ([`MotionFilter`]).
     pub motion: MotionFilter,
@@ -163,6 +166,7 @@ impl Default for SlamConfig {
             min_score: 0.15,
             search_below: 0.5,
             match_noise_m: 0.01,
+            innovation_gate: 30.0,
             odometry_noise: OdometryNoise::default(),
             motion: MotionFilter::default(),
             back_end: true,
@@ -503,8 +507,15 @@ impl RobotMapping {
         self.odometry_map.integrate_scan(odometry, scan);
         let prior = self.filter.pose;
         let mut outcome = match_scan(&self.slam_map, scan, &prior, &self.config);
-        if outcome.status != MatchStatus::OdometryOnly {
-            self.filter.update(&outcome.pose, &outcome.information);
+        if outcome.status != MatchStatus::OdometryOnly
+            && !self.filter.update(
+                &outcome.pose,
+                &outcome.information,
+                self.config.innovation_gate,
+            )
+        {
+            // Outside the gate: this step is odometry's (see super::filter).
+            outcome.status = MatchStatus::OdometryOnly;
         }
         outcome.pose = self.filter.pose;
         match outcome.status {
