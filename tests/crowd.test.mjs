@@ -53,10 +53,10 @@ test('frames thinned while workers hold them: the run completes with the report 
 });
 
 test('robots mapped on worker threads: the report, loop closures and all, is that of no workers', () => {
-  // The thesis's maze for 600 s, where both robots close loops: with one
+  // The thesis's maze for 900 s, where both robots close loops: with one
   // worker, the second robot maps on it (crate/src/slam/handoff.rs,
   // web/cli/slam-pool.mjs).
-  const args = ['run', 'scenarios/thesis.json', '--json', '--duration', '600'];
+  const args = ['run', 'scenarios/thesis.json', '--json', '--duration', '900'];
   const [alone, helped] = ['0', '1'].map((w) => run(...args, '--workers', w));
   assert.equal(alone.code, 0, alone.stderr);
   assert.equal(helped.code, 0, helped.stderr);

@@ -22,13 +22,32 @@
 //! along it ([`super::mapper`]).
 //!
 //! Normals come from each point's neighbours in beam order ([`scan_normals`]):
-//! the principal axes of the points within 0.12 m along the same surface
-//! (no gap over 0.3 m between consecutive beams), a line fit that averages
-//! the range noise; where the points do not lie on a line (a corner, a
-//! pillar narrower than the window) the point gets no normal. Only points
-//! that land on walls *already in the map* count: a corridor's end wall seen
-//! for the first time constrains nothing until it is mapped.
+//! the principal axes of the points near it along the same surface (no gap
+//! over 0.3 m between consecutive beams), a line fit that averages the
+//! range noise; where the points do not lie on a line (a corner, a pillar
+//! narrower than the window) the point gets no normal. Only points that
+//! land on walls *already in the map* count: a corridor's end wall seen for
+//! the first time constrains nothing until it is mapped.
+//!
+//! ## How near: a neighbourhood sized by the points' spacing
+//! Neighbouring beams land `r·Δφ` apart at range `r` (more on a wall seen
+//! obliquely): 1.6 cm at 0.9 m, 7 cm at 4 m for the lab's 1° laser. A fixed
+//! 0.12 m neighbourhood therefore holds some fifteen points on the near wall
+//! but only two or three on a far one, and whether a far point gets a
+//! normal at all then hangs on its own range noise: a point pushed along
+//! its beam moves along the wall too, closer to one neighbour and out of
+//! reach of the other. The points kept are thus a biased sample, and the
+//! match inherits the bias. Measured in a straight 3 m corridor with perfect
+//! odometry and 1 cm range noise, a robot following one wall veered towards
+//! it, 0.45 m after 100 m, and only when the far wall was in range; the
+//! outer-wall robots of the 16-robot hour drifted a degree a lap the same
+//! way (BENCHMARKS.md, sessions 25 and 26). So the neighbourhood grows with
+//! the range: its radius is the larger of 0.12 m and the spacing of
+//! [`SPACING_BEAMS`] beams at the point's range (0.56 m at 4 m). Near the
+//! robot nothing changes; far points get enough neighbours that noise no
+//! longer decides which of them count.
 
+use crate::sensors::laser::{LASER_BEAMS, LASER_FOV_RAD};
 use glam::DVec2;
 
 /// How well a scan pins the robot's position, in its own frame.
@@ -67,8 +86,11 @@ pub fn symmetric_eigen2(a: f64, b: f64, c: f64) -> (f64, f64, DVec2) {
     (l1, l2, v.normalize_or(DVec2::X))
 }
 
-/// Neighbourhood of a point for its normal (m).
+/// Neighbourhood of a point for its normal (m), at least.
 const NORMAL_RADIUS_M: f64 = 0.12;
+/// A point's neighbourhood reaches at least this many beam spacings at its
+/// range (see the module doc).
+pub const SPACING_BEAMS: f64 = 8.0;
 /// Consecutive beams farther apart than this lie on different surfaces (m).
 const MAX_GAP_M: f64 = 0.3;
 /// At most this many beams on each side take part in a normal.
@@ -82,22 +104,38 @@ const MIN_EXTENT_M: f64 = 0.05;
 /// corner with equal arms gives 0.25.
 const MAX_FLATNESS: f64 = 0.15;
 
-/// The unit surface normal at every point of a scan (robot frame, beam
-/// order), or `None` where the neighbours do not define one. The sign is
-/// arbitrary: only `n nᵀ` and `n·(q − s)` use it.
+/// The unit surface normal at every point of a scan of the lab's laser
+/// (robot frame, beam order), or `None` where the neighbours do not define
+/// one. The sign is arbitrary: only `n nᵀ` and `n·(q − s)` use it. The
+/// neighbourhood grows with the range (see the module doc).
 pub fn scan_normals(points: &[DVec2]) -> Vec<Option<DVec2>> {
-    scan_normals_within(points, NORMAL_RADIUS_M)
+    let step = LASER_FOV_RAD / (LASER_BEAMS - 1) as f64;
+    let per_metre = SPACING_BEAMS * step;
+    normals_within(points, |p| {
+        let r = NORMAL_RADIUS_M.max(per_metre * p.length());
+        r * r
+    })
 }
 
-/// [`scan_normals`] over neighbourhoods of `radius_m` (a scan thinned to
-/// one point per 10 cm needs more than the 0.12 m of a full one).
+/// [`scan_normals`] over neighbourhoods of a fixed `radius_m` (a scan
+/// thinned to one point per 10 cm needs more than the 0.12 m of a full
+/// one).
 pub fn scan_normals_within(points: &[DVec2], radius_m: f64) -> Vec<Option<DVec2>> {
-    // The distance tests on squared lengths, with bounds that give the same
-    // answers as on lengths (a square root per test was a third of this).
-    let (gap2, radius2) = (squared_bound(MAX_GAP_M), squared_bound(radius_m));
+    // The distance tests on squared lengths, with a bound that gives the
+    // same answers as on lengths (a square root per test was a third of
+    // this).
+    let radius2 = squared_bound(radius_m);
+    normals_within(points, |_| radius2)
+}
+
+/// The normals, with the squared radius of each point's neighbourhood
+/// from `radius2_at(point)`.
+fn normals_within(points: &[DVec2], radius2_at: impl Fn(DVec2) -> f64) -> Vec<Option<DVec2>> {
+    let gap2 = squared_bound(MAX_GAP_M);
     (0..points.len())
         .map(|i| {
             let p = points[i];
+            let radius2 = radius2_at(p);
             // Walk out along the beam order while the surface continues.
             let mut lo = i;
             while lo > 0
