@@ -136,6 +136,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             r.spec.name,
             profile.join(" ")
         );
+        let headings: Vec<String> = t
+            .mapping
+            .estimates()
+            .iter()
+            .zip(&r.log.truth)
+            .step_by(every)
+            .map(|(e, tr)| {
+                let d = slamlab::geom::wrap_angle(start.compose(e).theta - tr.theta);
+                format!("{:+.2}", d.to_degrees())
+            })
+            .collect();
+        println!(
+            "{} final heading error (°) every {every_s} s: {}",
+            r.spec.name,
+            headings.join(" ")
+        );
         t.slowest.sort_by(|a, b| b.0.total_cmp(&a.0));
         let slow: Vec<String> = t
             .slowest
