@@ -269,3 +269,40 @@ fn the_sensors_grid_finds_the_same_ranges_as_the_worlds() {
     assert!(hits > 400 * 181 / 2, "rays hit walls: {hits}");
     assert!(corners > 100, "rays through junctions: {corners}");
 }
+
+#[wasm_bindgen_test(unsupported = test)]
+fn the_aligned_ate_forgives_a_turned_map_the_start_aligned_does_not() {
+    use slamlab::slam::scoring::{ate_aligned_m, ate_m};
+    // The truth: 11 poses along y = 0 from x = 0 to 10, start at (2, 3).
+    // The estimate (odometry frame, origin at the start) turned by 1°
+    // about the start, as a heading error before the first wall would.
+    let start = Pose2::new(2.0, 3.0, 0.0);
+    let turn = 1f64.to_radians();
+    let truth: Vec<Pose2> = (0..=10)
+        .map(|k| Pose2::new(2.0 + k as f64, 3.0, 0.0))
+        .collect();
+    let turned: Vec<Pose2> = (0..=10)
+        .map(|k| Pose2::new(k as f64 * turn.cos(), k as f64 * turn.sin(), turn))
+        .collect();
+    // Start-aligned: point k is off by 2 k sin(0.5°); RMSE over k = 0..10
+    // is 2 sin(0.5°) √(Σk² / 11) = 2 sin(0.5°) √35.
+    let expected = 2.0 * (0.5f64.to_radians()).sin() * 35f64.sqrt();
+    assert!(close(ate_m(&start, &turned, &truth), expected, 1e-12));
+    // Aligned: the rotation is undone exactly.
+    assert!(ate_aligned_m(&start, &turned, &truth) < 1e-12);
+    // A bend is not a rigid motion: the last five points 0.1 m off sideways.
+    // The best fit leaves a residual, less than the start-aligned error.
+    let bent: Vec<Pose2> = (0..=10)
+        .map(|k| Pose2::new(k as f64, if k > 5 { 0.1 } else { 0.0 }, 0.0))
+        .collect();
+    let (aligned, anchored) = (
+        ate_aligned_m(&start, &bent, &truth),
+        ate_m(&start, &bent, &truth),
+    );
+    assert!(close(anchored, 0.1 * (5.0f64 / 11.0).sqrt(), 1e-12));
+    assert!(
+        aligned > 0.01 && aligned < anchored,
+        "{aligned} vs {anchored}"
+    );
+    assert_eq!(ate_aligned_m(&start, &[], &truth), 0.0);
+}

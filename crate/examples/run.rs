@@ -36,8 +36,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         for (i, spec) in lab.scenario().robots.iter().enumerate() {
             let f = lab.slam_figures(i)?;
             println!(
-                "  {}: SLAM ATE {:.4} m (odometry {:.4} m)",
-                spec.name, f.ate_m, f.odometry_ate_m
+                "  {}: SLAM ATE {:.4} m (odometry {:.4} m; SLAM aligned {:.4} m)",
+                spec.name, f.ate_m, f.odometry_ate_m, f.ate_aligned_m
             );
         }
         if let Some(sim) = lab.simulation() {

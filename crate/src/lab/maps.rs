@@ -10,7 +10,7 @@ use crate::sim::{RobotSim, Simulation};
 use crate::slam::export::{to_pgm, to_png, to_yaml, GridPicture};
 use crate::slam::grid::OccupancyGrid;
 use crate::slam::mapper::{MapperKind, RobotMapping};
-use crate::slam::scoring::{ate_m, map_accuracy, position_errors_m};
+use crate::slam::scoring::{ate_aligned_m, ate_m, map_accuracy, position_errors_m};
 use glam::DVec2;
 use serde::Serialize;
 
@@ -19,6 +19,10 @@ use serde::Serialize;
 pub struct SlamFigures {
     /// ATE of the SLAM poses (m).
     pub ate_m: f64,
+    /// The same after the best rigid fit onto the truth (m): without the
+    /// heading error made before anything was in view
+    /// ([`crate::slam::scoring`]).
+    pub ate_aligned_m: f64,
     /// ATE of the raw odometry (m).
     pub odometry_ate_m: f64,
     /// Position error at the last step (m).
@@ -66,6 +70,7 @@ pub fn figures(sim: &Simulation, robot: &RobotSim) -> SlamFigures {
     };
     SlamFigures {
         ate_m: r6(ate_m(&start, est, truth)),
+        ate_aligned_m: r6(ate_aligned_m(&start, est, truth)),
         odometry_ate_m: r6(ate_m(&start, &robot.log.odometry, truth)),
         final_error_m: r6(last_err(est)),
         odometry_final_error_m: r6(last_err(&robot.log.odometry)),
