@@ -56,7 +56,7 @@ enum Phase {
     /// earlier rotations' peaks.
     Peaks {
         delta: f64,
-        ra: Raster,
+        ra: Box<Raster>,
         a_max: Option<Option<MaxPyramid>>,
         k: usize,
         rotation: Option<RotationSearch>,
@@ -213,7 +213,7 @@ impl MapSearchSteps {
             Ok((delta, ra)) => {
                 self.phase = Phase::Peaks {
                     delta,
-                    ra,
+                    ra: Box::new(ra),
                     a_max: None,
                     k: 0,
                     rotation: None,
