@@ -639,7 +639,6 @@ pub struct CoarseOverlap {
     /// Quarter turns done.
     turns: usize,
     best: i64,
-    walls_b: usize,
     /// B drawn at the last turn done (the next is this turned a quarter,
     /// [`Raster::quarter_turn`]).
     last: Option<Raster>,
@@ -652,7 +651,6 @@ impl CoarseOverlap {
             delta: rotation_between(&a.spectrum, &b.spectrum),
             turns: 0,
             best: 0,
-            walls_b: 0,
             last: None,
         }
     }
@@ -681,17 +679,18 @@ impl CoarseOverlap {
                 None => return Some(0.0),
             },
         };
-        self.walls_b = rb.walls.len();
         let corr = correlate(ra, &rb);
-        self.last = Some(rb);
         self.best = self
             .best
             .max(corr.acc.iter().copied().max().unwrap_or(0) as i64);
+        // B has as many wall cells at every quarter turn.
+        let walls_b = rb.walls.len();
+        self.last = Some(rb);
         self.turns += 1;
         if self.turns < 4 {
             return None;
         }
-        let smaller = ra.walls.len().min(self.walls_b);
+        let smaller = ra.walls.len().min(walls_b);
         if smaller == 0 {
             return Some(0.0);
         }
