@@ -4,39 +4,41 @@
 //! translation search finds exactly the exhaustive search's peaks.
 //!
 //! ```text
-//! cargo run --release -p slamlab --example bench_mapsearch -- S.json [--pairs 12] [--robots 5,7,11] [--compare]
+//! cargo run --release -p slamlab --example bench_mapsearch -- S.json [--pairs 12] [--robots 5,7,11] [--compare] [--cache MAPS.bin]
 //! ```
+//!
+//! `--cache` keeps the SLAM maps in that file and reads them back on the
+//! next call instead of simulating again (`support/slam_maps.rs`, shared
+//! with `bench_overlaps`).
 //!
 //! The pairs are taken in order (1, 2), (1, 3), … (1, n), (2, 3), …; the
 //! first `--pairs` of them are searched.
 
-use slamlab::lab::Lab;
 use slamlab::merge::mapsearch::{coarse_peaks, search_maps, MapSearchConfig, TranslationSearch};
 use slamlab::merge::verdict::VerdictConfig;
-use slamlab::slam::MapperKind;
 use std::time::Instant;
+
+#[path = "support/slam_maps.rs"]
+mod slam_maps;
+use slam_maps::slam_maps;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
     let path = args
         .get(1)
-        .ok_or("usage: bench_mapsearch S.json [--pairs N] [--compare]")?;
+        .ok_or("usage: bench_mapsearch S.json [--pairs N] [--robots A,B,...] [--compare] [--cache MAPS.bin]")?;
     let pairs: usize = args
         .iter()
         .position(|a| a == "--pairs")
         .and_then(|i| args.get(i + 1))
         .map_or(Ok(12), |s| s.parse())?;
     let compare = args.iter().any(|a| a == "--compare");
-    let mut lab = Lab::new(&std::fs::read_to_string(path)?)?;
-    let start = Instant::now();
-    lab.run_to_end()?;
-    println!("simulate (ms): {:.0}", start.elapsed().as_secs_f64() * 1e3);
-    let sim = lab.simulation().ok_or("no simulation")?;
-    let maps: Vec<_> = sim
-        .robots
+    let cache = args
         .iter()
-        .map(|r| r.mapping.map(MapperKind::Slam))
-        .collect();
+        .position(|a| a == "--cache")
+        .and_then(|i| args.get(i + 1));
+    let owned = slam_maps(path, cache)?;
+    let maps: Vec<_> = owned.iter().collect();
     let n = maps.len();
     // `--robots 5,7,11` restricts the pairs to those robots (1-based).
     let chosen: Vec<usize> = match args.iter().position(|a| a == "--robots") {

@@ -14,14 +14,17 @@
 //!
 //! The scenario is simulated once natively (a minute for sixteen robots
 //! over an hour); with `--cache` its SLAM maps are kept in that file
-//! (postcard) and read back on the next call instead.
+//! (postcard) and read back on the next call instead (`support/slam_maps.rs`).
 
-use slamlab::lab::Lab;
 use slamlab::merge::mapsearch::{coarse_overlap, search_maps, CoarseMap, MapSearchConfig};
 use slamlab::merge::pairbudget::PairBudgetConfig;
 use slamlab::merge::verdict::VerdictConfig;
-use slamlab::slam::{MapperKind, OccupancyGrid};
+use slamlab::slam::OccupancyGrid;
 use std::time::Instant;
+
+#[path = "support/slam_maps.rs"]
+mod slam_maps;
+use slam_maps::slam_maps;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
@@ -34,7 +37,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .and_then(|i| args.get(i + 1))
     };
     let runs: usize = value("--runs").map_or(Ok(3), |s| s.parse())?;
-    let maps = maps_of(path, value("--cache"))?;
+    let maps = slam_maps(path, value("--cache"))?;
     if let Some(n) = value("--search") {
         return search(&maps, n.parse()?, runs);
     }
@@ -97,29 +100,4 @@ fn search(
         );
     }
     Ok(())
-}
-
-/// The scenario's SLAM maps: from the cache when it is there, else
-/// simulated (and cached when asked).
-fn maps_of(
-    path: &str,
-    cache: Option<&String>,
-) -> Result<Vec<OccupancyGrid>, Box<dyn std::error::Error>> {
-    if let Some(bytes) = cache.and_then(|c| std::fs::read(c).ok()) {
-        return Ok(postcard::from_bytes(&bytes)?);
-    }
-    let mut lab = Lab::new(&std::fs::read_to_string(path)?)?;
-    let start = Instant::now();
-    lab.run_to_end()?;
-    println!("simulate (ms): {:.0}", start.elapsed().as_secs_f64() * 1e3);
-    let sim = lab.simulation().ok_or("no simulation")?;
-    let maps: Vec<OccupancyGrid> = sim
-        .robots
-        .iter()
-        .map(|r| r.mapping.map(MapperKind::Slam).clone())
-        .collect();
-    if let Some(c) = cache {
-        std::fs::write(c, postcard::to_allocvec(&maps)?)?;
-    }
-    Ok(maps)
 }
