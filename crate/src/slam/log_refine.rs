@@ -189,61 +189,14 @@ mod tests {
     use super::*;
     use crate::geom::Pose2;
     use crate::slam::posegraph::Edge;
-
-    /// The walls of a 12 × 6 m room with two pillars, as segments.
-    fn room() -> Vec<(DVec2, DVec2)> {
-        // Off the 5 cm raster, as real walls are.
-        let v = |x: f64, y: f64| DVec2::new(x + 0.013, y + 0.031);
-        let mut walls = vec![
-            (v(0.0, 0.0), v(12.0, 0.0)),
-            (v(12.0, 0.0), v(12.0, 6.0)),
-            (v(12.0, 6.0), v(0.0, 6.0)),
-            (v(0.0, 6.0), v(0.0, 0.0)),
-        ];
-        for (cx, cy) in [(4.0, 4.2), (8.5, 1.0)] {
-            let (a, b, c, d) = (
-                v(cx, cy),
-                v(cx + 0.6, cy),
-                v(cx + 0.6, cy + 0.4),
-                v(cx, cy + 0.4),
-            );
-            walls.extend([(a, b), (b, c), (c, d), (d, a)]);
-        }
-        walls
-    }
-
-    /// A 360-beam scan from `pose` in the robot frame, one point per 10 cm
-    /// or so, as `scan_points` keeps them.
-    fn scan(pose: &Pose2, walls: &[(DVec2, DVec2)]) -> Vec<DVec2> {
-        let f = pose.frame();
-        let o = pose.position();
-        let mut out: Vec<DVec2> = Vec::new();
-        for i in 0..360 {
-            let dir = DVec2::from_angle(pose.theta + (i as f64).to_radians());
-            let hit = walls
-                .iter()
-                .filter_map(|&(a, b)| {
-                    let (e, w) = (b - a, a - o);
-                    let den = dir.perp_dot(e);
-                    let t = w.perp_dot(e) / den;
-                    let u = w.perp_dot(dir) / den;
-                    (den.abs() > 1e-12 && t > 0.0 && (0.0..=1.0).contains(&u)).then_some(t)
-                })
-                .fold(f64::INFINITY, f64::min);
-            let p = f.to_local(o + dir * hit);
-            if out.last().is_none_or(|q| q.distance(p) >= 0.1) {
-                out.push(p);
-            }
-        }
-        out
-    }
+    use crate::slam::scenes;
 
     /// Three passes along the room, each internally right; the third one
     /// was joined to the second by a wrong edge that left it 5–15 cm and 0.5°
     /// off. The refinement links it to the first pass and brings it back.
     #[test]
     fn a_pass_left_off_by_a_wrong_edge_is_brought_back() {
-        let walls = room();
+        let walls = scenes::room();
         let mut truth = Vec::new();
         for k in 0..30 {
             truth.push(Pose2::new(1.5 + 0.3 * k as f64, 2.5, 0.0));
@@ -254,7 +207,10 @@ mod tests {
         for k in 0..30 {
             truth.push(Pose2::new(1.5 + 0.3 * k as f64, 2.2, 0.02));
         }
-        let key_points: Vec<Vec<DVec2>> = truth.iter().map(|p| scan(p, &walls)).collect();
+        let key_points: Vec<Vec<DVec2>> = truth
+            .iter()
+            .map(|p| scenes::scan(p, &walls, f64::INFINITY))
+            .collect();
         let slip = Pose2::new(0.05, -0.04, 0.5f64.to_radians());
         let mut graph = PoseGraph::default();
         for (k, p) in truth.iter().enumerate() {

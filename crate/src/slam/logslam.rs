@@ -49,7 +49,14 @@
 //!    often a wrong place that merely fits better than the right one within
 //!    reach (on the raw MIT CSAIL log the four closures so refused include
 //!    the two that slid 1.8–1.9 m along a corridor; its relation error went
-//!    from 0.43 to 0.22 m, BENCHMARKS.md).
+//!    from 0.43 to 0.22 m, BENCHMARKS.md). With `loop_min_weak` > 0 a
+//!    closure is also refused when the new key's points, laid at the match
+//!    onto the visit's scans, pin it in their weakest direction by fewer
+//!    than that many points' worth ([`super::loop_closure::closure_pinned`]):
+//!    a corridor whose ends are out of sight pins nothing along it. Off by
+//!    default: it removes the corridor slides that make some settings'
+//!    figures jump, but costs the corridor-rich logs right closures too
+//!    (BENCHMARKS.md, session 29).
 //! 5. **Chain of recent keys** (Karto's scan-to-scan links, off unless
 //!    `chain_keys` > 0): the new key's scan is also matched against each of
 //!    the `chain_keys` keys before the previous one, alone, and every match
@@ -85,7 +92,7 @@ use super::grid::{GridConfig, OccupancyGrid};
 use super::likelihood::LikelihoodField;
 use super::log_refine::{refine, RefineConfig};
 use super::loop_closure::{
-    closures_agree, find_closure_among, on_window_edge, Closure, LoopConfig,
+    closure_pinned, closures_agree, find_closure_among, on_window_edge, Closure, LoopConfig,
 };
 use super::match_covariance::{edge_information, response_covariance, ResponseWindow};
 use super::multires::{field_from_points, match_scan, ScanMatch, Window};
@@ -166,6 +173,12 @@ pub struct LogSlamConfig {
     /// window (the best pose inside the window is then not a peak of the
     /// response: the true one may lie outside, as for the local match).
     pub loop_edge_reject: bool,
+    /// Refuse a closure whose match leaves the new key pinned by fewer than
+    /// this many points' worth of constraint in its weakest direction, as
+    /// a point-to-line fit onto the visit's scans at the matched pose sees
+    /// it ([`closure_pinned`]; 0: off). A corridor pins a scan only across
+    /// itself, and a closure there can slide along it by metres.
+    pub loop_min_weak: f64,
     /// The closing refinement after the replay ([`super::log_refine`]).
     pub refine: RefineConfig,
 }
@@ -214,6 +227,7 @@ impl Default for LogSlamConfig {
             chain_min_score: 0.5,
             loop_visits: 1,
             loop_edge_reject: true,
+            loop_min_weak: 0.0,
             refine: RefineConfig::default(),
         }
     }
@@ -258,6 +272,8 @@ pub struct LogSlamStats {
     pub chain_edges: usize,
     /// Closures refused for lying on the search window's edge.
     pub closures_on_edge: usize,
+    /// Closures refused as not pinned in every direction (`loop_min_weak`).
+    pub closures_degenerate: usize,
     /// Links the closing refinement added ([`super::log_refine`]).
     pub refine_links: usize,
 }
@@ -553,6 +569,17 @@ impl LogSlam {
         self.stats.closures_found += 1;
         if self.config.loop_edge_reject && self.on_window_edge(&found) {
             self.stats.closures_on_edge += 1;
+            return;
+        }
+        if self.config.loop_min_weak > 0.0
+            && closure_pinned(
+                &self.graph.nodes,
+                &self.key_points,
+                &found,
+                &self.config.loops,
+            ) < self.config.loop_min_weak
+        {
+            self.stats.closures_degenerate += 1;
             return;
         }
         let cfg = &self.config;

@@ -31,6 +31,8 @@
 //!    ([`super::logslam`]) then optimises the graph and keeps the edge only if
 //!    the result is consistent (see there).
 
+use super::degeneracy::scan_normals_within;
+use super::icp::IcpTarget;
 use super::match_covariance::{edge_information, response_covariance, ResponseWindow};
 use super::multires::{field_from_points, match_scan, Window};
 use super::posegraph::Edge;
@@ -208,6 +210,44 @@ pub(super) fn match_visit(
     })
 }
 
+/// Neighbourhood of a thinned key scan's point for its normal, and the
+/// association radius and Huber threshold of [`closure_pinned`]'s fit (m):
+/// those of the closing refinement ([`super::log_refine`]).
+const PIN_NORMAL_RADIUS_M: f64 = 0.35;
+const PIN_RADIUS_M: f64 = 0.2;
+const PIN_HUBER_M: f64 = 0.02;
+
+/// How well closure `c` pins its new key in the weakest direction: the
+/// smaller eigenvalue of the translational information `Σ w n nᵀ` of the
+/// new key's points laid at the matched pose onto the visit's scans (each
+/// point measured along the normal of the nearest visit point within
+/// 0.2 m; [`super::icp`]), in points' worth. A room or a corner gives tens;
+/// a corridor whose end walls and doors are out of sight gives nearly
+/// nothing along it, and a match there may sit anywhere along it.
+pub fn closure_pinned(
+    nodes: &[Pose2],
+    key_points: &[Vec<DVec2>],
+    c: &Closure,
+    cfg: &LoopConfig,
+) -> f64 {
+    let (i, centre) = (c.edge.to, c.edge.from);
+    let (mut points, mut normals) = (Vec::new(), Vec::new());
+    for j in visit_keys(i, centre, cfg) {
+        let f = nodes[j].frame();
+        points.extend(key_points[j].iter().map(|&p| f.to_parent(p)));
+        normals.extend(
+            scan_normals_within(&key_points[j], PIN_NORMAL_RADIUS_M)
+                .into_iter()
+                .map(|n| n.map(|n| f.rotate(n))),
+        );
+    }
+    let found = nodes[centre].compose(&c.edge.measurement);
+    // One pass: the information at the matched pose, not a refined one.
+    IcpTarget::new(&points, &normals, PIN_RADIUS_M)
+        .align(&key_points[i], &found, PIN_HUBER_M, 1)
+        .weak
+}
+
 /// Pairwise consistency of two closures `a` and `b` (Olson, "Recognizing
 /// places using spectrally clustered local matches", RAS 2009): the cycle
 /// *old_a → new_a → new_b → old_b → old_a*, made of the two closures and the
@@ -222,4 +262,51 @@ pub fn closures_agree(nodes: &[Pose2], a: &Closure, b: &Closure, max_m: f64, max
         .compose(&b.edge.measurement.inverse())
         .compose(&nodes[b.edge.from].between(&nodes[a.edge.from]));
     cycle.position().length() <= max_m && cycle.theta.abs() <= max_rad
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::slam::scenes;
+
+    /// Keys every 0.3 m along a path at heading 0 through `walls`, scanned
+    /// to `range_m`, and the closure of the last key onto the first at its
+    /// true relative pose.
+    fn closure_along(
+        walls: &[(DVec2, DVec2)],
+        from: DVec2,
+        range_m: f64,
+    ) -> (Vec<Pose2>, Vec<Vec<DVec2>>, Closure, LoopConfig) {
+        let cfg = LoopConfig {
+            min_key_gap: 10,
+            submap_half: 2,
+            ..LoopConfig::default()
+        };
+        // Out along the path, and back to the start facing the same way.
+        let mut nodes: Vec<Pose2> = (0..12)
+            .map(|k| Pose2::new(from.x + 0.3 * k as f64, from.y, 0.0))
+            .collect();
+        nodes.push(Pose2::new(from.x + 0.05, from.y + 0.02, 0.01));
+        let key_points = nodes
+            .iter()
+            .map(|p| scenes::scan(p, walls, range_m))
+            .collect();
+        let i = nodes.len() - 1;
+        let edge = Edge::new(0, i, nodes[0].between(&nodes[i]), 0.05, 0.02);
+        (nodes, key_points, Closure { edge, score: 1.0 }, cfg)
+    }
+
+    /// A room pins a closure in every direction: tens of points' worth
+    /// along its weakest one. In a corridor whose ends are out of range
+    /// nothing pins it along the corridor.
+    #[test]
+    fn a_closure_in_a_corridor_is_not_pinned_along_it() {
+        let (nodes, points, c, cfg) = closure_along(&scenes::room(), DVec2::new(2.0, 2.5), 20.0);
+        let room = closure_pinned(&nodes, &points, &c, &cfg);
+        let (nodes, points, c, cfg) =
+            closure_along(&scenes::corridor(), DVec2::new(-2.0, 1.0), 8.0);
+        let corridor = closure_pinned(&nodes, &points, &c, &cfg);
+        assert!(room > 20.0, "room: {room}");
+        assert!(corridor < 1.0, "corridor: {corridor}");
+    }
 }

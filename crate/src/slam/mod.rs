@@ -53,6 +53,8 @@ pub mod multires;
 pub mod posegraph;
 pub mod relations;
 pub mod robot_graph;
+#[cfg(test)]
+mod scenes;
 pub mod scoring;
 pub mod surface;
 pub mod surface_blocks;
