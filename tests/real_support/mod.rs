@@ -235,6 +235,7 @@ pub fn config_from_env() -> LogSlamConfig {
             "refine_icp" => cfg.refine.icp = v != 0.0,
             "refine_min_weak" => cfg.refine.icp_min_weak = v,
             "loop_min_weak" => cfg.loop_min_weak = v,
+            "loop_loosen_ratio" => cfg.loop_loosen_ratio = v,
             "local_keys" => cfg.local_keys = v as usize,
             "key_distance_m" => cfg.key_distance_m = v,
             "key_angle_deg" => cfg.key_angle_rad = v.to_radians(),

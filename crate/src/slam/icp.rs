@@ -43,6 +43,9 @@ pub struct IcpFit {
     /// Smaller eigenvalue of the translational information (points' worth
     /// of constraint in the weakest direction).
     pub weak: f64,
+    /// The larger eigenvalue, and the weakest direction (world frame).
+    pub strong: f64,
+    pub weak_direction: DVec2,
 }
 
 impl IcpTarget {
@@ -117,6 +120,7 @@ impl IcpTarget {
     ) -> IcpFit {
         let mut pose = *start;
         let (mut weak, mut associated) = (0.0, 0);
+        let (mut strong, mut weak_direction) = (0.0, DVec2::X);
         for _ in 0..iterations {
             let mut h = [[0.0; 3]; 3];
             let mut g = [0.0; 3];
@@ -135,7 +139,8 @@ impl IcpTarget {
                     }
                 }
             }
-            weak = symmetric_eigen2(h[0][0], h[0][1], h[1][1]).1;
+            let (l1, l2, along) = symmetric_eigen2(h[0][0], h[0][1], h[1][1]);
+            (strong, weak, weak_direction) = (l1, l2, along);
             for (a, row) in h.iter_mut().enumerate() {
                 row[a] += 1e-6;
             }
@@ -151,6 +156,8 @@ impl IcpTarget {
             pose,
             associated,
             weak,
+            strong,
+            weak_direction,
         }
     }
 }

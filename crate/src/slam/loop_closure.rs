@@ -32,7 +32,7 @@
 //!    the result is consistent (see there).
 
 use super::degeneracy::scan_normals_within;
-use super::icp::IcpTarget;
+use super::icp::{IcpFit, IcpTarget};
 use super::match_covariance::{edge_information, response_covariance, ResponseWindow};
 use super::multires::{field_from_points, match_scan, Window};
 use super::posegraph::Edge;
@@ -230,6 +230,17 @@ pub fn closure_pinned(
     c: &Closure,
     cfg: &LoopConfig,
 ) -> f64 {
+    closure_fit(nodes, key_points, c, cfg).weak
+}
+
+/// The point-to-line information of closure `c`'s match ([`closure_pinned`]),
+/// with its strong and weak directions.
+pub fn closure_fit(
+    nodes: &[Pose2],
+    key_points: &[Vec<DVec2>],
+    c: &Closure,
+    cfg: &LoopConfig,
+) -> IcpFit {
     let (i, centre) = (c.edge.to, c.edge.from);
     let (mut points, mut normals) = (Vec::new(), Vec::new());
     for j in visit_keys(i, centre, cfg) {
@@ -243,9 +254,30 @@ pub fn closure_pinned(
     }
     let found = nodes[centre].compose(&c.edge.measurement);
     // One pass: the information at the matched pose, not a refined one.
-    IcpTarget::new(&points, &normals, PIN_RADIUS_M)
-        .align(&key_points[i], &found, PIN_HUBER_M, 1)
-        .weak
+    IcpTarget::new(&points, &normals, PIN_RADIUS_M).align(&key_points[i], &found, PIN_HUBER_M, 1)
+}
+
+/// Closure `c`'s edge made loose along its weak direction: the variance
+/// `sigma_m²` across it, `sigma_m² · min(strong / weak, max_ratio)` along
+/// it, heading `sigma_rad²`, as the edge's information.
+pub fn loosened_along_weak(
+    nodes: &[Pose2],
+    c: &Closure,
+    fit: &IcpFit,
+    sigma_m: f64,
+    sigma_rad: f64,
+    max_ratio: f64,
+) -> Option<[[f64; 3]; 3]> {
+    let ratio = (fit.strong / fit.weak.max(1e-9)).clamp(1.0, max_ratio);
+    let (v, s2) = (fit.weak_direction, sigma_m * sigma_m);
+    let k = s2 * (ratio - 1.0);
+    let cov = [
+        [s2 + k * v.x * v.x, k * v.x * v.y, 0.0],
+        [k * v.x * v.y, s2 + k * v.y * v.y, 0.0],
+        [0.0, 0.0, sigma_rad * sigma_rad],
+    ];
+    let found = nodes[c.edge.from].compose(&c.edge.measurement);
+    edge_information(&cov, found.theta)
 }
 
 /// Pairwise consistency of two closures `a` and `b` (Olson, "Recognizing
@@ -308,5 +340,38 @@ mod tests {
         let corridor = closure_pinned(&nodes, &points, &c, &cfg);
         assert!(room > 20.0, "room: {room}");
         assert!(corridor < 1.0, "corridor: {corridor}");
+    }
+
+    /// Loosened, a corridor's closure keeps its σ across the corridor and
+    /// heading, and takes `max_ratio` times the variance along it (here the
+    /// keys' frames are the world's: the corridor runs along x). A room's
+    /// keeps nearly the σ it had in every direction.
+    #[test]
+    fn a_corridor_closure_is_loose_along_the_corridor_only() {
+        let (sigma_m, sigma_rad) = (0.05, 1f64.to_radians());
+        let info = |walls: &[(DVec2, DVec2)], from: DVec2, range_m: f64| {
+            let (nodes, points, c, cfg) = closure_along(walls, from, range_m);
+            let fit = closure_fit(&nodes, &points, &c, &cfg);
+            loosened_along_weak(&nodes, &c, &fit, sigma_m, sigma_rad, 10.0).unwrap()
+        };
+        let corridor = info(&scenes::corridor(), DVec2::new(-2.0, 1.0), 8.0);
+        let nominal = 1.0 / (sigma_m * sigma_m);
+        // The closing key is turned by 0.01 rad: its frame is nearly the world's.
+        assert!(
+            (corridor[0][0] - nominal / 10.0).abs() < 0.01 * nominal,
+            "{corridor:?}"
+        );
+        assert!(
+            (corridor[1][1] - nominal).abs() < 0.01 * nominal,
+            "{corridor:?}"
+        );
+        assert!((corridor[2][2] - 1.0 / (sigma_rad * sigma_rad)).abs() < 1e-6 * corridor[2][2]);
+        let room = info(&scenes::room(), DVec2::new(2.0, 2.5), 20.0);
+        for a in 0..2 {
+            assert!(
+                room[a][a] > 0.5 * nominal && room[a][a] <= nominal * 1.001,
+                "{room:?}"
+            );
+        }
     }
 }
