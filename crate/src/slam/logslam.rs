@@ -98,8 +98,8 @@ use super::grid::{GridConfig, OccupancyGrid};
 use super::likelihood::LikelihoodField;
 use super::log_refine::{refine, RefineConfig};
 use super::loop_closure::{
-    closure_fit, closure_pinned, closures_agree, find_closure_among, loosened_along_weak,
-    on_window_edge, Closure, LoopConfig,
+    closure_fit, closures_agree, find_closure_among, loosened_along_weak, on_window_edge, Closure,
+    LoopConfig,
 };
 use super::match_covariance::{edge_information, response_covariance, ResponseWindow};
 use super::multires::{field_from_points, match_scan, ScanMatch, Window};
@@ -183,7 +183,7 @@ pub struct LogSlamConfig {
     /// Refuse a closure whose match leaves the new key pinned by fewer than
     /// this many points' worth of constraint in its weakest direction, as
     /// a point-to-line fit onto the visit's scans at the matched pose sees
-    /// it ([`closure_pinned`]; 0: off). A corridor pins a scan only across
+    /// it ([`super::loop_closure::closure_pinned`]; 0: off). A corridor pins a scan only across
     /// itself, and a closure there can slide along it by metres.
     pub loop_min_weak: f64,
     /// A closure's edge is loose along its weakest direction: its variance
@@ -585,21 +585,23 @@ impl LogSlam {
             self.stats.closures_on_edge += 1;
             return;
         }
-        if self.config.loop_min_weak > 0.0
-            && closure_pinned(
+        // How the match pins the new key, when a setting asks (one fit).
+        let loosen = self.config.loop_loosen_ratio > 1.0 && !self.config.loop_covariance;
+        let fit = (loosen || self.config.loop_min_weak > 0.0).then(|| {
+            closure_fit(
                 &self.graph.nodes,
                 &self.key_points,
                 &found,
                 &self.config.loops,
-            ) < self.config.loop_min_weak
-        {
+            )
+        });
+        if fit.is_some_and(|f| f.weak < self.config.loop_min_weak) {
             self.stats.closures_degenerate += 1;
             return;
         }
         let mut found = found;
-        if self.config.loop_loosen_ratio > 1.0 && !self.config.loop_covariance {
+        if let Some(fit) = fit.filter(|_| loosen) {
             let loops = &self.config.loops;
-            let fit = closure_fit(&self.graph.nodes, &self.key_points, &found, loops);
             if let Some(info) = loosened_along_weak(
                 &self.graph.nodes,
                 &found,
