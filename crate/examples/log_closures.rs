@@ -10,11 +10,20 @@
 //! MIT CSAIL log, where a key scan without a GMapping pose takes the nearest
 //! scan's that has one, moved by our own estimate between the two (a few
 //! scans apart: locally accurate). `SLAMLAB_LOG_SLAM` as in `log_relations`.
+//!
+//! Then, for the corrected logs, the closures the search could have found:
+//! every key the driver tried to close whose place (by the reference) lies
+//! within [`REVISIT_M`] of an older key outside the local map is an
+//! *opportunity*. Each is counted as found or missed, and a missed one by
+//! why the search could not reach it at that moment: the old key's estimate
+//! beyond the candidate radius, or the correction the match had to make
+//! (where the reference puts the new key, given the old key's estimate)
+//! beyond the search window.
 
 use slamlab::geom::Pose2;
 use slamlab::slam::logslam::LogSlam;
 use slamlab::slam::posegraph::PoseGraph;
-use slamlab::slam::relations::{drift_odometry, DriftModel};
+use slamlab::slam::relations::{drift_odometry, relation_errors, DriftModel};
 
 #[path = "../../tests/real_support/mod.rs"]
 mod support;
@@ -76,6 +85,7 @@ fn report(name: &str, slam: &LogSlam, reference: &[Pose2]) {
         }
     }
     println!("  closures: {total}, wrong (> 0.2 m or > 2 deg): {wrong}");
+    optimum(slam, reference, &key_scan);
     calibration(slam, reference, &key_scan);
     let n = seq.len().max(1) as f64;
     let (mt, mr) = seq
@@ -94,6 +104,32 @@ fn report(name: &str, slam: &LogSlam, reference: &[Pose2]) {
             println!("    key edge scans {a:5} -> {b:5} error {t:6.3} m {r:6.2} deg{kind}");
         }
     }
+}
+
+/// Whether the graph's own optimum is the estimate: the final graph's edges
+/// optimised again from the reference's key poses, and the relation errors
+/// of the keys (all pairs) from there and from the estimate. Equal: the
+/// edges themselves put the keys where they are; the restart better: the
+/// replay's optimisation ended in another minimum.
+fn optimum(slam: &LogSlam, reference: &[Pose2], key_scan: &[usize]) {
+    let truth: Vec<Pose2> = key_scan.iter().map(|&s| reference[s]).collect();
+    let mut restart = slam.graph.clone();
+    restart.nodes = truth.clone();
+    let anchor = restart.nodes[0].between(&slam.graph.nodes[0]);
+    restart.nodes = restart.nodes.iter().map(|p| p.compose(&anchor)).collect();
+    let restart_result = restart.optimise(50);
+    let all = |est: &[Pose2]| {
+        let e = relation_errors(est, &truth, 1000, 1);
+        let a = e.last().expect("all");
+        (a.trans_m, a.rot_deg)
+    };
+    let (t0, r0) = all(&slam.graph.nodes);
+    let (t1, r1) = all(&restart.nodes);
+    println!(
+        "  keys' relation errors (all pairs): estimate {t0:.3} m {r0:.2} deg (chi2 {:.1}); optimised from the reference {t1:.3} m {r1:.2} deg (chi2 {:.1}, {restart_result:?})",
+        slam.graph.total_chi2(),
+        restart.total_chi2()
+    );
 }
 
 /// How well the edges' information matches their errors: the mean χ² of
@@ -141,6 +177,85 @@ fn calibration(slam: &LogSlam, reference: &[Pose2], key_scan: &[usize]) {
     }
 }
 
+/// A key within this distance of an older one (by the reference) revisits
+/// its place: their scans overlap well.
+const REVISIT_M: f64 = 1.0;
+
+/// Replays the log scan by scan and scores every closure try against the
+/// reference (see the module doc).
+fn opportunities(
+    log: &slamlab::carmen::CarmenLog,
+    odom: &[Pose2],
+    reference: &[Pose2],
+    cfg: &slamlab::slam::logslam::LogSlamConfig,
+) {
+    let loops = &cfg.loops;
+    let mut slam = LogSlam::new(cfg.clone());
+    let mut key_scan: Vec<usize> = Vec::new();
+    let (mut chances, mut found, mut beyond_radius, mut beyond_window, mut in_reach) =
+        (0, 0, 0, 0, 0);
+    let mut needed: Vec<(f64, f64)> = Vec::new();
+    for (k, scan) in log.scans.iter().enumerate() {
+        let mut s = scan.clone();
+        s.odometry = odom[k];
+        let (keys, tried, got) = (
+            slam.graph.nodes.len(),
+            slam.stats.closures_tried,
+            slam.stats.closures_found,
+        );
+        slam.add_scan(&s);
+        if slam.graph.nodes.len() == keys {
+            continue;
+        }
+        key_scan.push(k);
+        if slam.stats.closures_tried == tried {
+            continue;
+        }
+        let id = keys;
+        let here = reference[k].position();
+        let Some(j) = (0..=id.saturating_sub(loops.min_key_gap))
+            .filter(|_| id >= loops.min_key_gap)
+            .min_by(|&a, &b| {
+                let da = reference[key_scan[a]].position().distance(here);
+                let db = reference[key_scan[b]].position().distance(here);
+                da.total_cmp(&db)
+            })
+            .filter(|&j| reference[key_scan[j]].position().distance(here) <= REVISIT_M)
+        else {
+            continue;
+        };
+        chances += 1;
+        let nodes = &slam.graph.nodes;
+        let should = nodes[j].compose(&reference[key_scan[j]].between(&reference[k]));
+        let d = nodes[id].between(&should);
+        needed.push((d.position().length(), d.theta.to_degrees().abs()));
+        if slam.stats.closures_found > got {
+            found += 1;
+        } else if nodes[j].position().distance(nodes[id].position()) > loops.search_radius_m {
+            beyond_radius += 1;
+        } else if d.x.abs() > loops.window.linear_m
+            || d.y.abs() > loops.window.linear_m
+            || d.theta.abs() > loops.window.angular_rad
+        {
+            beyond_window += 1;
+        } else {
+            in_reach += 1;
+        }
+    }
+    needed.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let q = |f: f64| {
+        needed
+            .get(((needed.len() as f64 - 1.0) * f) as usize)
+            .map_or(0.0, |x| x.0)
+    };
+    println!(
+        "  opportunities (a try within {REVISIT_M} m of an older key): {chances}; found {found}; missed: old key beyond the radius {beyond_radius}, correction beyond the window {beyond_window}, within reach {in_reach}; correction needed median {:.2} m, 90 % {:.2} m, max {:.2} m",
+        q(0.5),
+        q(0.9),
+        q(1.0)
+    );
+}
+
 fn main() {
     let cfg = support::config_from_env();
     for name in support::logs_from_args() {
@@ -158,6 +273,7 @@ fn main() {
             let odom = drift_odometry(&reference, &DriftModel::default(), support::drift_seed());
             let (_, slam, _) = support::replay(&log, Some(&odom), &cfg);
             report(name, &slam, &reference);
+            opportunities(&log, &odom, &reference, &cfg);
         }
     }
 }

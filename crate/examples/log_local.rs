@@ -21,8 +21,11 @@
 //! reference relations to both neighbours lay the scans worse than ours, by
 //! `GLITCH_MM`) and the relation errors without them; the same comparison
 //! on revisits (pairs far apart in the log, near in space), which tests the
-//! far relations where the scans can; and the far relations' translational
-//! error split along and across the reference's path.
+//! far relations where the scans can; the far relations' translational
+//! error split along and across the reference's path; and the floor the
+//! reference's own noise puts under the relation errors (what the truth
+//! itself would score against a reference that far off it, see
+//! `reference_floor`).
 //!
 //! All beams within the matching range take part (no thinning), in the
 //! robot frame through the laser's offset. `SLAMLAB_DRIFT_SEED` changes the
@@ -33,6 +36,7 @@
 use glam::DVec2;
 use slamlab::carmen::{CarmenLog, LogScan};
 use slamlab::geom::{wrap_angle, Pose2};
+use slamlab::rng::Rng;
 use slamlab::slam::degeneracy::scan_normals;
 use slamlab::slam::icp::IcpTarget;
 use slamlab::slam::logslam::{scan_points, LogSlamConfig};
@@ -194,6 +198,8 @@ fn report(name: &str, log_all: &CarmenLog, reference: &[Pose2], cfg: &LogSlamCon
     let mut skipped = 0;
     let mut bad_pairs = Vec::new();
     let mut ours_bad = 0;
+    // The reference's consecutive relations' offsets from pairwise ICP.
+    let mut off_icp: Vec<[f64; 3]> = Vec::new();
     for i in 0..log.len() - 1 {
         let target = Target::new(scan_points(&log[i], &dense));
         let points = scan_points(&log[i + 1], &dense);
@@ -219,6 +225,8 @@ fn report(name: &str, log_all: &CarmenLog, reference: &[Pose2], cfg: &LogSlamCon
             skipped += 1;
             continue;
         }
+        let d = r.between(&target.icp(&points, &r).0);
+        off_icp.push([d.x, d.y, wrap_angle(d.theta)]);
         if let Some(f) = f {
             compare(&target, &points, &[r, o, f], &mut keyed);
         }
@@ -242,6 +250,7 @@ fn report(name: &str, log_all: &CarmenLog, reference: &[Pose2], cfg: &LogSlamCon
     );
     revisits(log, reference, &est, &dense);
     far_split(&est, reference);
+    reference_floor(reference, &off_icp);
     for (title, means) in [("all pairs", &all), ("pairs of keys", &keyed)] {
         println!(
             "  {title} ({}): misfit mm | ICP moves it m / deg | off ICP(ref) m / deg | ICP end vs ICP(ref) m / deg | misfit after ICP mm",
@@ -251,6 +260,50 @@ fn report(name: &str, log_all: &CarmenLog, reference: &[Pose2], cfg: &LogSlamCon
             m.print_row(names[k]);
         }
     }
+}
+
+/// What the reference's own noise costs a perfect estimate. If each
+/// reference pose is the truth moved by independent noise of deviation σ
+/// (per axis, robot frame), a consecutive relation is off by σ√2, and
+/// the pairwise ICP (far more precise on a well-constrained pair) shows it:
+/// σ is estimated robustly, as 1.4826 · median |offset| / √2 per axis, so
+/// the glitches do not count (a lower bound). The truth would then score
+/// what the reference moved by such noise scores against the reference
+/// itself, averaged over five noise seeds.
+fn reference_floor(reference: &[Pose2], off_icp: &[[f64; 3]]) {
+    let sigma: Vec<f64> = (0..3)
+        .map(|a| {
+            let mut v: Vec<f64> = off_icp.iter().map(|d| d[a].abs()).collect();
+            v.sort_by(f64::total_cmp);
+            1.4826 * v.get(v.len() / 2).copied().unwrap_or(0.0) / 2f64.sqrt()
+        })
+        .collect();
+    let (mut t, mut r) = (0.0, 0.0);
+    for seed in 1..=5u64 {
+        let mut rng = Rng::new(seed);
+        let noisy: Vec<Pose2> = reference
+            .iter()
+            .map(|p| {
+                let n = Pose2::new(
+                    rng.normal(sigma[0]),
+                    rng.normal(sigma[1]),
+                    rng.normal(sigma[2]),
+                );
+                p.compose(&n)
+            })
+            .collect();
+        let e = relation_errors(&noisy, reference, support::RANDOM_PAIRS, 1);
+        let all = e.last().expect("all pairs");
+        t += all.trans_m / 5.0;
+        r += all.rot_deg / 5.0;
+    }
+    println!(
+        "  the reference's own noise, from its consecutive relations against pairwise ICP (robust, {} pairs): sigma x {:.4} m, y {:.4} m, heading {:.3} deg; the truth seen through such noise scores (all pairs) {t:.3} m / {r:.2} deg",
+        off_icp.len(),
+        sigma[0],
+        sigma[1],
+        sigma[2].to_degrees()
+    );
 }
 
 /// A consecutive relation is the reference's fault when ours lays the scans

@@ -52,7 +52,7 @@
 //!    from 0.43 to 0.22 m, BENCHMARKS.md). With `loop_min_weak` > 0 a
 //!    closure is also refused when the new key's points, laid at the match
 //!    onto the visit's scans, pin it in their weakest direction by fewer
-//!    than that many points' worth ([`super::loop_closure::closure_pinned`]):
+//!    than that many points' worth ([`super::loop_closure::closure_fit`]):
 //!    a corridor whose ends are out of sight pins nothing along it. Off by
 //!    default: it removes the corridor slides that make some settings'
 //!    figures jump, but costs the corridor-rich logs right closures too
@@ -183,7 +183,7 @@ pub struct LogSlamConfig {
     /// Refuse a closure whose match leaves the new key pinned by fewer than
     /// this many points' worth of constraint in its weakest direction, as
     /// a point-to-line fit onto the visit's scans at the matched pose sees
-    /// it ([`super::loop_closure::closure_pinned`]; 0: off). A corridor pins a scan only across
+    /// it ([`super::loop_closure::closure_fit`]; 0: off). A corridor pins a scan only across
     /// itself, and a closure there can slide along it by metres.
     pub loop_min_weak: f64,
     /// A closure's edge is loose along its weakest direction: its variance

@@ -211,30 +211,19 @@ pub(super) fn match_visit(
 }
 
 /// Neighbourhood of a thinned key scan's point for its normal, and the
-/// association radius and Huber threshold of [`closure_pinned`]'s fit (m):
+/// association radius and Huber threshold of [`closure_fit`] (m):
 /// those of the closing refinement ([`super::log_refine`]).
 const PIN_NORMAL_RADIUS_M: f64 = 0.35;
 const PIN_RADIUS_M: f64 = 0.2;
 const PIN_HUBER_M: f64 = 0.02;
 
-/// How well closure `c` pins its new key in the weakest direction: the
-/// smaller eigenvalue of the translational information `Σ w n nᵀ` of the
-/// new key's points laid at the matched pose onto the visit's scans (each
-/// point measured along the normal of the nearest visit point within
-/// 0.2 m; [`super::icp`]), in points' worth. A room or a corner gives tens;
-/// a corridor whose end walls and doors are out of sight gives nearly
-/// nothing along it, and a match there may sit anywhere along it.
-pub fn closure_pinned(
-    nodes: &[Pose2],
-    key_points: &[Vec<DVec2>],
-    c: &Closure,
-    cfg: &LoopConfig,
-) -> f64 {
-    closure_fit(nodes, key_points, c, cfg).weak
-}
-
-/// The point-to-line information of closure `c`'s match ([`closure_pinned`]),
-/// with its strong and weak directions.
+/// How well closure `c`'s match pins its new key: the point-to-line
+/// information `Σ w n nᵀ` of the new key's points laid at the matched pose
+/// onto the visit's scans (each point measured along the normal of the
+/// nearest visit point within 0.2 m; [`super::icp`]), with its strong and
+/// weak directions. `weak` is in points' worth: a room or a corner gives
+/// tens; a corridor whose end walls and doors are out of sight gives
+/// nearly nothing along it, and a match there may sit anywhere along it.
 pub fn closure_fit(
     nodes: &[Pose2],
     key_points: &[Vec<DVec2>],
@@ -334,10 +323,10 @@ mod tests {
     #[test]
     fn a_closure_in_a_corridor_is_not_pinned_along_it() {
         let (nodes, points, c, cfg) = closure_along(&scenes::room(), DVec2::new(2.0, 2.5), 20.0);
-        let room = closure_pinned(&nodes, &points, &c, &cfg);
+        let room = closure_fit(&nodes, &points, &c, &cfg).weak;
         let (nodes, points, c, cfg) =
             closure_along(&scenes::corridor(), DVec2::new(-2.0, 1.0), 8.0);
-        let corridor = closure_pinned(&nodes, &points, &c, &cfg);
+        let corridor = closure_fit(&nodes, &points, &c, &cfg).weak;
         assert!(room > 20.0, "room: {room}");
         assert!(corridor < 1.0, "corridor: {corridor}");
     }
