@@ -25,7 +25,9 @@
 //! error split along and across the reference's path; and the floor the
 //! reference's own noise puts under the relation errors (what the truth
 //! itself would score against a reference that far off it, see
-//! `reference_floor`).
+//! `reference_floor`); and, needing no reference, how many cells the
+//! scans' returns fall in at the reference's poses, ours and odometry's
+//! (`support::cells_hit`).
 //!
 //! All beams within the matching range take part (no thinning), in the
 //! robot frame through the laser's offset. `SLAMLAB_DRIFT_SEED` changes the
@@ -251,6 +253,13 @@ fn report(name: &str, log_all: &CarmenLog, reference: &[Pose2], cfg: &LogSlamCon
     revisits(log, reference, &est, &dense);
     far_split(&est, reference);
     reference_floor(reference, &off_icp);
+    println!(
+        "  cells hit at {} m (fewer: the scans agree better): reference {}, ours {}, odometry {}",
+        support::CRISP_CELL_M,
+        support::cells_hit(log, reference),
+        support::cells_hit(log, &est),
+        support::cells_hit(log, &odom)
+    );
     for (title, means) in [("all pairs", &all), ("pairs of keys", &keyed)] {
         println!(
             "  {title} ({}): misfit mm | ICP moves it m / deg | off ICP(ref) m / deg | ICP end vs ICP(ref) m / deg | misfit after ICP mm",
@@ -279,6 +288,7 @@ fn reference_floor(reference: &[Pose2], off_icp: &[[f64; 3]]) {
         })
         .collect();
     let (mut t, mut r) = (0.0, 0.0);
+    let mut per_k: Vec<RelationErrors> = Vec::new();
     for seed in 1..=5u64 {
         let mut rng = Rng::new(seed);
         let noisy: Vec<Pose2> = reference
@@ -296,6 +306,20 @@ fn reference_floor(reference: &[Pose2], off_icp: &[[f64; 3]]) {
         let all = e.last().expect("all pairs");
         t += all.trans_m / 5.0;
         r += all.rot_deg / 5.0;
+        if per_k.is_empty() {
+            per_k = e
+                .iter()
+                .map(|x| RelationErrors {
+                    trans_m: 0.0,
+                    rot_deg: 0.0,
+                    ..x.clone()
+                })
+                .collect();
+        }
+        for (p, x) in per_k.iter_mut().zip(&e) {
+            p.trans_m += x.trans_m / 5.0;
+            p.rot_deg += x.rot_deg / 5.0;
+        }
     }
     println!(
         "  the reference's own noise, from its consecutive relations against pairwise ICP (robust, {} pairs): sigma x {:.4} m, y {:.4} m, heading {:.3} deg; the truth seen through such noise scores (all pairs) {t:.3} m / {r:.2} deg",
@@ -304,6 +328,7 @@ fn reference_floor(reference: &[Pose2], off_icp: &[[f64; 3]]) {
         sigma[1],
         sigma[2].to_degrees()
     );
+    print_errors("the floor by pairs", &per_k);
 }
 
 /// A consecutive relation is the reference's fault when ours lays the scans

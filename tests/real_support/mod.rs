@@ -3,7 +3,8 @@
 //! replaying a log through the log SLAM, scoring it by relation errors.
 #![allow(dead_code)]
 
-use slamlab::carmen::{parse_bytes, CarmenLog};
+use glam::DVec2;
+use slamlab::carmen::{parse_bytes, CarmenLog, LogScan};
 use slamlab::geom::Pose2;
 use slamlab::slam::logslam::{LogSlam, LogSlamConfig};
 use slamlab::slam::relations::{drift_odometry, relation_errors, DriftModel, RelationErrors};
@@ -31,6 +32,33 @@ pub fn load(name: &str) -> CarmenLog {
     parse_bytes(&bytes).unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
+/// The cell size of [`cells_hit`] (m).
+pub const CRISP_CELL_M: f64 = 0.05;
+/// Returns farther than this take no part in [`cells_hit`] (m): the
+/// matching range of the log SLAM's defaults.
+pub const CRISP_RANGE_M: f64 = 20.0;
+
+/// A measure of a trajectory that needs no reference: the number of
+/// distinct `CRISP_CELL_M` cells the scans' returns fall in, every scan at
+/// its pose. The same walls seen from poses that agree land in the same
+/// cells; a wrong pose draws a wall beside itself, in new cells. It is
+/// blind to an error every scan of a place shares (a place seen once).
+pub fn cells_hit(scans: &[LogScan], poses: &[Pose2]) -> usize {
+    let mut cells = std::collections::HashSet::new();
+    for (scan, pose) in scans.iter().zip(poses) {
+        let laser = pose.compose(&scan.laser_offset);
+        for (i, &r) in scan.ranges.iter().enumerate() {
+            if scan.no_return(i) || r > CRISP_RANGE_M {
+                continue;
+            }
+            let p = laser.position() + DVec2::from_angle(laser.theta + scan.bearing(i)) * r;
+            let c = (p / CRISP_CELL_M).floor();
+            cells.insert((c.x as i64, c.y as i64));
+        }
+    }
+    cells.len()
+}
+
 /// One evaluated replay.
 pub struct Outcome {
     pub ours: Vec<RelationErrors>,
@@ -39,6 +67,8 @@ pub struct Outcome {
     pub scans: usize,
     pub closures: usize,
     pub slam: LogSlam,
+    /// [`cells_hit`] at our poses and at the reference's (corrected logs).
+    pub cells_hit: Option<(usize, usize)>,
 }
 
 /// Replays `log` (its odometry replaced by `odometry` when given) and
@@ -100,6 +130,10 @@ pub fn corrected_with(name: &str, cfg: &LogSlamConfig) -> Outcome {
         scans: log.scans.len(),
         closures: slam.closures.len(),
         slam,
+        cells_hit: Some((
+            cells_hit(&log.scans, &est),
+            cells_hit(&log.scans, &reference),
+        )),
     }
 }
 
@@ -160,6 +194,7 @@ pub fn csail_raw_with(cfg: &LogSlamConfig) -> (Outcome, f64) {
             scans: log.scans.len(),
             closures: slam.closures.len(),
             slam,
+            cells_hit: None,
         },
         recorded,
     )
