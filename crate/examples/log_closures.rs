@@ -80,12 +80,15 @@ fn report(name: &str, slam: &LogSlam, reference: &[Pose2]) {
                 r,
                 if bad { "  WRONG" } else { "" }
             );
-        } else {
+        } else if e.information[0][0] > 0.0 {
+            // (Heading-only edges are the square walls' priors, not the
+            // front end's.)
             seq.push((t, r, a, b, e.information[0][0]));
         }
     }
     println!("  closures: {total}, wrong (> 0.2 m or > 2 deg): {wrong}");
     optimum(slam, reference, &key_scan);
+    square_spread(slam, reference, &key_scan);
     calibration(slam, reference, &key_scan);
     let n = seq.len().max(1) as f64;
     let (mt, mr) = seq
@@ -103,6 +106,50 @@ fn report(name: &str, slam: &LogSlam, reference: &[Pose2]) {
             let kind = if *info < 50.0 { " (odometry)" } else { "" };
             println!("    key edge scans {a:5} -> {b:5} error {t:6.3} m {r:6.2} deg{kind}");
         }
+    }
+}
+
+/// How far each square key's wall direction ([`slamlab::slam::manhattan`])
+/// lies from the building's, at the reference's headings and at ours: the
+/// noise of the square walls' prior, and how much wander it sees.
+fn square_spread(slam: &LogSlam, reference: &[Pose2], key_scan: &[usize]) {
+    use slamlab::slam::manhattan::{building_direction, scan_direction};
+    let m = slam.config.manhattan.clone().unwrap_or_default();
+    let fold = |a: f64| {
+        let q = std::f64::consts::FRAC_PI_2;
+        (a + q / 2.0).rem_euclid(q) - q / 2.0
+    };
+    let dirs: Vec<(usize, f64)> = (0..slam.graph.nodes.len())
+        .filter_map(|i| scan_direction(slam.key_points(i), &m).map(|(d, _)| (i, d)))
+        .collect();
+    let headings = [
+        (
+            "reference",
+            key_scan
+                .iter()
+                .map(|&s| reference[s].theta)
+                .collect::<Vec<f64>>(),
+        ),
+        ("ours", slam.graph.nodes.iter().map(|p| p.theta).collect()),
+    ];
+    for (label, heading) in headings {
+        let world: Vec<f64> = dirs.iter().map(|&(i, d)| fold(heading[i] + d)).collect();
+        let Some(b) = building_direction(&world, m.gate_rad) else {
+            continue;
+        };
+        let mut off: Vec<f64> = world
+            .iter()
+            .map(|&a| fold(a - b).abs().to_degrees())
+            .filter(|&a| a <= m.gate_rad.to_degrees())
+            .collect();
+        off.sort_by(f64::total_cmp);
+        let rms = (off.iter().map(|a| a * a).sum::<f64>() / off.len().max(1) as f64).sqrt();
+        println!(
+            "  square keys at the {label}'s headings: {} of {} within the gate, offset median {:.2} deg, rms {rms:.2} deg",
+            off.len(),
+            dirs.len(),
+            off.get(off.len() / 2).copied().unwrap_or(0.0)
+        );
     }
 }
 

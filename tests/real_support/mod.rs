@@ -7,6 +7,7 @@ use glam::DVec2;
 use slamlab::carmen::{parse_bytes, CarmenLog, LogScan};
 use slamlab::geom::Pose2;
 use slamlab::slam::logslam::{LogSlam, LogSlamConfig};
+use slamlab::slam::manhattan::ManhattanConfig;
 use slamlab::slam::relations::{drift_odometry, relation_errors, DriftModel, RelationErrors};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -220,6 +221,11 @@ pub fn table(name: &str, o: &Outcome) -> String {
     s
 }
 
+/// The square walls' settings of `cfg`, switched on with the defaults if off.
+fn manhattan(cfg: &mut LogSlamConfig) -> &mut ManhattanConfig {
+    cfg.manhattan.get_or_insert_with(ManhattanConfig::default)
+}
+
 /// The defaults with the overrides of `$SLAMLAB_LOG_SLAM`.
 pub fn config_from_env() -> LogSlamConfig {
     let mut cfg = LogSlamConfig::default();
@@ -275,6 +281,11 @@ pub fn config_from_env() -> LogSlamConfig {
             "key_distance_m" => cfg.key_distance_m = v,
             "key_angle_deg" => cfg.key_angle_rad = v.to_radians(),
             "point_spacing_m" => cfg.point_spacing_m = v,
+            "manhattan" => cfg.manhattan = (v != 0.0).then(ManhattanConfig::default),
+            "manhattan_sigma_deg" => manhattan(&mut cfg).sigma_rad = v.to_radians(),
+            "manhattan_gate_deg" => manhattan(&mut cfg).gate_rad = v.to_radians(),
+            "manhattan_window_deg" => manhattan(&mut cfg).window_rad = v.to_radians(),
+            "manhattan_min_share" => manhattan(&mut cfg).min_share = v,
             _ => panic!("SLAMLAB_LOG_SLAM: unknown setting {key}"),
         }
     }

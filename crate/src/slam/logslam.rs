@@ -101,6 +101,7 @@ use super::loop_closure::{
     closure_fit, closures_agree, find_closure_among, loosened_along_weak, on_window_edge, Closure,
     LoopConfig,
 };
+use super::manhattan::{add_priors, scan_direction, ManhattanConfig};
 use super::match_covariance::{edge_information, response_covariance, ResponseWindow};
 use super::multires::{field_from_points, match_scan, ScanMatch, Window};
 use super::posegraph::{Edge, PoseGraph};
@@ -194,6 +195,10 @@ pub struct LogSlamConfig {
     pub loop_loosen_ratio: f64,
     /// The closing refinement after the replay ([`super::log_refine`]).
     pub refine: RefineConfig,
+    /// Square walls' heading prior after the replay ([`super::manhattan`];
+    /// `None`: off). On: a building whose walls are not square gets no
+    /// prior.
+    pub manhattan: Option<ManhattanConfig>,
 }
 
 impl Default for LogSlamConfig {
@@ -243,6 +248,7 @@ impl Default for LogSlamConfig {
             loop_min_weak: 0.0,
             loop_loosen_ratio: 10.0,
             refine: RefineConfig::default(),
+            manhattan: Some(ManhattanConfig::default()),
         }
     }
 }
@@ -290,6 +296,8 @@ pub struct LogSlamStats {
     pub closures_degenerate: usize,
     /// Links the closing refinement added ([`super::log_refine`]).
     pub refine_links: usize,
+    /// Keys given a square walls' heading prior ([`super::manhattan`]).
+    pub square_keys: usize,
 }
 
 /// The SLAM state of one log replay.
@@ -673,18 +681,28 @@ impl LogSlam {
     /// Final optimisation (the graph is already optimised after each
     /// accepted closure; this settles it).
     pub fn finish(&mut self) -> Result<(), String> {
-        if self.closures.is_empty() {
-            return Ok(());
+        if !self.closures.is_empty() {
+            self.graph.optimise_robust(20, self.dcs())?;
+            let cfg = &self.config;
+            self.stats.refine_links = refine(
+                &mut self.graph,
+                &self.key_points,
+                cfg.resolution_m,
+                &cfg.loops,
+                &cfg.refine,
+            )?;
         }
-        self.graph.optimise_robust(20, self.dcs())?;
-        let cfg = &self.config;
-        self.stats.refine_links = refine(
-            &mut self.graph,
-            &self.key_points,
-            cfg.resolution_m,
-            &cfg.loops,
-            &cfg.refine,
-        )?;
+        if let Some(m) = &self.config.manhattan {
+            let directions: Vec<Option<f64>> = self
+                .key_points
+                .iter()
+                .map(|p| scan_direction(p, m).map(|(d, _)| d))
+                .collect();
+            self.stats.square_keys = add_priors(&mut self.graph, &directions, m);
+            if self.stats.square_keys > 0 {
+                self.graph.optimise_robust(20, self.dcs())?;
+            }
+        }
         Ok(())
     }
 
@@ -697,6 +715,11 @@ impl LogSlam {
     pub fn scan_pose(&self, k: usize) -> Pose2 {
         let s = &self.scans[k];
         self.graph.nodes[s.key].compose(&s.relative)
+    }
+
+    /// Key `i`'s scan points (robot frame, thinned as matched).
+    pub fn key_points(&self, i: usize) -> &[DVec2] {
+        &self.key_points[i]
     }
 
     /// Every scan's current estimate, in the order added.

@@ -25,6 +25,7 @@
 //! | loop closure by correlative matching | [`loop_closure`] | Konolige et al. 2010; Hess et al. 2016 |
 //! | SLAM for real laser logs | [`logslam`] | Karto / slam_toolbox, Cartographer |
 //! | its closing refinement, every revisit linked | [`log_refine`] | Konolige et al. 2010; Agarwal et al. 2013 |
+//! | its square walls' heading prior | [`manhattan`] | Nguyen et al., IROS 2006 (Orthogonal SLAM) |
 //! | the simulated robots' loop-closing back end | [`robot_graph`] | Konolige et al. 2010; Hess et al. 2016 |
 //! | its key edges' compounded covariance | [`key_chain`] | Smith, Self, Cheeseman 1990; Konolige et al. 2010 |
 //! | relation errors against a reference | [`relations`] | Kümmerle et al., Auton. Robots 2009 |
@@ -47,6 +48,7 @@ pub mod log_refine;
 pub mod log_replay;
 pub mod logslam;
 pub mod loop_closure;
+pub mod manhattan;
 pub mod mapper;
 pub mod match_covariance;
 pub mod multires;

@@ -1,0 +1,295 @@
+//! # Square walls: a heading prior for rectilinear buildings
+//!
+//! A pose graph knows only relative poses. Between loop closures its keys
+//! hang on a chain of scan matches, and the chain's heading wanders: each
+//! match is good to a tenth of a degree, but a local map of a few metres
+//! is drawn with the very heading it is meant to hold, so a few tenths of
+//! a degree come and go over tens of metres (on the real logs, about 0.45°
+//! by twenty scans; BENCHMARKS.md, issue 21). Across a building that is
+//! decimetres.
+//!
+//! Most buildings are built square: their walls run in two directions at
+//! right angles. Nguyen, Harati, Martinelli, Siegwart and Tomatis
+//! ("Orthogonal SLAM: a step toward lightweight indoor autonomous
+//! navigation", IROS 2006) use that to take the heading out of the
+//! estimation altogether. Here it is a soft prior, and only where the scans
+//! say it holds:
+//!
+//! 1. **A scan's own direction.** Each key scan's surface normals
+//!    ([`super::degeneracy::scan_normals_within`]) are folded modulo 90°,
+//!    so a wall and its perpendicular vote alike, and the strongest fold
+//!    (a histogram of half-degree bins, each vote spread over ±`window`) is
+//!    refined by the mean of the votes within `window` of it, on the circle
+//!    of four times the angle. The key is *square* if at least `min_share`
+//!    of its normals, and `min_normals` of them, lie within `window` of
+//!    that direction.
+//! 2. **The building's direction.** Every square key's direction in the
+//!    world (its heading plus its scan's direction) is a vote for the
+//!    building's, found as a scan's is from its normals, with `gate` for
+//!    the window. It is measured, never assumed to be the map's x axis, and
+//!    a wing built at an angle does not pull it.
+//! 3. **The prior.** A square key whose world direction lies within `gate`
+//!    of the building's gets a heading-only edge from the anchored first
+//!    node, asking its heading to move by the difference, with deviation
+//!    `sigma_rad`. A key outside the gate (a wing built at an angle, a
+//!    room full of furniture) gets nothing: the prior corrects a wander of
+//!    tenths of a degree, never a heading the matches have put elsewhere.
+//!
+//! Then the graph is optimised again. In a building that is not square no
+//! key passes step 1 or the gate of step 3, and nothing changes.
+//!
+//! ## What the numbers say
+//! The wall directions of square keys scatter by 0.4–0.5° rms about the
+//! building's on the corrected logs, at the reference's headings and at
+//! ours alike (`log_closures`): a single key's direction is no better than
+//! its heading, so the prior is loose (σ 2°) and works by numbers — a
+//! chain's wander is pulled in by hundreds of keys at once. Against σ 0.5°
+//! (worse on ACES and CSAIL corrected) and 1°, σ 2° lowers the relation
+//! errors of the raw MIT CSAIL log 0.213 → 0.193 m, ACES 0.161 → 0.155,
+//! CSAIL corrected 0.240 → 0.234, and over three more drift seeds ACES by
+//! 0.007–0.031 m and CSAIL corrected by up to 0.046 m; Intel and Freiburg
+//! 079 move by a millimetre or two (BENCHMARKS.md, issue 21, session 30).
+
+use super::degeneracy::scan_normals_within;
+use super::posegraph::{Edge, PoseGraph};
+use crate::geom::{wrap_angle, Pose2};
+use glam::DVec2;
+use std::f64::consts::FRAC_PI_2;
+
+/// Settings of the square-walls prior.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ManhattanConfig {
+    /// Neighbourhood of a point for its normal (m).
+    pub normal_radius_m: f64,
+    /// Half-width of a direction's bundle of normals (rad).
+    pub window_rad: f64,
+    /// Share of a scan's normals its direction must gather.
+    pub min_share: f64,
+    /// Normals its direction must gather.
+    pub min_normals: usize,
+    /// Largest difference from the building's direction that is corrected (rad).
+    pub gate_rad: f64,
+    /// Standard deviation of the heading prior (rad): loose, as a single
+    /// key's wall direction is good to about half a degree.
+    pub sigma_rad: f64,
+}
+
+impl Default for ManhattanConfig {
+    fn default() -> Self {
+        ManhattanConfig {
+            normal_radius_m: 0.35,
+            window_rad: 2f64.to_radians(),
+            min_share: 0.5,
+            min_normals: 20,
+            gate_rad: 2f64.to_radians(),
+            sigma_rad: 2f64.to_radians(),
+        }
+    }
+}
+
+/// `a` folded into [−45°, 45°).
+fn fold(a: f64) -> f64 {
+    (a + FRAC_PI_2 / 2.0).rem_euclid(FRAC_PI_2) - FRAC_PI_2 / 2.0
+}
+
+/// The mean of `angles` modulo 90°, weighted (on the circle of 4θ).
+fn folded_mean(angles: impl Iterator<Item = (f64, f64)>) -> Option<f64> {
+    let s: DVec2 = angles
+        .map(|(a, w)| w * DVec2::from_angle(4.0 * a))
+        .sum::<DVec2>();
+    (s.length() > 1e-12).then(|| fold(s.y.atan2(s.x) / 4.0))
+}
+
+/// The strongest direction modulo 90° of `angles` (folded): the
+/// half-degree bin with most votes within `window_rad`, refined by the
+/// mean of the votes within twice `window_rad` of it, then within
+/// `window_rad` of that. Returns it and how many
+/// votes lie within `window_rad` of it.
+fn peak(angles: &[f64], window_rad: f64) -> Option<(f64, usize)> {
+    let bins = 180;
+    let bin = FRAC_PI_2 / bins as f64;
+    let reach = (window_rad / bin).round() as i64;
+    let mut hist = vec![0u32; bins];
+    for &a in angles {
+        let b = ((a + FRAC_PI_2 / 2.0) / bin).floor() as i64;
+        for d in -reach..=reach {
+            hist[(b + d).rem_euclid(bins as i64) as usize] += 1;
+        }
+    }
+    let top = (0..bins).max_by_key(|&b| (hist[b], std::cmp::Reverse(b)))?;
+    let centre = -FRAC_PI_2 / 2.0 + (top as f64 + 0.5) * bin;
+    let near = |c: f64, w: f64| {
+        angles
+            .iter()
+            .copied()
+            .filter(move |&a| fold(a - c).abs() <= w)
+    };
+    // The top bin may lie anywhere on a plateau as wide as the window: the
+    // first mean reaches twice as far.
+    let rough = folded_mean(near(centre, 2.0 * window_rad).map(|a| (a, 1.0)))?;
+    let direction = folded_mean(near(rough, window_rad).map(|a| (a, 1.0)))?;
+    Some((direction, near(direction, window_rad).count()))
+}
+
+/// A scan's direction modulo 90° in its own frame and the share of its
+/// normals within `cfg.window_rad` of it (step 1 of the module doc), or
+/// `None` if it is not square.
+pub fn scan_direction(points: &[DVec2], cfg: &ManhattanConfig) -> Option<(f64, f64)> {
+    let angles: Vec<f64> = scan_normals_within(points, cfg.normal_radius_m)
+        .into_iter()
+        .flatten()
+        .map(|n| fold(n.y.atan2(n.x)))
+        .collect();
+    if angles.len() < cfg.min_normals {
+        return None;
+    }
+    let (direction, count) = peak(&angles, cfg.window_rad)?;
+    let share = count as f64 / angles.len() as f64;
+    (count >= cfg.min_normals && share >= cfg.min_share).then_some((direction, share))
+}
+
+/// The building's direction modulo 90° from the square keys' world
+/// directions (step 2): the strongest bundle within `gate_rad`, or `None`
+/// without any.
+pub fn building_direction(world: &[f64], gate_rad: f64) -> Option<f64> {
+    peak(world, gate_rad).map(|(d, _)| d)
+}
+
+/// Adds the heading priors of step 3 to `graph` for the keys whose scan
+/// directions are `directions[i]` (`None`: not square) and returns how
+/// many were added. Node 0 is the anchor: it votes for the building's
+/// direction but gets no prior.
+pub fn add_priors(
+    graph: &mut PoseGraph,
+    directions: &[Option<f64>],
+    cfg: &ManhattanConfig,
+) -> usize {
+    let n = graph.nodes.len().min(directions.len());
+    let world: Vec<(usize, f64)> = (0..n)
+        .filter_map(|i| directions[i].map(|d| (i, fold(graph.nodes[i].theta + d))))
+        .collect();
+    let angles: Vec<f64> = world.iter().map(|&(_, a)| a).collect();
+    let Some(building) = building_direction(&angles, cfg.gate_rad) else {
+        return 0;
+    };
+    let anchor = graph.nodes[0];
+    let mut added = 0;
+    for &(i, a) in &world {
+        let off = fold(a - building);
+        if i == 0 || off.abs() > cfg.gate_rad {
+            continue;
+        }
+        let wanted = graph.nodes[i].theta - off;
+        let measurement = Pose2::new(0.0, 0.0, wrap_angle(wanted - anchor.theta));
+        let w = 1.0 / (cfg.sigma_rad * cfg.sigma_rad);
+        graph.edges.push(Edge {
+            from: 0,
+            to: i,
+            measurement,
+            information: [[0.0; 3], [0.0; 3], [0.0, 0.0, w]],
+            loop_closure: false,
+        });
+        added += 1;
+    }
+    added
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Points along the sides of a rectangle turned by `turn`, one per
+    /// 0.1 m, seen from its centre.
+    fn room(turn: f64) -> Vec<DVec2> {
+        let (w, h) = (6.0, 4.0);
+        let mut pts = Vec::new();
+        let mut side = |a: DVec2, b: DVec2| {
+            let n = ((b - a).length() / 0.1) as usize;
+            for k in 0..n {
+                pts.push(a + (b - a) * (k as f64 / n as f64));
+            }
+        };
+        let c = [
+            DVec2::new(-w / 2.0, -h / 2.0),
+            DVec2::new(w / 2.0, -h / 2.0),
+            DVec2::new(w / 2.0, h / 2.0),
+            DVec2::new(-w / 2.0, h / 2.0),
+        ];
+        for k in 0..4 {
+            side(c[k], c[(k + 1) % 4]);
+        }
+        let r = DVec2::from_angle(turn);
+        pts.into_iter().map(|p| r.rotate(p)).collect()
+    }
+
+    #[test]
+    fn fold_maps_into_a_quarter_turn() {
+        assert!((fold(100f64.to_radians()) - 10f64.to_radians()).abs() < 1e-12);
+        assert!((fold(-50f64.to_radians()) - 40f64.to_radians()).abs() < 1e-12);
+        assert!((fold(44f64.to_radians()) - 44f64.to_radians()).abs() < 1e-12);
+    }
+
+    /// A rectangular room turned by 7.3° is square at 7.3°; a room of walls
+    /// in three directions 30° apart is not.
+    #[test]
+    fn a_square_room_gives_its_turn_and_a_skewed_one_nothing() {
+        let cfg = ManhattanConfig::default();
+        let (d, share) = scan_direction(&room(7.3f64.to_radians()), &cfg).expect("square");
+        assert!(
+            (d.to_degrees() - 7.3).abs() < 0.05,
+            "direction {}",
+            d.to_degrees()
+        );
+        assert!(share > 0.9, "share {share}");
+        // A triangle-ish fan: walls at 0°, 30° and 60°.
+        let mut skew = Vec::new();
+        for (k, a) in [0.0f64, 30.0, 60.0].iter().enumerate() {
+            let dir = DVec2::from_angle(a.to_radians());
+            let base = DVec2::new(0.0, 2.0 + 3.0 * k as f64);
+            for s in 0..40 {
+                skew.push(base + dir * (s as f64 * 0.1));
+            }
+        }
+        assert!(scan_direction(&skew, &cfg).is_none());
+    }
+
+    /// Keys whose headings wander by a few tenths of a degree in a square
+    /// building are pulled back to a common direction (the building's as
+    /// the votes measure it: off the truth by their mean wander, which
+    /// turns every key alike); a key whose walls lie 20° off the
+    /// building's gets no prior.
+    #[test]
+    fn priors_take_out_a_heading_wander() {
+        let cfg = ManhattanConfig::default();
+        let wander: [f64; 6] = [0.0, 0.3, -0.4, 0.5, 0.2, 20.0];
+        let mut graph = PoseGraph::default();
+        let mut directions = Vec::new();
+        for (i, w) in wander.iter().enumerate() {
+            // The key's estimate is off by `w`; its scan sees the building
+            // (direction 3°) from its true heading.
+            let truth = 0.1 * i as f64;
+            graph
+                .nodes
+                .push(Pose2::new(i as f64, 0.0, truth + w.to_radians()));
+            directions.push(Some(fold(3f64.to_radians() - truth)));
+            if i > 0 {
+                let z = Pose2::new(1.0, 0.0, 0.1);
+                graph
+                    .edges
+                    .push(Edge::new(i - 1, i, z, 0.1, 5f64.to_radians()));
+            }
+        }
+        let added = add_priors(&mut graph, &directions, &cfg);
+        assert_eq!(added, 4, "keys 1 to 4; key 5 lies 20° off");
+        graph.optimise(20).expect("optimise");
+        let err = |i: usize| (graph.nodes[i].theta - 0.1 * i as f64).to_degrees();
+        // The votes' mean wander: (0 + 0.3 − 0.4 + 0.5 + 0.2) / 5 = 0.12°.
+        for i in 1..5 {
+            assert!(
+                (err(i) - 0.12).abs() < 0.03,
+                "key {i}: heading off by {}°",
+                err(i)
+            );
+        }
+    }
+}
