@@ -13,13 +13,27 @@ use slamlab::slam::robot_graph::RobotGraphConfig;
 /// `GRAPH_CLOSURE_SIGMA_DEG`, `GRAPH_REFINE_MIN_POINTS`,
 /// `GRAPH_CLOSURE_MAX_WEAK_M`, `GRAPH_CONFIRM_M`, `GRAPH_CONFIRM_DEG`,
 /// `GRAPH_FLOOR_M`, `GRAPH_FLOOR_DEG`, `GRAPH_LOOP_EVERY`,
-/// `GRAPH_SATISFIED_M`, `GRAPH_COOLDOWN`; `GRAPH_NO_LOOPS` (set) searches
+/// `GRAPH_SATISFIED_M`, `GRAPH_COOLDOWN`; `GRAPH_MANHATTAN_DEG` (the square
+/// walls' prior's σ; 0: off), `GRAPH_MANHATTAN_ANCHOR`, `GRAPH_MANHATTAN_EVERY`; `GRAPH_NO_LOOPS` (set) searches
 /// no closure, `GRAPH_TRIALS` (set) records every closure found.
 pub fn config_from_env(c: &mut RobotGraphConfig) {
     let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
     let deg = |k: &str, v: &mut f64| *v = env(k).map_or(*v, f64::to_radians);
     let count = |k: &str, v: &mut usize| *v = env(k).map_or(*v, |x| x as usize);
     let num = |k: &str, v: &mut f64| *v = env(k).unwrap_or(*v);
+    if let Ok(v) = std::env::var("GRAPH_MANHATTAN_DEG") {
+        let sigma: f64 = v.parse().expect("GRAPH_MANHATTAN_DEG");
+        c.manhattan = (sigma > 0.0).then(|| slamlab::slam::manhattan::ManhattanConfig {
+            sigma_rad: sigma.to_radians(),
+            ..Default::default()
+        });
+    }
+    if let Ok(v) = std::env::var("GRAPH_MANHATTAN_ANCHOR") {
+        c.manhattan_anchor_keys = v.parse().expect("GRAPH_MANHATTAN_ANCHOR");
+    }
+    if let Ok(v) = std::env::var("GRAPH_MANHATTAN_EVERY") {
+        c.manhattan_every = v.parse().expect("GRAPH_MANHATTAN_EVERY");
+    }
     num("GRAPH_MIN_SCORE", &mut c.loops.min_score);
     num("GRAPH_MIN_CONSTRAINT", &mut c.min_constraint);
     num("GRAPH_RADIUS_M", &mut c.loops.search_radius_m);

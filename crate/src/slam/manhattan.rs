@@ -88,7 +88,7 @@ impl Default for ManhattanConfig {
 }
 
 /// `a` folded into [−45°, 45°).
-fn fold(a: f64) -> f64 {
+pub fn fold(a: f64) -> f64 {
     (a + FRAC_PI_2 / 2.0).rem_euclid(FRAC_PI_2) - FRAC_PI_2 / 2.0
 }
 
@@ -155,6 +155,19 @@ pub fn building_direction(world: &[f64], gate_rad: f64) -> Option<f64> {
     peak(world, gate_rad).map(|(d, _)| d)
 }
 
+/// A heading-only edge from the anchored node 0 (at `anchor`) asking node
+/// `to`'s heading to be `wanted`, with deviation `sigma_rad`.
+pub fn heading_prior(anchor: &Pose2, to: usize, wanted: f64, sigma_rad: f64) -> Edge {
+    let w = 1.0 / (sigma_rad * sigma_rad);
+    Edge {
+        from: 0,
+        to,
+        measurement: Pose2::new(0.0, 0.0, wrap_angle(wanted - anchor.theta)),
+        information: [[0.0; 3], [0.0; 3], [0.0, 0.0, w]],
+        loop_closure: false,
+    }
+}
+
 /// Adds the heading priors of step 3 to `graph` for the keys whose scan
 /// directions are `directions[i]` (`None`: not square) and returns how
 /// many were added. Node 0 is the anchor: it votes for the building's
@@ -179,16 +192,12 @@ pub fn add_priors(
         if i == 0 || off.abs() > cfg.gate_rad {
             continue;
         }
-        let wanted = graph.nodes[i].theta - off;
-        let measurement = Pose2::new(0.0, 0.0, wrap_angle(wanted - anchor.theta));
-        let w = 1.0 / (cfg.sigma_rad * cfg.sigma_rad);
-        graph.edges.push(Edge {
-            from: 0,
-            to: i,
-            measurement,
-            information: [[0.0; 3], [0.0; 3], [0.0, 0.0, w]],
-            loop_closure: false,
-        });
+        graph.edges.push(heading_prior(
+            &anchor,
+            i,
+            graph.nodes[i].theta - off,
+            cfg.sigma_rad,
+        ));
         added += 1;
     }
     added

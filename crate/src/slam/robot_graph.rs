@@ -70,6 +70,22 @@
 //!    scans, so a redraw is never one long task in the page;
 //!    [`RobotGraph::settle`] completes the map at the end of a run.
 //!
+//! 5. **Square walls** ([`super::manhattan`], session 30). A lap's middle
+//!    keeps the front end's slow heading meander: the lap's closures make
+//!    it consistent, not straight, and on the hour the worst robots were a
+//!    lap turned by a quarter of a degree. Each key whose scan's normals
+//!    bundle into one direction modulo 90° is a vote; the building's
+//!    direction is measured from the first `manhattan_anchor_keys` votes,
+//!    near the start, where the heading has not wandered yet (the start
+//!    pose is known), and every later square key within 2° of it gets a
+//!    loose (σ 2°) heading-only edge from the anchored first key. The graph
+//!    is optimised after every `manhattan_every` such edges (and with every
+//!    accepted closure), and the front end moves with it as after a
+//!    closure. A world that is not square gives no votes and nothing
+//!    changes. On the hour's scenario of issue 22 it takes the worst robot
+//!    from 0.194 to 0.091 m natively and every robot under 0.05 m in wasm
+//!    (BENCHMARKS.md, issue 22, session 30).
+//!
 //! ## What the numbers say
 //! On the one-hour, 16-robot, 60 × 60 m maze of issue 22
 //! (`examples/sim_drift.rs`), some robots' SLAM drifts: they follow the
@@ -177,6 +193,7 @@ use super::grid::{beam_directions, GridConfig, OccupancyGrid};
 use super::key_chain::KeyChain;
 pub use super::key_chain::StepMatch;
 use super::loop_closure::{closures_agree, find_closure, Closure, LoopConfig};
+use super::manhattan::{building_direction, fold, heading_prior, scan_direction, ManhattanConfig};
 use super::multires::Window;
 use super::posegraph::{Edge, PoseGraph};
 use super::surface::{refine_to_surface, RefineConfig};
@@ -243,6 +260,15 @@ pub struct RobotGraphConfig {
     pub redraw_keys_per_scan: usize,
     /// Keep a [`ClosureTrial`] of every closure found (experiments).
     pub record_trials: bool,
+    /// Square walls' heading prior ([`super::manhattan`]; `None`: off).
+    /// The building's direction is measured from the first
+    /// `manhattan_anchor_keys` square keys, near the start, where the
+    /// heading has not wandered yet; each later square key within the gate
+    /// gets a prior, and the graph is optimised after every
+    /// `manhattan_every` of them.
+    pub manhattan: Option<ManhattanConfig>,
+    pub manhattan_anchor_keys: usize,
+    pub manhattan_every: usize,
 }
 
 impl Default for RobotGraphConfig {
@@ -284,6 +310,9 @@ impl Default for RobotGraphConfig {
             rebuild_m: 0.05,
             redraw_keys_per_scan: 48,
             record_trials: false,
+            manhattan: Some(ManhattanConfig::default()),
+            manhattan_anchor_keys: 50,
+            manhattan_every: 200,
         }
     }
 }
@@ -373,6 +402,8 @@ pub struct RobotGraphStats {
     /// Confirmed closures the graph already satisfied (not added).
     pub closures_satisfied: usize,
     pub map_rebuilds: usize,
+    /// Keys given a square walls' heading prior.
+    pub square_keys: usize,
 }
 
 /// An accepted loop closure: its keys, the steps they were taken at, the
@@ -475,6 +506,13 @@ pub struct RobotGraph {
     #[serde(with = "super::handoff::keep_capacity")]
     pub trials: Vec<ClosureTrial>,
     pub stats: RobotGraphStats,
+    /// Square keys waiting for a heading prior: (key, scan direction).
+    #[serde(with = "super::handoff::keep_capacity")]
+    square: Vec<(usize, f64)>,
+    /// The building's direction modulo 90°, once measured.
+    building: Option<f64>,
+    /// Priors added since the last optimisation.
+    priors_pending: usize,
 }
 
 impl RobotGraph {
@@ -519,8 +557,54 @@ impl RobotGraph {
         if is_key && self.should_try() {
             if let Some(closures) = self.try_close(front.map.resolution_m()) {
                 self.accept(closures, front);
+                return;
             }
         }
+        if is_key && self.priors_pending >= self.config.manhattan_every.max(1) {
+            self.priors_pending = 0;
+            let before = self.graph.nodes.clone();
+            if self.graph.optimise(10).is_ok() {
+                self.apply(&before, front);
+            } else {
+                self.graph.nodes = before;
+            }
+        }
+    }
+
+    /// Square walls (see [`RobotGraphConfig::manhattan`]): notes key `id`'s
+    /// wall direction, measures the building's once enough keys are square,
+    /// and gives the waiting keys within the gate their heading prior.
+    fn square_walls(&mut self, id: usize) {
+        let Some(m) = &self.config.manhattan else {
+            return;
+        };
+        if let Some((d, _)) = scan_direction(&self.keys[id].points(), m) {
+            self.square.push((id, d));
+        }
+        let nodes = &self.graph.nodes;
+        let world = |&(k, d): &(usize, f64)| fold(nodes[k].theta + d);
+        if self.building.is_none() {
+            if self.square.len() < self.config.manhattan_anchor_keys.max(1) {
+                return;
+            }
+            let votes: Vec<f64> = self.square.iter().map(world).collect();
+            self.building = building_direction(&votes, m.gate_rad);
+        }
+        let Some(building) = self.building else {
+            return;
+        };
+        let anchor = nodes[0];
+        let mut edges = Vec::new();
+        for &(k, d) in &self.square {
+            let off = fold(world(&(k, d)) - building);
+            if k > 0 && off.abs() <= m.gate_rad {
+                edges.push(heading_prior(&anchor, k, nodes[k].theta - off, m.sigma_rad));
+            }
+        }
+        self.square.clear();
+        self.stats.square_keys += edges.len();
+        self.priors_pending += edges.len();
+        self.graph.edges.extend(edges);
     }
 
     fn add_key(&mut self, scan: &LaserScan, pose: Pose2) {
@@ -547,6 +631,7 @@ impl RobotGraph {
         self.keys.push(KeyScan::pack(scan));
         self.chain = Some(KeyChain::start(pose));
         self.stats.keys += 1;
+        self.square_walls(id);
     }
 
     /// Whether the newest key is due for a closure search and its scan pins
