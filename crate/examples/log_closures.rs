@@ -113,12 +113,8 @@ fn report(name: &str, slam: &LogSlam, reference: &[Pose2]) {
 /// lies from the building's, at the reference's headings and at ours: the
 /// noise of the square walls' prior, and how much wander it sees.
 fn square_spread(slam: &LogSlam, reference: &[Pose2], key_scan: &[usize]) {
-    use slamlab::slam::manhattan::{building_direction, scan_direction};
+    use slamlab::slam::manhattan::{building_direction, fold, scan_direction};
     let m = slam.config.manhattan.clone().unwrap_or_default();
-    let fold = |a: f64| {
-        let q = std::f64::consts::FRAC_PI_2;
-        (a + q / 2.0).rem_euclid(q) - q / 2.0
-    };
     let dirs: Vec<(usize, f64)> = (0..slam.graph.nodes.len())
         .filter_map(|i| scan_direction(slam.key_points(i), &m).map(|(d, _)| (i, d)))
         .collect();
@@ -130,7 +126,7 @@ fn square_spread(slam: &LogSlam, reference: &[Pose2], key_scan: &[usize]) {
                 .map(|&s| reference[s].theta)
                 .collect::<Vec<f64>>(),
         ),
-        ("ours", slam.graph.nodes.iter().map(|p| p.theta).collect()),
+        ("our", slam.graph.nodes.iter().map(|p| p.theta).collect()),
     ];
     for (label, heading) in headings {
         let world: Vec<f64> = dirs.iter().map(|&(i, d)| fold(heading[i] + d)).collect();
@@ -145,7 +141,7 @@ fn square_spread(slam: &LogSlam, reference: &[Pose2], key_scan: &[usize]) {
         off.sort_by(f64::total_cmp);
         let rms = (off.iter().map(|a| a * a).sum::<f64>() / off.len().max(1) as f64).sqrt();
         println!(
-            "  square keys at the {label}'s headings: {} of {} within the gate, offset median {:.2} deg, rms {rms:.2} deg",
+            "  square keys at {label} headings: {} of {} within the gate, offset median {:.2} deg, rms {rms:.2} deg",
             off.len(),
             dirs.len(),
             off.get(off.len() / 2).copied().unwrap_or(0.0)
