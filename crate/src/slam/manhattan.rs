@@ -168,6 +168,27 @@ pub fn heading_prior(anchor: &Pose2, to: usize, wanted: f64, sigma_rad: f64) -> 
     }
 }
 
+/// The heading priors of step 3 towards the building's direction
+/// `building` for the square keys `square` (`(node, scan direction)`):
+/// one edge per key within `cfg.gate_rad` of it, none for node 0, the
+/// anchor.
+pub fn priors_towards(
+    nodes: &[Pose2],
+    square: &[(usize, f64)],
+    building: f64,
+    cfg: &ManhattanConfig,
+) -> Vec<Edge> {
+    let anchor = nodes[0];
+    square
+        .iter()
+        .filter_map(|&(i, d)| {
+            let off = fold(fold(nodes[i].theta + d) - building);
+            (i > 0 && off.abs() <= cfg.gate_rad)
+                .then(|| heading_prior(&anchor, i, nodes[i].theta - off, cfg.sigma_rad))
+        })
+        .collect()
+}
+
 /// Adds the heading priors of step 3 to `graph` for the keys whose scan
 /// directions are `directions[i]` (`None`: not square) and returns how
 /// many were added. Node 0 is the anchor: it votes for the building's
@@ -178,28 +199,19 @@ pub fn add_priors(
     cfg: &ManhattanConfig,
 ) -> usize {
     let n = graph.nodes.len().min(directions.len());
-    let world: Vec<(usize, f64)> = (0..n)
-        .filter_map(|i| directions[i].map(|d| (i, fold(graph.nodes[i].theta + d))))
+    let square: Vec<(usize, f64)> = (0..n)
+        .filter_map(|i| directions[i].map(|d| (i, d)))
         .collect();
-    let angles: Vec<f64> = world.iter().map(|&(_, a)| a).collect();
-    let Some(building) = building_direction(&angles, cfg.gate_rad) else {
+    let votes: Vec<f64> = square
+        .iter()
+        .map(|&(i, d)| fold(graph.nodes[i].theta + d))
+        .collect();
+    let Some(building) = building_direction(&votes, cfg.gate_rad) else {
         return 0;
     };
-    let anchor = graph.nodes[0];
-    let mut added = 0;
-    for &(i, a) in &world {
-        let off = fold(a - building);
-        if i == 0 || off.abs() > cfg.gate_rad {
-            continue;
-        }
-        graph.edges.push(heading_prior(
-            &anchor,
-            i,
-            graph.nodes[i].theta - off,
-            cfg.sigma_rad,
-        ));
-        added += 1;
-    }
+    let edges = priors_towards(&graph.nodes, &square, building, cfg);
+    let added = edges.len();
+    graph.edges.extend(edges);
     added
 }
 

@@ -193,7 +193,7 @@ use super::grid::{beam_directions, GridConfig, OccupancyGrid};
 use super::key_chain::KeyChain;
 pub use super::key_chain::StepMatch;
 use super::loop_closure::{closures_agree, find_closure, Closure, LoopConfig};
-use super::manhattan::{building_direction, fold, heading_prior, scan_direction, ManhattanConfig};
+use super::manhattan::{building_direction, fold, priors_towards, scan_direction, ManhattanConfig};
 use super::multires::Window;
 use super::posegraph::{Edge, PoseGraph};
 use super::surface::{refine_to_surface, RefineConfig};
@@ -582,25 +582,21 @@ impl RobotGraph {
             self.square.push((id, d));
         }
         let nodes = &self.graph.nodes;
-        let world = |&(k, d): &(usize, f64)| fold(nodes[k].theta + d);
         if self.building.is_none() {
             if self.square.len() < self.config.manhattan_anchor_keys.max(1) {
                 return;
             }
-            let votes: Vec<f64> = self.square.iter().map(world).collect();
+            let votes: Vec<f64> = self
+                .square
+                .iter()
+                .map(|&(k, d)| fold(nodes[k].theta + d))
+                .collect();
             self.building = building_direction(&votes, m.gate_rad);
         }
         let Some(building) = self.building else {
             return;
         };
-        let anchor = nodes[0];
-        let mut edges = Vec::new();
-        for &(k, d) in &self.square {
-            let off = fold(world(&(k, d)) - building);
-            if k > 0 && off.abs() <= m.gate_rad {
-                edges.push(heading_prior(&anchor, k, nodes[k].theta - off, m.sigma_rad));
-            }
-        }
+        let edges = priors_towards(nodes, &self.square, building, m);
         self.square.clear();
         self.stats.square_keys += edges.len();
         self.priors_pending += edges.len();
