@@ -286,6 +286,8 @@ pub fn config_from_env() -> LogSlamConfig {
             "manhattan_gate_deg" => manhattan(&mut cfg).gate_rad = v.to_radians(),
             "manhattan_window_deg" => manhattan(&mut cfg).window_rad = v.to_radians(),
             "manhattan_min_share" => manhattan(&mut cfg).min_share = v,
+            "manhattan_line_min_m" => manhattan(&mut cfg).line_min_m = v,
+            "manhattan_line_max_rms_m" => manhattan(&mut cfg).line_max_rms_m = v,
             _ => panic!("SLAMLAB_LOG_SLAM: unknown setting {key}"),
         }
     }

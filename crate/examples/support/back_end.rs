@@ -14,7 +14,8 @@ use slamlab::slam::robot_graph::RobotGraphConfig;
 /// `GRAPH_CLOSURE_MAX_WEAK_M`, `GRAPH_CONFIRM_M`, `GRAPH_CONFIRM_DEG`,
 /// `GRAPH_FLOOR_M`, `GRAPH_FLOOR_DEG`, `GRAPH_LOOP_EVERY`,
 /// `GRAPH_SATISFIED_M`, `GRAPH_COOLDOWN`; `GRAPH_MANHATTAN_DEG` (the square
-/// walls' prior's σ; 0: off), `GRAPH_MANHATTAN_ANCHOR`, `GRAPH_MANHATTAN_EVERY`; `GRAPH_NO_LOOPS` (set) searches
+/// walls' prior's σ; 0: off), `GRAPH_MANHATTAN_ANCHOR`, `GRAPH_MANHATTAN_EVERY`,
+/// `GRAPH_MANHATTAN_LINE_M`, `GRAPH_MANHATTAN_LINE_RMS_M` (its straight walls); `GRAPH_NO_LOOPS` (set) searches
 /// no closure, `GRAPH_TRIALS` (set) records every closure found.
 pub fn config_from_env(c: &mut RobotGraphConfig) {
     let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
@@ -27,6 +28,10 @@ pub fn config_from_env(c: &mut RobotGraphConfig) {
             sigma_rad: sigma.to_radians(),
             ..Default::default()
         });
+    }
+    if let Some(m) = &mut c.manhattan {
+        num("GRAPH_MANHATTAN_LINE_M", &mut m.line_min_m);
+        num("GRAPH_MANHATTAN_LINE_RMS_M", &mut m.line_max_rms_m);
     }
     if let Ok(v) = std::env::var("GRAPH_MANHATTAN_ANCHOR") {
         c.manhattan_anchor_keys = v.parse().expect("GRAPH_MANHATTAN_ANCHOR");
