@@ -30,7 +30,7 @@ use slamlab::geom::{wrap_angle, Pose2};
 use slamlab::scenario::Scenario;
 use slamlab::sim::Simulation;
 use slamlab::slam::mapper::{MatchCounts, RobotMapping, SlamConfig};
-use slamlab::slam::scoring::{ate_m, position_errors_m};
+use slamlab::slam::scoring::{ate_aligned_m, ate_m, position_errors_m};
 
 struct Traced {
     index: usize,
@@ -169,9 +169,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             print_key_matches(r, &t.mapping);
         }
         println!(
-            "{}: ATE slam {:.3} m, odometry {:.3} m, path {:.0} m, counts {:?}, back end {:?}",
+            "{}: ATE slam {:.3} m (rigidly aligned {:.3} m), odometry {:.3} m, path {:.0} m, counts {:?}, back end {:?}",
             r.spec.name,
             ate_m(&start, t.mapping.estimates(), &r.log.truth),
+            ate_aligned_m(&start, t.mapping.estimates(), &r.log.truth),
             ate_m(&start, &r.log.odometry, &r.log.truth),
             r.log.path_length_m(),
             t.mapping.counts,
