@@ -86,6 +86,23 @@ pub fn symmetric_eigen2(a: f64, b: f64, c: f64) -> (f64, f64, DVec2) {
     (l1, l2, v.normalize_or(DVec2::X))
 }
 
+/// The covariance `[xx, xy, yy]` of `points` (not empty) about their
+/// mean: with [`symmetric_eigen2`], a line fit by total least squares —
+/// the larger eigenvalue the spread along the line, the smaller the mean
+/// squared distance from it, and its eigenvector the line's normal.
+pub fn covariance2(points: &[DVec2]) -> [f64; 3] {
+    let mean = points.iter().copied().sum::<DVec2>() / points.len() as f64;
+    let (mut a, mut b, mut c) = (0.0, 0.0, 0.0);
+    for &q in points {
+        let d = q - mean;
+        a += d.x * d.x;
+        b += d.x * d.y;
+        c += d.y * d.y;
+    }
+    let n = points.len() as f64;
+    [a / n, b / n, c / n]
+}
+
 /// Neighbourhood of a point for its normal (m), at least.
 const NORMAL_RADIUS_M: f64 = 0.12;
 /// A point's neighbourhood reaches at least this many beam spacings at its
@@ -156,17 +173,8 @@ fn normals_within(points: &[DVec2], radius2_at: impl Fn(DVec2) -> f64) -> Vec<Op
             if lo == i || hi == i {
                 return None;
             }
-            let nbrs = &points[lo..=hi];
-            let mean = nbrs.iter().copied().sum::<DVec2>() / nbrs.len() as f64;
-            let (mut a, mut b, mut c) = (0.0, 0.0, 0.0);
-            for &q in nbrs {
-                let d = q - mean;
-                a += d.x * d.x;
-                b += d.x * d.y;
-                c += d.y * d.y;
-            }
-            let n = nbrs.len() as f64;
-            let (along, across, normal) = symmetric_eigen2(a / n, b / n, c / n);
+            let [a, b, c] = covariance2(&points[lo..=hi]);
+            let (along, across, normal) = symmetric_eigen2(a, b, c);
             // Spread along the line: a uniform spread of extent L has
             // variance L²/12.
             if (12.0 * along).sqrt() < MIN_EXTENT_M || across > MAX_FLATNESS * along {

@@ -63,7 +63,7 @@
 //! instead of fifty, it trades one hour's failures for another's. Both are
 //! measured in BENCHMARKS.md, session 31; it stays off.
 
-use super::degeneracy::scan_normals_within;
+use super::degeneracy::{covariance2, scan_normals_within, symmetric_eigen2};
 use super::posegraph::{Edge, PoseGraph};
 use crate::geom::{wrap_angle, Pose2};
 use glam::DVec2;
@@ -229,23 +229,10 @@ fn line_vote(run: &[DVec2], cfg: &ManhattanConfig) -> Option<(f64, f64)> {
     if run.len() < 5 || run[0].distance(run[run.len() - 1]) < cfg.line_min_m {
         return None;
     }
-    let mean = run.iter().copied().sum::<DVec2>() / run.len() as f64;
-    let (mut a, mut b, mut c) = (0.0, 0.0, 0.0);
-    for &q in run {
-        let d = q - mean;
-        a += d.x * d.x;
-        b += d.x * d.y;
-        c += d.y * d.y;
-    }
-    let phi = 0.5 * (2.0 * b).atan2(a - c);
-    let dir = DVec2::from_angle(phi);
-    let (mut along, mut across) = (0.0, 0.0);
-    for &q in run {
-        along += dir.dot(q - mean).powi(2);
-        across += dir.perp_dot(q - mean).powi(2);
-    }
-    ((across / run.len() as f64).sqrt() <= cfg.line_max_rms_m)
-        .then(|| (fold(phi + FRAC_PI_2), along))
+    let [a, b, c] = covariance2(run);
+    let (along, across, normal) = symmetric_eigen2(a, b, c);
+    (across.sqrt() <= cfg.line_max_rms_m)
+        .then(|| (fold(normal.y.atan2(normal.x)), along * run.len() as f64))
 }
 
 /// The building's direction modulo 90° from the square keys' world
