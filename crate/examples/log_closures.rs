@@ -113,8 +113,8 @@ fn report(name: &str, slam: &LogSlam, reference: &[Pose2]) {
 /// lies from the building's, at the reference's headings and at ours: the
 /// noise of the square walls' prior, and how much wander it sees. Twice:
 /// each key's direction from its normals, and refined by its straight
-/// walls (runs of at least 1 m fitted by lines), which leaves less of the
-/// spread to the direction's own noise and more to the headings'.
+/// walls (runs of at least 1 m fitted by lines; sharper on clean walls,
+/// wider on these logs: BENCHMARKS.md, issue 21, session 31).
 fn square_spread(slam: &LogSlam, reference: &[Pose2], key_scan: &[usize]) {
     use slamlab::slam::manhattan::{building_direction, fold, scan_direction};
     let normals = slam.config.manhattan.clone().unwrap_or_default();

@@ -109,7 +109,7 @@ const NORMAL_RADIUS_M: f64 = 0.12;
 /// range (see the module doc).
 pub const SPACING_BEAMS: f64 = 8.0;
 /// Consecutive beams farther apart than this lie on different surfaces (m).
-const MAX_GAP_M: f64 = 0.3;
+pub const MAX_GAP_M: f64 = 0.3;
 /// At most this many beams on each side take part in a normal.
 const REACH: usize = 8;
 /// A neighbourhood narrower than this along its main axis is too short to

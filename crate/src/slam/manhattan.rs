@@ -63,14 +63,11 @@
 //! instead of fifty, it trades one hour's failures for another's. Both are
 //! measured in BENCHMARKS.md, session 31; it stays off.
 
-use super::degeneracy::{covariance2, scan_normals_within, symmetric_eigen2};
+use super::degeneracy::{covariance2, scan_normals_within, symmetric_eigen2, MAX_GAP_M};
 use super::posegraph::{Edge, PoseGraph};
 use crate::geom::{wrap_angle, Pose2};
 use glam::DVec2;
 use std::f64::consts::FRAC_PI_2;
-
-/// Neighbouring points further apart than this are not one wall (m).
-const MAX_GAP_M: f64 = 0.3;
 
 /// Settings of the square-walls prior.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -362,8 +359,8 @@ mod tests {
     }
 
     /// With 1 cm of range noise, the straight walls measure a room's turn
-    /// better than its normals do, and a bent wall (a run further than
-    /// `line_max_rms_m` from straight) takes no part.
+    /// better than its normals do, and a run further than
+    /// `line_max_rms_m` from straight (a zigzag) is no wall.
     #[test]
     fn straight_walls_measure_the_turn_through_noise() {
         let turn = 7.3f64.to_radians();
