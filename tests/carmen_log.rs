@@ -176,3 +176,59 @@ fn bad_and_truncated_lines_name_their_line() {
     let e = parse_bytes(b"FLASER 1 \xff\xfe").unwrap_err();
     assert_eq!(e.line, 1);
 }
+
+/// A log whose robot is seen at two places 300 m apart (a campus toured
+/// outdoors): at 5 cm its map would need 6,200 × 6,200 cells, past the
+/// 16 Mi a log's map may hold, so it is drawn at 10 cm, whole: nothing is
+/// dropped, and the corridor walls at both places are in it.
+#[wasm_bindgen_test(unsupported = test)]
+fn a_tour_too_big_for_5_cm_is_mapped_whole_at_10_cm() {
+    use slamlab::slam::log_replay::LogReplay;
+    use slamlab::slam::CellState;
+    // 181 beams over 180°: walls 1.5 m either side, nothing ahead.
+    let ranges: Vec<f64> = (0..181)
+        .map(|i| {
+            let s = ((i as f64 - 90.0).to_radians()).sin().abs();
+            if s > 0.1 {
+                1.5 / s
+            } else {
+                81.91
+            }
+        })
+        .collect();
+    let mut lines = Vec::new();
+    for (k, x) in [0.0, 0.5, 1.0, 300.0, 300.5, 301.0].iter().enumerate() {
+        let y = if *x > 100.0 { 300.0 } else { 0.0 };
+        lines.push(flaser(&ranges, [*x, y, 0.0], [*x, y, 0.0], k as f64));
+    }
+    let mut replay = LogReplay::new(lines.join("\n").as_bytes()).unwrap();
+    replay.finish().unwrap();
+    let map = replay.map().unwrap();
+    assert_eq!(map.resolution_m(), 0.1);
+    assert_eq!(map.dropped_updates(), 0);
+    assert!(map.width() * map.height() <= slamlab::slam::logslam::MAP_MAX_CELLS);
+    // Beside each place (the first scan's pose, then the fourth's), 1.5 m
+    // to its left, the wall.
+    for p in [[0.5, 1.5], [300.5, 301.5]] {
+        let [gx, gy] = map.global_cell(glam::DVec2::new(p[0], p[1] + 0.02));
+        let (x, y) = map.local([gx, gy]).expect("inside the map");
+        assert_eq!(map.state(x, y), CellState::Occupied, "wall at {p:?}");
+    }
+}
+
+/// The map's resolution is the finest power-of-two multiple of 5 cm that
+/// fits the tour: a 100 m tour stays at 5 cm; 300 m goes to 10 cm; 2 km
+/// to 80 cm (all with 20 m of reach around the poses).
+#[wasm_bindgen_test(unsupported = test)]
+fn the_log_map_resolution_grows_with_the_tour() {
+    use glam::DVec2;
+    use slamlab::slam::logslam::{map_resolution, MAP_MAX_CELLS};
+    let tour = |side: f64| [DVec2::ZERO, DVec2::splat(side)].into_iter();
+    assert_eq!(map_resolution(0.05, tour(100.0), 20.0, MAP_MAX_CELLS), 0.05);
+    assert_eq!(map_resolution(0.05, tour(300.0), 20.0, MAP_MAX_CELLS), 0.1);
+    assert_eq!(map_resolution(0.05, tour(2000.0), 20.0, MAP_MAX_CELLS), 0.8);
+    assert_eq!(
+        map_resolution(0.05, std::iter::empty(), 20.0, MAP_MAX_CELLS),
+        0.05
+    );
+}

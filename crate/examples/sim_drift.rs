@@ -83,6 +83,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let o = &mut config.odometry_noise;
             o.radians_per_metre = env("SLAM_ODO_RAD_PER_M").unwrap_or(o.radians_per_metre);
             o.metres_per_metre = env("SLAM_ODO_M_PER_M").unwrap_or(o.metres_per_metre);
+            // The motion filter: distance (m), angle (degrees), interval (s).
+            let m = &mut config.motion;
+            m.min_distance_m = env("SLAM_MOTION_M").unwrap_or(m.min_distance_m);
+            m.min_angle_rad = env("SLAM_MOTION_DEG").map_or(m.min_angle_rad, f64::to_radians);
+            m.max_interval_s = env("SLAM_MOTION_S").unwrap_or(m.max_interval_s);
             back_end_support::config_from_env(&mut config.graph);
             let mapping = RobotMapping::new(config);
             Ok(Traced {

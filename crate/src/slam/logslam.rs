@@ -94,7 +94,7 @@
 //! The poses are in the log's odometry frame: the first scan's pose is its
 //! odometry pose, and the graph's first node stays fixed there.
 
-use super::grid::{GridConfig, OccupancyGrid};
+use super::grid::{GridConfig, OccupancyGrid, GROW_STEP_CELLS};
 use super::likelihood::LikelihoodField;
 use super::log_refine::{refine, RefineConfig};
 use super::loop_closure::{
@@ -728,15 +728,20 @@ impl LogSlam {
     }
 
     /// Draws the occupancy grid of `scans` (the same scans, in the same
-    /// order, as were added) at the current estimates.
+    /// order, as were added) at the current estimates, at the finest of
+    /// `resolution_m`, twice it, four times it, … at which the whole tour
+    /// fits in [`MAP_MAX_CELLS`] ([`map_resolution`]): a campus toured
+    /// outdoors is mapped whole at 10 cm rather than cut off at 5 cm.
     pub fn build_map(&self, scans: &[LogScan]) -> OccupancyGrid {
+        let reach = self.config.match_range_m.max(self.config.free_range_m);
+        let count = self.scans.len().min(scans.len());
+        let positions = (0..count).map(|k| self.scan_pose(k).position());
         let config = GridConfig {
-            resolution_m: self.config.resolution_m,
-            max_cells: 1 << 24,
+            resolution_m: map_resolution(self.config.resolution_m, positions, reach, MAP_MAX_CELLS),
+            max_cells: MAP_MAX_CELLS,
             ..GridConfig::default()
         };
-        let reach = self.config.match_range_m.max(self.config.free_range_m);
-        let poses = (0..self.scans.len().min(scans.len())).map(|k| self.scan_pose(k));
+        let poses = (0..count).map(|k| self.scan_pose(k));
         OccupancyGrid::drawn_at(config, poses, |grid, k, pose| {
             let scan = &scans[k];
             let c = pose.position();
@@ -753,4 +758,37 @@ impl LogSlam {
             }
         })
     }
+}
+
+/// Cells a log's map may hold: 16 Mi, a 205 m square at 5 cm (16 MB).
+pub const MAP_MAX_CELLS: usize = 1 << 24;
+
+/// The finest of `base`, 2·`base`, 4·`base`, … (at most 64·`base`) at which
+/// a grid covering every one of `positions` plus `reach` around it, with
+/// the grid's growth steps on every side, holds at most `max_cells` cells.
+pub fn map_resolution(
+    base: f64,
+    positions: impl Iterator<Item = DVec2>,
+    reach: f64,
+    max_cells: usize,
+) -> f64 {
+    let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+    for p in positions {
+        lo = lo.min(p);
+        hi = hi.max(p);
+    }
+    if !(lo.x <= hi.x && lo.y <= hi.y) {
+        return base;
+    }
+    let size = hi - lo + 2.0 * reach;
+    let margin = 2.0 * GROW_STEP_CELLS as f64;
+    let mut resolution = base;
+    for _ in 0..6 {
+        let cells = (size.x / resolution + margin) * (size.y / resolution + margin);
+        if cells <= max_cells as f64 {
+            break;
+        }
+        resolution *= 2.0;
+    }
+    resolution
 }
