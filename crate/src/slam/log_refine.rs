@@ -92,6 +92,7 @@ pub fn refine(
     let search = LoopConfig {
         search_radius_m: cfg.radius_m,
         window: cfg.window.clone(),
+        window_per_m: 0.0,
         min_score: cfg.min_score,
         ..loops.clone()
     };

@@ -98,8 +98,8 @@ use super::grid::{GridConfig, OccupancyGrid, GROW_STEP_CELLS};
 use super::likelihood::LikelihoodField;
 use super::log_refine::{refine, RefineConfig};
 use super::loop_closure::{
-    closure_fit, closures_agree, find_closure_among, loosened_along_weak, on_window_edge, Closure,
-    LoopConfig,
+    closure_fit, closure_window, closures_agree, find_closure_among, loosened_along_weak,
+    on_window_edge, Closure, LoopConfig,
 };
 use super::manhattan::{add_priors, scan_direction, ManhattanConfig};
 use super::match_covariance::{edge_information, response_covariance, ResponseWindow};
@@ -187,6 +187,10 @@ pub struct LogSlamConfig {
     /// it ([`super::loop_closure::closure_fit`]; 0: off). A corridor pins a scan only across
     /// itself, and a closure there can slide along it by metres.
     pub loop_min_weak: f64,
+    /// The score a closure must reach when it moves its key beyond the
+    /// fixed window (`loops.window`): a search grown with the path sees
+    /// more of a building, and a corridor's doors repeat.
+    pub far_min_score: f64,
     /// A closure's edge is loose along its weakest direction: its variance
     /// there is `loops.sigma_m²` times the ratio of the strong to the weak
     /// eigenvalue of the match's point-to-line information, at most this
@@ -246,6 +250,7 @@ impl Default for LogSlamConfig {
             loop_visits: 1,
             loop_edge_reject: true,
             loop_min_weak: 0.0,
+            far_min_score: 0.7,
             loop_loosen_ratio: 10.0,
             refine: RefineConfig::default(),
             manhattan: Some(ManhattanConfig::default()),
@@ -292,6 +297,9 @@ pub struct LogSlamStats {
     pub chain_edges: usize,
     /// Closures refused for lying on the search window's edge.
     pub closures_on_edge: usize,
+    /// Closures refused for moving their key beyond the fixed window with
+    /// a score under `far_min_score`.
+    pub closures_far_weak: usize,
     /// Closures refused as not pinned in every direction (`loop_min_weak`).
     pub closures_degenerate: usize,
     /// Links the closing refinement added ([`super::log_refine`]).
@@ -589,6 +597,10 @@ impl LogSlam {
             return;
         };
         self.stats.closures_found += 1;
+        if found.score < self.config.far_min_score && self.beyond_base_window(&found) {
+            self.stats.closures_far_weak += 1;
+            return;
+        }
         if self.config.loop_edge_reject && self.on_window_edge(&found) {
             self.stats.closures_on_edge += 1;
             return;
@@ -642,12 +654,21 @@ impl LogSlam {
         }
     }
 
+    /// Whether closure `c` moves its new key further than the fixed window
+    /// (`loops.window`) would have reached: found only thanks to the reach
+    /// grown with the path ([`closure_window`]).
+    fn beyond_base_window(&self, c: &Closure) -> bool {
+        let window = &self.config.loops.window;
+        on_window_edge(&self.graph.nodes, c, window, 0.0, 0.0)
+    }
+
     /// Whether closure `c`'s match lies on the edge of the search window
     /// (within two cells of a side, half a degree of the heading range).
     fn on_window_edge(&self, c: &Closure) -> bool {
         let res = self.config.resolution_m;
-        let window = &self.config.loops.window;
-        on_window_edge(&self.graph.nodes, c, window, 2.0 * res, 0.5f64.to_radians())
+        let (nodes, loops) = (&self.graph.nodes, &self.config.loops);
+        let window = closure_window(nodes, c.edge.from, c.edge.to, loops);
+        on_window_edge(nodes, c, &window, 2.0 * res, 0.5f64.to_radians())
     }
 
     /// Adds confirmed closures, optimises, and undoes it all if a closure

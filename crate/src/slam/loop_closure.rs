@@ -47,6 +47,12 @@ pub struct LoopConfig {
     pub min_key_gap: usize,
     pub submap_half: usize,
     pub window: Window,
+    /// How much the window's reach (and the candidates' radius with it)
+    /// grows per metre the estimate has travelled since the candidate key
+    /// ([`closure_window`]): 0 keeps `window` for every candidate.
+    pub window_per_m: f64,
+    /// The reach it grows to at most (m).
+    pub max_window_m: f64,
     pub min_score: f64,
     /// Standard deviations given to an accepted closure's edge.
     pub sigma_m: f64,
@@ -63,6 +69,8 @@ impl Default for LoopConfig {
                 linear_m: 1.5,
                 angular_rad: 12f64.to_radians(),
             },
+            window_per_m: 0.0,
+            max_window_m: 8.0,
             min_score: 0.55,
             sigma_m: 0.05,
             sigma_rad: 1f64.to_radians(),
@@ -121,9 +129,10 @@ pub(super) fn visit_centres(nodes: &[Pose2], i: usize, cfg: &LoopConfig) -> Vec<
         return Vec::new();
     }
     let here = nodes[i].position();
+    let travelled = travelled_m(nodes, i);
     let near: Vec<(usize, f64)> = (0..=i - cfg.min_key_gap)
         .map(|j| (j, nodes[j].position().distance(here)))
-        .filter(|&(_, d)| d <= cfg.search_radius_m)
+        .filter(|&(j, d)| d <= cfg.search_radius_m + widening_m(cfg, travelled[i] - travelled[j]))
         .collect();
     let mut centres: Vec<(usize, f64)> = Vec::new();
     let mut last: Option<usize> = None;
@@ -141,6 +150,51 @@ pub(super) fn visit_centres(nodes: &[Pose2], i: usize, cfg: &LoopConfig) -> Vec<
     }
     centres.sort_by(|a, b| a.1.total_cmp(&b.1));
     centres.into_iter().map(|c| c.0).collect()
+}
+
+/// The distance the estimate travels from key 0 to each key up to `i`
+/// (m), key by key.
+fn travelled_m(nodes: &[Pose2], i: usize) -> Vec<f64> {
+    let mut sum = 0.0;
+    let mut out = Vec::with_capacity(i + 1);
+    for k in 0..=i {
+        if k > 0 {
+            sum += nodes[k].position().distance(nodes[k - 1].position());
+        }
+        out.push(sum);
+    }
+    out
+}
+
+/// How much further than `cfg.window` a closure search reaches after the
+/// estimate has travelled `path_m` since the candidate key.
+fn widening_m(cfg: &LoopConfig, path_m: f64) -> f64 {
+    let reach = (cfg.window.linear_m + cfg.window_per_m * path_m).min(cfg.max_window_m);
+    (reach - cfg.window.linear_m).max(0.0)
+}
+
+/// The window a closure of key `i` onto the visit around `centre` is
+/// searched in: `cfg.window`, its reach grown by `window_per_m` for every
+/// metre the estimate travelled from `centre` to `i`, up to `max_window_m`.
+///
+/// The drift a revisit must undo grows with the path since the place was
+/// last seen: on the logs of `../shared/data` it never passed 0.36 m, but
+/// on a convention centre's hall (the Acapulco log, 812 m of path) it
+/// reached 3–8 m, far outside a fixed 1.5 m window, and the loops stayed
+/// open. Karto sizes its loop search by the covariance accumulated along
+/// the chain; a reach proportional to the path is that bound for drift
+/// that grows with distance. It is a setting, off by default (0 per
+/// metre): measured on nine logs never tuned with (BENCHMARKS.md, issue
+/// 21, session 32), it closes Acapulco's loops but lets a corridor's
+/// repeating doors through elsewhere, and searches cost 3–7× more.
+pub fn closure_window(nodes: &[Pose2], centre: usize, i: usize, cfg: &LoopConfig) -> Window {
+    let path: f64 = (centre.min(i)..centre.max(i))
+        .map(|k| nodes[k + 1].position().distance(nodes[k].position()))
+        .sum();
+    Window {
+        linear_m: cfg.window.linear_m + widening_m(cfg, path),
+        angular_rad: cfg.window.angular_rad,
+    }
 }
 
 /// The keys of the visit around `centre` that key `i` is matched against:
@@ -185,8 +239,9 @@ pub(super) fn match_visit(
         let f = nodes[j].frame();
         world.extend(key_points[j].iter().map(|&p| f.to_parent(p)));
     }
-    let field = field_from_points(&world, resolution_m, 8, cfg.window.linear_m + 1.0);
-    let m = match_scan(&field, &key_points[i], &nodes[i], &cfg.window)?;
+    let window = closure_window(nodes, centre, i, cfg);
+    let field = field_from_points(&world, resolution_m, 8, window.linear_m + 1.0);
+    let m = match_scan(&field, &key_points[i], &nodes[i], &window)?;
     if m.score < cfg.min_score {
         return None;
     }
@@ -362,5 +417,31 @@ mod tests {
                 "{room:?}"
             );
         }
+    }
+
+    /// The window grows by `window_per_m` for each metre the estimate
+    /// travelled from the candidate to the new key, up to `max_window_m`;
+    /// off (0 per metre), it is the fixed window.
+    #[test]
+    fn the_closure_window_grows_with_the_path_since_the_candidate() {
+        // Keys 2 m apart along x: 10 keys apart is 20 m of path.
+        let nodes: Vec<Pose2> = (0..200)
+            .map(|k| Pose2::new(2.0 * k as f64, 0.0, 0.0))
+            .collect();
+        let cfg = LoopConfig {
+            window_per_m: 0.03,
+            max_window_m: 8.0,
+            ..LoopConfig::default()
+        };
+        let reach = |centre, i| closure_window(&nodes, centre, i, &cfg).linear_m;
+        assert!((reach(0, 10) - (1.5 + 0.03 * 20.0)).abs() < 1e-12);
+        assert!((reach(5, 55) - (1.5 + 0.03 * 100.0)).abs() < 1e-12);
+        assert_eq!(reach(0, 199), 8.0);
+        let fixed = LoopConfig::default();
+        assert_eq!(closure_window(&nodes, 0, 199, &fixed).linear_m, 1.5);
+        assert_eq!(
+            closure_window(&nodes, 0, 199, &cfg).angular_rad,
+            fixed.window.angular_rad
+        );
     }
 }

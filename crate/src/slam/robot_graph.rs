@@ -289,6 +289,8 @@ impl Default for RobotGraphConfig {
                     linear_m: 1.2,
                     angular_rad: 10f64.to_radians(),
                 },
+                window_per_m: 0.0,
+                max_window_m: 1.2,
                 min_score: 0.6,
                 sigma_m: 0.03,
                 sigma_rad: 1f64.to_radians(),
