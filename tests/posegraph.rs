@@ -305,3 +305,71 @@ fn a_world_covariance_becomes_the_edge_frame_information() {
     assert!(close(w[1][1], 0.04 / det, 1e-6) && close(w[2][2], 10000.0, 1e-6));
     assert!(edge_information(&[[0.0; 3]; 3], 0.0).is_none());
 }
+
+/// The rival of a match (`multires::rival_score`: the best pose more than
+/// 0.5 m from it): in a corridor whose door posts repeat every 2 m, a scan
+/// of three of them fits as well two metres on, so its rival scores as
+/// its match does; in a closed room nothing else fits. The search that
+/// finds the rival never returns a pose inside the excluded box.
+#[wasm_bindgen_test(unsupported = test)]
+fn a_repeating_corridor_has_a_rival_and_a_room_has_none() {
+    use glam::DVec2;
+    use slamlab::slam::correlative::{search_outside, CorrelativeConfig, Exclusion};
+    use slamlab::slam::multires::{field_from_points, match_scan, rival_score, Window};
+    let mut walls = vec![((-8.0, -1.0), (8.0, -1.0)), ((-8.0, 1.0), (8.0, 1.0))];
+    for k in -3..=3 {
+        let x = 2.0 * k as f64;
+        walls.push(((x, 1.0), (x, 1.5)));
+    }
+    let map = wall_points(&walls);
+    // The scan: what lies within 2.5 m of the origin along x.
+    let scan: Vec<DVec2> = map.iter().copied().filter(|p| p.x.abs() <= 2.5).collect();
+    let field = field_from_points(&map, 0.05, 4, 3.5);
+    let window = Window {
+        linear_m: 3.0,
+        angular_rad: 2f64.to_radians(),
+    };
+    let m = match_scan(&field, &scan, &Pose2::IDENTITY, &window).unwrap();
+    assert!(m.pose.position().length() < 0.03, "{:?}", m.pose);
+    let rival = rival_score(&field, &scan, &Pose2::IDENTITY, &window, &m.pose, 0.5);
+    assert!(
+        rival >= 0.95 * m.search_score,
+        "corridor: rival {rival}, match {}",
+        m.search_score
+    );
+    let cfg = CorrelativeConfig {
+        linear_window_m: 3.0,
+        angular_window_rad: 2f64.to_radians(),
+        angular_step_rad: 0.2f64.to_radians(),
+        coarse_cells: 4,
+    };
+    let exclusion = Exclusion {
+        centre: DVec2::ZERO,
+        radius_m: 0.5,
+    };
+    let other = search_outside(&field, &scan, &Pose2::IDENTITY, &cfg, Some(exclusion)).unwrap();
+    assert!(
+        other.pose.x.abs() > 0.5 || other.pose.y.abs() > 0.5,
+        "outside the box: {:?}",
+        other.pose
+    );
+    assert!(
+        (other.pose.x.abs() - 2.0).abs() < 0.06,
+        "two metres on: {:?}",
+        other.pose
+    );
+    let room = wall_points(&[
+        ((-2.0, -2.0), (2.0, -2.0)),
+        ((2.0, -2.0), (2.0, 2.0)),
+        ((2.0, 2.0), (-2.0, 2.0)),
+        ((-2.0, 2.0), (-2.0, -2.0)),
+    ]);
+    let field = field_from_points(&room, 0.05, 4, 3.5);
+    let m = match_scan(&field, &room, &Pose2::IDENTITY, &window).unwrap();
+    let rival = rival_score(&field, &room, &Pose2::IDENTITY, &window, &m.pose, 0.5);
+    assert!(
+        rival < 0.7 * m.search_score,
+        "room: rival {rival}, match {}",
+        m.search_score
+    );
+}

@@ -70,10 +70,45 @@ pub fn search(
     prior: &Pose2,
     cfg: &CorrelativeConfig,
 ) -> Option<CorrelativeMatch> {
+    search_outside(field, points, prior, cfg, None)
+}
+
+/// Positions a search leaves out: every pose whose position lies within
+/// `radius_m` of `centre` along both axes, at any heading.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Exclusion {
+    pub centre: DVec2,
+    pub radius_m: f64,
+}
+
+/// [`search`] over the window less `exclude`: the best pose elsewhere, to
+/// tell a unique match from one of a pattern that repeats (a corridor's
+/// doors). The coarse bounds still bound every pose they cover, so the
+/// branch and bound stays exact over what is left. `None` without points
+/// or when nothing is left.
+pub fn search_outside(
+    field: &LikelihoodField,
+    points: &[DVec2],
+    prior: &Pose2,
+    cfg: &CorrelativeConfig,
+    exclude: Option<Exclusion>,
+) -> Option<CorrelativeMatch> {
     if points.is_empty() {
         return None;
     }
     let res = field.resolution_m;
+    // The excluded box in cell offsets from the prior (none: an empty box).
+    let (ex, ey, er) = match exclude {
+        Some(e) => {
+            let c = (e.centre - prior.position()) / res;
+            (
+                c.x.round() as i64,
+                c.y.round() as i64,
+                (e.radius_m / res).ceil() as i64,
+            )
+        }
+        None => (0, 0, -1),
+    };
     let w = (cfg.linear_window_m / res).round() as i64;
     let k = field.k as i64;
     let nt = (cfg.angular_window_rad / cfg.angular_step_rad).round() as i64;
@@ -152,8 +187,17 @@ pub fn search(
         }
         let ti = (c.t + nt) as usize;
         let pc = &cells[ti * n..(ti + 1) * n];
+        // Whether this block meets the excluded box (never without one).
+        let meets = er >= 0
+            && c.ox <= ex + er
+            && c.ox + k > ex - er
+            && c.oy <= ey + er
+            && c.oy + k > ey - er;
         for oy in c.oy..(c.oy + k).min(w + 1) {
             for ox in c.ox..(c.ox + k).min(w + 1) {
+                if meets && (ox - ex).abs() <= er && (oy - ey).abs() <= er {
+                    continue;
+                }
                 let s: f32 = if inside[ti] {
                     score_at(&field.fine, ti, ox, oy)
                 } else {

@@ -34,7 +34,7 @@
 use super::degeneracy::scan_normals_within;
 use super::icp::{IcpFit, IcpTarget};
 use super::match_covariance::{edge_information, response_covariance, ResponseWindow};
-use super::multires::{field_from_points, match_scan, Window};
+use super::multires::{field_from_points, match_scan, rival_score, Window};
 use super::posegraph::Edge;
 use crate::geom::{wrap_angle, Pose2};
 use glam::DVec2;
@@ -53,6 +53,12 @@ pub struct LoopConfig {
     pub window_per_m: f64,
     /// The reach it grows to at most (m).
     pub max_window_m: f64,
+    /// A closure found in a grown window must beat its strongest rival
+    /// (the best pose more than [`RIVAL_EXCLUDE_M`] from it) by this
+    /// ratio: the rival's search score at most `unique_ratio` times its
+    /// own. A corridor whose doors repeat offers a rival as good a door
+    /// further on.
+    pub unique_ratio: f64,
     pub min_score: f64,
     /// Standard deviations given to an accepted closure's edge.
     pub sigma_m: f64,
@@ -71,6 +77,7 @@ impl Default for LoopConfig {
             },
             window_per_m: 0.0,
             max_window_m: 8.0,
+            unique_ratio: 0.9,
             min_score: 0.55,
             sigma_m: 0.05,
             sigma_rad: 1f64.to_radians(),
@@ -183,10 +190,17 @@ fn widening_m(cfg: &LoopConfig, path_m: f64) -> f64 {
 /// reached 3–8 m, far outside a fixed 1.5 m window, and the loops stayed
 /// open. Karto sizes its loop search by the covariance accumulated along
 /// the chain; a reach proportional to the path is that bound for drift
-/// that grows with distance. It is a setting, off by default (0 per
-/// metre): measured on nine logs never tuned with (BENCHMARKS.md, issue
-/// 21, session 32), it closes Acapulco's loops but lets a corridor's
-/// repeating doors through elsewhere, and searches cost 3–7× more.
+/// that grows with distance.
+///
+/// [`match_visit`] searches the fixed window first and the grown one only
+/// where the fixed one finds nothing good enough, and a match found there
+/// must have no rival: no pose more than [`RIVAL_EXCLUDE_M`] from it may
+/// score `unique_ratio` of its score (a corridor's doors repeat, and a
+/// window that reaches several metres along one finds the wrong door as
+/// readily as the right one). It is a setting, off by default (0 per
+/// metre): measured on fourteen logs (BENCHMARKS.md, issue 21, session
+/// 32) it adds no wrong closure and closes the halls' loops, but makes one
+/// of the tuned logs worse by a centimetre and the replays 4–10× slower.
 pub fn closure_window(nodes: &[Pose2], centre: usize, i: usize, cfg: &LoopConfig) -> Window {
     let path: f64 = (centre.min(i)..centre.max(i))
         .map(|k| nodes[k + 1].position().distance(nodes[k].position()))
@@ -239,12 +253,31 @@ pub(super) fn match_visit(
         let f = nodes[j].frame();
         world.extend(key_points[j].iter().map(|&p| f.to_parent(p)));
     }
-    let window = closure_window(nodes, centre, i, cfg);
-    let field = field_from_points(&world, resolution_m, 8, window.linear_m + 1.0);
-    let m = match_scan(&field, &key_points[i], &nodes[i], &window)?;
-    if m.score < cfg.min_score {
-        return None;
-    }
+    // The fixed window first; the grown one (if any) only where it finds
+    // nothing good enough, and then only a match without a rival: the
+    // grown reach adds closures, never replaces one the fixed window finds.
+    let points = &key_points[i];
+    let field = field_from_points(&world, resolution_m, 8, cfg.window.linear_m + 1.0);
+    let found = match_scan(&field, points, &nodes[i], &cfg.window);
+    let (field, m) = match found.filter(|m| m.score >= cfg.min_score) {
+        Some(m) => (field, m),
+        None => {
+            let window = closure_window(nodes, centre, i, cfg);
+            if window.linear_m <= cfg.window.linear_m {
+                return None;
+            }
+            let field = field_from_points(&world, resolution_m, 8, window.linear_m + 1.0);
+            let m = match_scan(&field, points, &nodes[i], &window)?;
+            if m.score < cfg.min_score {
+                return None;
+            }
+            let rival = rival_score(&field, points, &nodes[i], &window, &m.pose, RIVAL_EXCLUDE_M);
+            if rival > cfg.unique_ratio * m.search_score {
+                return None;
+            }
+            (field, m)
+        }
+    };
     let mut edge = Edge::new(
         centre,
         i,
@@ -264,6 +297,11 @@ pub(super) fn match_visit(
         score: m.score,
     })
 }
+
+/// How far from a closure's pose its rivals are looked for (m): beyond
+/// the width of one peak of the search's response, within a corridor's
+/// door spacing.
+pub const RIVAL_EXCLUDE_M: f64 = 0.5;
 
 /// Neighbourhood of a thinned key scan's point for its normal, and the
 /// association radius and Huber threshold of [`closure_fit`] (m):

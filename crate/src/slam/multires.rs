@@ -24,7 +24,7 @@
 //! the choice Olson recommends: a real laser's beams reach 20 m, where the
 //! simulator's 4 m beams allowed steps five times coarser.
 
-use super::correlative::{search, CorrelativeConfig};
+use super::correlative::{search, search_outside, CorrelativeConfig, Exclusion};
 use super::gauss_newton::refine;
 use super::likelihood::LikelihoodField;
 use crate::geom::Pose2;
@@ -143,6 +143,9 @@ pub struct ScanMatch {
     pub pose: Pose2,
     /// Mean field value at the points after refinement (0..1).
     pub score: f64,
+    /// The correlative search's score of its best pose, before refinement
+    /// (comparable with [`rival_score`]).
+    pub search_score: f64,
 }
 
 /// Matches `points` (robot frame) against `field` in `window` around
@@ -153,14 +156,43 @@ pub fn match_scan(
     prior: &Pose2,
     window: &Window,
 ) -> Option<ScanMatch> {
+    let cfg = search_config(field, points, window);
+    let coarse = search(field, points, prior, &cfg)?;
+    let (pose, score) = refine(field, points, &coarse.pose, 10);
+    Some(ScanMatch {
+        pose,
+        score,
+        search_score: coarse.score,
+    })
+}
+
+/// The correlative search of `window` on `field` for `points`: its angular
+/// step moves the farthest point by about a cell.
+fn search_config(field: &LikelihoodField, points: &[DVec2], window: &Window) -> CorrelativeConfig {
     let reach = points.iter().map(|p| p.length()).fold(1.0f64, f64::max);
-    let cfg = CorrelativeConfig {
+    CorrelativeConfig {
         linear_window_m: window.linear_m,
         angular_window_rad: window.angular_rad,
         angular_step_rad: (field.resolution_m / reach).clamp(0.001, 0.02),
         coarse_cells: field.k,
+    }
+}
+
+/// The search's score of the best pose in `window` around `prior` whose
+/// position lies more than `exclude_m` (along either axis) from `found`:
+/// the strongest rival of a match at `found` (0 when there is none).
+pub fn rival_score(
+    field: &LikelihoodField,
+    points: &[DVec2],
+    prior: &Pose2,
+    window: &Window,
+    found: &Pose2,
+    exclude_m: f64,
+) -> f64 {
+    let cfg = search_config(field, points, window);
+    let exclusion = Exclusion {
+        centre: found.position(),
+        radius_m: exclude_m,
     };
-    let coarse = search(field, points, prior, &cfg)?;
-    let (pose, score) = refine(field, points, &coarse.pose, 10);
-    Some(ScanMatch { pose, score })
+    search_outside(field, points, prior, &cfg, Some(exclusion)).map_or(0.0, |m| m.score)
 }

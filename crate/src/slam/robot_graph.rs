@@ -291,6 +291,7 @@ impl Default for RobotGraphConfig {
                 },
                 window_per_m: 0.0,
                 max_window_m: 1.2,
+                unique_ratio: 0.9,
                 min_score: 0.6,
                 sigma_m: 0.03,
                 sigma_rad: 1f64.to_radians(),
