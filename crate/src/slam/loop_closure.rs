@@ -136,10 +136,19 @@ pub(super) fn visit_centres(nodes: &[Pose2], i: usize, cfg: &LoopConfig) -> Vec<
         return Vec::new();
     }
     let here = nodes[i].position();
-    let travelled = travelled_m(nodes, i);
+    // The path from each key to key i, only when the reach grows with it.
+    let travelled = if cfg.window_per_m > 0.0 {
+        travelled_m(nodes, i)
+    } else {
+        Vec::new()
+    };
+    let widening = |j: usize| match travelled.get(j) {
+        Some(&t) => widening_m(cfg, travelled[i] - t),
+        None => 0.0,
+    };
     let near: Vec<(usize, f64)> = (0..=i - cfg.min_key_gap)
         .map(|j| (j, nodes[j].position().distance(here)))
-        .filter(|&(j, d)| d <= cfg.search_radius_m + widening_m(cfg, travelled[i] - travelled[j]))
+        .filter(|&(j, d)| d <= cfg.search_radius_m + widening(j))
         .collect();
     let mut centres: Vec<(usize, f64)> = Vec::new();
     let mut last: Option<usize> = None;
@@ -166,11 +175,16 @@ fn travelled_m(nodes: &[Pose2], i: usize) -> Vec<f64> {
     let mut out = Vec::with_capacity(i + 1);
     for k in 0..=i {
         if k > 0 {
-            sum += nodes[k].position().distance(nodes[k - 1].position());
+            sum += step_m(nodes, k - 1);
         }
         out.push(sum);
     }
     out
+}
+
+/// The distance the estimate moves from key `k` to key `k + 1` (m).
+fn step_m(nodes: &[Pose2], k: usize) -> f64 {
+    nodes[k + 1].position().distance(nodes[k].position())
 }
 
 /// How much further than `cfg.window` a closure search reaches after the
@@ -203,7 +217,7 @@ fn widening_m(cfg: &LoopConfig, path_m: f64) -> f64 {
 /// of the tuned logs worse by a centimetre and the replays 4–10× slower.
 pub fn closure_window(nodes: &[Pose2], centre: usize, i: usize, cfg: &LoopConfig) -> Window {
     let path: f64 = (centre.min(i)..centre.max(i))
-        .map(|k| nodes[k + 1].position().distance(nodes[k].position()))
+        .map(|k| step_m(nodes, k))
         .sum();
     Window {
         linear_m: cfg.window.linear_m + widening_m(cfg, path),
