@@ -287,6 +287,7 @@ pub fn config_from_env() -> LogSlamConfig {
             "point_spacing_m" => cfg.point_spacing_m = v,
             "manhattan" => cfg.manhattan = (v != 0.0).then(ManhattanConfig::default),
             "manhattan_sigma_deg" => manhattan(&mut cfg).sigma_rad = v.to_radians(),
+            "manhattan_rounds" => manhattan(&mut cfg).rounds = v as usize,
             "manhattan_gate_deg" => manhattan(&mut cfg).gate_rad = v.to_radians(),
             "manhattan_window_deg" => manhattan(&mut cfg).window_rad = v.to_radians(),
             "manhattan_min_share" => manhattan(&mut cfg).min_share = v,

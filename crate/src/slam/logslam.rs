@@ -101,7 +101,7 @@ use super::loop_closure::{
     closure_fit, closure_window, closures_agree, find_closure_among, loosened_along_weak,
     on_window_edge, Closure, LoopConfig,
 };
-use super::manhattan::{add_priors, scan_direction, ManhattanConfig};
+use super::manhattan::{scan_direction, settle_priors, ManhattanConfig};
 use super::match_covariance::{edge_information, response_covariance, ResponseWindow};
 use super::multires::{field_from_points, match_scan, ScanMatch, Window};
 use super::posegraph::{Edge, PoseGraph};
@@ -253,7 +253,7 @@ impl Default for LogSlamConfig {
             far_min_score: 0.7,
             loop_loosen_ratio: 10.0,
             refine: RefineConfig::default(),
-            manhattan: Some(ManhattanConfig::default()),
+            manhattan: Some(ManhattanConfig::for_logs()),
         }
     }
 }
@@ -719,10 +719,10 @@ impl LogSlam {
                 .iter()
                 .map(|p| scan_direction(p, m).map(|(d, _)| d))
                 .collect();
-            self.stats.square_keys = add_priors(&mut self.graph, &directions, m);
-            if self.stats.square_keys > 0 {
-                self.graph.optimise_robust(20, self.dcs())?;
-            }
+            let dcs = self.dcs();
+            self.stats.square_keys = settle_priors(&mut self.graph, &directions, m, |g| {
+                g.optimise_robust(20, dcs).map(|_| ())
+            })?;
         }
         Ok(())
     }

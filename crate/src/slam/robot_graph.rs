@@ -594,7 +594,7 @@ impl RobotGraph {
                 .iter()
                 .map(|&(k, d)| fold(nodes[k].theta + d))
                 .collect();
-            self.building = building_direction(&votes, m.gate_rad);
+            self.building = building_direction(&votes, m.window_rad);
         }
         let Some(building) = self.building else {
             return;
