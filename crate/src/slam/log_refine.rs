@@ -115,13 +115,20 @@ pub fn refine(
     for _ in 0..cfg.rounds {
         let nodes = graph.nodes.clone();
         for i in (0..nodes.len()).step_by(cfg.every.max(1)) {
-            for centre in visit_centres(&nodes, i, &search) {
+            for centre in visit_centres(&nodes, i, &search, &[]) {
                 if linked.contains(&(centre, i)) {
                     continue;
                 }
-                let Some(c) =
-                    match_visit(&nodes, key_points, i, centre, resolution_m, &search, None)
-                else {
+                let Some(c) = match_visit(
+                    &nodes,
+                    key_points,
+                    i,
+                    centre,
+                    0.0,
+                    resolution_m,
+                    &search,
+                    None,
+                ) else {
                     continue;
                 };
                 let edge_m = 2.0 * resolution_m;

@@ -99,7 +99,7 @@ use super::likelihood::LikelihoodField;
 use super::log_refine::{refine, RefineConfig};
 use super::loop_closure::{
     closure_fit, closure_window, closures_agree, find_closure_among, loosened_along_weak,
-    on_window_edge, Closure, LoopConfig,
+    on_window_edge, paths_to, Closure, LoopConfig,
 };
 use super::manhattan::{scan_direction, settle_priors, ManhattanConfig};
 use super::match_covariance::{edge_information, response_covariance, ResponseWindow};
@@ -593,6 +593,7 @@ impl LogSlam {
             &self.config.loops,
             Some(&self.config.response).filter(|_| self.config.loop_covariance),
             self.config.loop_visits,
+            &self.links(),
         ) else {
             return;
         };
@@ -654,6 +655,14 @@ impl LogSlam {
         }
     }
 
+    /// The accepted closures' keys, `(older, newer)`.
+    fn links(&self) -> Vec<(usize, usize)> {
+        self.closures
+            .iter()
+            .map(|c| (c.from_key, c.to_key))
+            .collect()
+    }
+
     /// Whether closure `c` moves its new key further than the fixed window
     /// (`loops.window`) would have reached: found only thanks to the reach
     /// grown with the path ([`closure_window`]).
@@ -667,7 +676,12 @@ impl LogSlam {
     fn on_window_edge(&self, c: &Closure) -> bool {
         let res = self.config.resolution_m;
         let (nodes, loops) = (&self.graph.nodes, &self.config.loops);
-        let window = closure_window(nodes, c.edge.from, c.edge.to, loops);
+        let path_m = if loops.window_per_m > 0.0 {
+            paths_to(nodes, &self.links(), c.edge.to)[c.edge.from]
+        } else {
+            0.0
+        };
+        let window = closure_window(loops, path_m);
         on_window_edge(nodes, c, &window, 2.0 * res, 0.5f64.to_radians())
     }
 

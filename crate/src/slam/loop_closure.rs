@@ -105,7 +105,7 @@ pub fn find_closure(
     cfg: &LoopConfig,
     response: Option<&ResponseWindow>,
 ) -> Option<Closure> {
-    find_closure_among(nodes, key_points, i, resolution_m, cfg, response, 1)
+    find_closure_among(nodes, key_points, i, resolution_m, cfg, response, 1, &[])
 }
 
 /// [`find_closure`] against up to `visits` earlier passes through the
@@ -113,6 +113,10 @@ pub fn find_closure(
 /// split into visits (runs of keys, a new one after a gap of more than
 /// `2 · submap_half` keys), each visit's nearest key is a centre, and the
 /// best-scoring match of the `visits` nearest centres is returned.
+/// `links` are the closures accepted so far (`(older key, newer key)`):
+/// with a window that grows with the path ([`closure_window`]), the path
+/// is the shortest through them ([`paths_to`]).
+#[allow(clippy::too_many_arguments)]
 pub fn find_closure_among(
     nodes: &[Pose2],
     key_points: &[Vec<DVec2>],
@@ -121,31 +125,47 @@ pub fn find_closure_among(
     cfg: &LoopConfig,
     response: Option<&ResponseWindow>,
     visits: usize,
+    links: &[(usize, usize)],
 ) -> Option<Closure> {
-    visit_centres(nodes, i, cfg)
+    // The path from each key to key i, only when the reach grows with it.
+    let paths = if cfg.window_per_m > 0.0 {
+        paths_to(nodes, links, i)
+    } else {
+        Vec::new()
+    };
+    let path = |j: usize| paths.get(j).copied().unwrap_or(0.0);
+    visit_centres(nodes, i, cfg, &paths)
         .into_iter()
         .take(visits.max(1))
-        .filter_map(|c| match_visit(nodes, key_points, i, c, resolution_m, cfg, response))
+        .filter_map(|c| {
+            match_visit(
+                nodes,
+                key_points,
+                i,
+                c,
+                path(c),
+                resolution_m,
+                cfg,
+                response,
+            )
+        })
         .max_by(|a, b| a.score.total_cmp(&b.score))
 }
 
 /// The nearest key of each visit to key `i`'s place (see
-/// [`find_closure_among`]), nearest first.
-pub(super) fn visit_centres(nodes: &[Pose2], i: usize, cfg: &LoopConfig) -> Vec<usize> {
+/// [`find_closure_among`]), nearest first. `paths[j]` is the path from key
+/// `j` to key `i` ([`paths_to`]; empty: the reach does not grow).
+pub(super) fn visit_centres(
+    nodes: &[Pose2],
+    i: usize,
+    cfg: &LoopConfig,
+    paths: &[f64],
+) -> Vec<usize> {
     if i < cfg.min_key_gap {
         return Vec::new();
     }
     let here = nodes[i].position();
-    // The path from each key to key i, only when the reach grows with it.
-    let travelled = if cfg.window_per_m > 0.0 {
-        travelled_m(nodes, i)
-    } else {
-        Vec::new()
-    };
-    let widening = |j: usize| match travelled.get(j) {
-        Some(&t) => widening_m(cfg, travelled[i] - t),
-        None => 0.0,
-    };
+    let widening = |j: usize| paths.get(j).map_or(0.0, |&p| widening_m(cfg, p));
     let near: Vec<(usize, f64)> = (0..=i - cfg.min_key_gap)
         .map(|j| (j, nodes[j].position().distance(here)))
         .filter(|&(j, d)| d <= cfg.search_radius_m + widening(j))
@@ -168,23 +188,62 @@ pub(super) fn visit_centres(nodes: &[Pose2], i: usize, cfg: &LoopConfig) -> Vec<
     centres.into_iter().map(|c| c.0).collect()
 }
 
-/// The distance the estimate travels from key 0 to each key up to `i`
-/// (m), key by key.
-fn travelled_m(nodes: &[Pose2], i: usize) -> Vec<f64> {
-    let mut sum = 0.0;
-    let mut out = Vec::with_capacity(i + 1);
-    for k in 0..=i {
-        if k > 0 {
-            sum += step_m(nodes, k - 1);
+/// The shortest path (m) from each key `j ≤ i` to key `i` along the chain
+/// of keys (the distance the estimate moves from key to key) and across
+/// the accepted closures `links` (the distance between their two keys'
+/// estimates), by Dijkstra's algorithm. Without links it is the path the
+/// estimate travelled since key `j`; with them, a place already tied to
+/// the newer part of the tour is near it however long ago it was first
+/// seen, as its drift has been taken out.
+pub fn paths_to(nodes: &[Pose2], links: &[(usize, usize)], i: usize) -> Vec<f64> {
+    let n = i + 1;
+    let mut across: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for &(a, b) in links {
+        if a < n && b < n && a != b {
+            across[a].push(b);
+            across[b].push(a);
         }
-        out.push(sum);
     }
-    out
+    let mut dist = vec![f64::INFINITY; n];
+    let mut done = vec![false; n];
+    // (distance, key) ordered by distance, nearest first.
+    let mut queue = std::collections::BinaryHeap::new();
+    dist[i] = 0.0;
+    queue.push(std::cmp::Reverse((Ordered(0.0), i)));
+    while let Some(std::cmp::Reverse((Ordered(d), k))) = queue.pop() {
+        if done[k] {
+            continue;
+        }
+        done[k] = true;
+        let chain = [k.checked_sub(1), (k + 1 < n).then_some(k + 1)];
+        let neighbours = chain.into_iter().flatten().chain(across[k].iter().copied());
+        for m in neighbours {
+            let step = nodes[m].position().distance(nodes[k].position());
+            if d + step < dist[m] {
+                dist[m] = d + step;
+                queue.push(std::cmp::Reverse((Ordered(d + step), m)));
+            }
+        }
+    }
+    dist
 }
 
-/// The distance the estimate moves from key `k` to key `k + 1` (m).
-fn step_m(nodes: &[Pose2], k: usize) -> f64 {
-    nodes[k + 1].position().distance(nodes[k].position())
+/// An `f64` ordered by `total_cmp`, for the queue of [`paths_to`].
+#[derive(Clone, Copy, PartialEq)]
+struct Ordered(f64);
+
+impl Eq for Ordered {}
+
+impl PartialOrd for Ordered {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Ordered {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0)
+    }
 }
 
 /// How much further than `cfg.window` a closure search reaches after the
@@ -194,9 +253,9 @@ fn widening_m(cfg: &LoopConfig, path_m: f64) -> f64 {
     (reach - cfg.window.linear_m).max(0.0)
 }
 
-/// The window a closure of key `i` onto the visit around `centre` is
-/// searched in: `cfg.window`, its reach grown by `window_per_m` for every
-/// metre the estimate travelled from `centre` to `i`, up to `max_window_m`.
+/// The window a closure onto a visit `path_m` along the tour from the new
+/// key ([`paths_to`]) is searched in: `cfg.window`, its reach grown by
+/// `window_per_m` for every metre of that path, up to `max_window_m`.
 ///
 /// The drift a revisit must undo grows with the path since the place was
 /// last seen: on the logs of `../shared/data` it never passed 0.36 m, but
@@ -204,7 +263,13 @@ fn widening_m(cfg: &LoopConfig, path_m: f64) -> f64 {
 /// reached 3–8 m, far outside a fixed 1.5 m window, and the loops stayed
 /// open. Karto sizes its loop search by the covariance accumulated along
 /// the chain; a reach proportional to the path is that bound for drift
-/// that grows with distance.
+/// that grows with distance. The path is the shortest through the
+/// closures accepted so far (session 33): a place already tied to the
+/// newer part of the tour has had its drift taken out, and the search
+/// there stays near the fixed window. Against the path the estimate
+/// travelled, that takes the five shared logs' replays from 4× to about
+/// 1.5× the time with the reach fixed, with the same closures on the
+/// halls; an outdoor campus, with few closures, still takes 9×.
 ///
 /// [`match_visit`] searches the fixed window first and the grown one only
 /// where the fixed one finds nothing good enough, and a match found there
@@ -215,12 +280,9 @@ fn widening_m(cfg: &LoopConfig, path_m: f64) -> f64 {
 /// metre): measured on fourteen logs (BENCHMARKS.md, issue 21, session
 /// 32) it adds no wrong closure and closes the halls' loops, but makes one
 /// of the tuned logs worse by a centimetre and the replays 4–10× slower.
-pub fn closure_window(nodes: &[Pose2], centre: usize, i: usize, cfg: &LoopConfig) -> Window {
-    let path: f64 = (centre.min(i)..centre.max(i))
-        .map(|k| step_m(nodes, k))
-        .sum();
+pub fn closure_window(cfg: &LoopConfig, path_m: f64) -> Window {
     Window {
-        linear_m: cfg.window.linear_m + widening_m(cfg, path),
+        linear_m: cfg.window.linear_m + widening_m(cfg, path_m),
         angular_rad: cfg.window.angular_rad,
     }
 }
@@ -252,12 +314,15 @@ pub(super) fn on_window_edge(
         || wrap_angle(found.theta - here.theta).abs() > window.angular_rad - margin_rad
 }
 
-/// Matches key `i` against the key scans around `centre`.
+/// Matches key `i` against the key scans around `centre`, `path_m` along
+/// the tour from it ([`closure_window`]).
+#[allow(clippy::too_many_arguments)]
 pub(super) fn match_visit(
     nodes: &[Pose2],
     key_points: &[Vec<DVec2>],
     i: usize,
     centre: usize,
+    path_m: f64,
     resolution_m: f64,
     cfg: &LoopConfig,
     response: Option<&ResponseWindow>,
@@ -276,7 +341,7 @@ pub(super) fn match_visit(
     let (field, m) = match found.filter(|m| m.score >= cfg.min_score) {
         Some(m) => (field, m),
         None => {
-            let window = closure_window(nodes, centre, i, cfg);
+            let window = closure_window(cfg, path_m);
             if window.linear_m <= cfg.window.linear_m {
                 return None;
             }
@@ -485,15 +550,48 @@ mod tests {
             max_window_m: 8.0,
             ..LoopConfig::default()
         };
-        let reach = |centre, i| closure_window(&nodes, centre, i, &cfg).linear_m;
+        let reach = |centre: usize, i: usize| {
+            closure_window(&cfg, paths_to(&nodes, &[], i)[centre]).linear_m
+        };
         assert!((reach(0, 10) - (1.5 + 0.03 * 20.0)).abs() < 1e-12);
         assert!((reach(5, 55) - (1.5 + 0.03 * 100.0)).abs() < 1e-12);
         assert_eq!(reach(0, 199), 8.0);
         let fixed = LoopConfig::default();
-        assert_eq!(closure_window(&nodes, 0, 199, &fixed).linear_m, 1.5);
+        assert_eq!(closure_window(&fixed, 398.0).linear_m, 1.5);
         assert_eq!(
-            closure_window(&nodes, 0, 199, &cfg).angular_rad,
+            closure_window(&cfg, 398.0).angular_rad,
             fixed.window.angular_rad
         );
+    }
+
+    /// The path to a key runs along the chain, or across an accepted
+    /// closure where that is shorter: a tour out along a corridor and back
+    /// beside it, tied once near its start.
+    #[test]
+    fn paths_run_along_the_chain_or_across_a_closure() {
+        // Keys 0–5 out along y = 0, 1 m apart; keys 6–10 back along y = 0.5.
+        let nodes: Vec<Pose2> = (0..=10)
+            .map(|k| {
+                if k <= 5 {
+                    Pose2::new(k as f64, 0.0, 0.0)
+                } else {
+                    Pose2::new((10 - k) as f64, 0.5, 0.0)
+                }
+            })
+            .collect();
+        let turn = 1.25f64.sqrt();
+        let chain = paths_to(&nodes, &[], 10);
+        assert!((chain[0] - (9.0 + turn)).abs() < 1e-12, "{}", chain[0]);
+        assert!((chain[5] - (4.0 + turn)).abs() < 1e-12, "{}", chain[5]);
+        assert_eq!(chain[10], 0.0);
+        // Key 1 tied to key 9 (0.5 m apart): key 0 is 1 + 0.5 + 1 m away,
+        // key 3 1 + 0.5 + 2 m.
+        let tied = paths_to(&nodes, &[(1, 9)], 10);
+        assert!((tied[0] - 2.5).abs() < 1e-12, "{}", tied[0]);
+        assert!((tied[3] - 3.5).abs() < 1e-12, "{}", tied[3]);
+        // Key 5 is still nearer along the chain (5.118 m against 5.5 m).
+        assert!((tied[5] - (4.0 + turn)).abs() < 1e-12, "{}", tied[5]);
+        // Keys after `i` are not part of its paths.
+        assert_eq!(paths_to(&nodes, &[(1, 9)], 6).len(), 7);
     }
 }
