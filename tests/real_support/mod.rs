@@ -221,9 +221,10 @@ pub fn table(name: &str, o: &Outcome) -> String {
     s
 }
 
-/// The square walls' settings of `cfg`, switched on with the defaults if off.
+/// The square walls' settings of `cfg`, switched on with a log's defaults
+/// if off.
 fn manhattan(cfg: &mut LogSlamConfig) -> &mut ManhattanConfig {
-    cfg.manhattan.get_or_insert_with(ManhattanConfig::default)
+    cfg.manhattan.get_or_insert_with(ManhattanConfig::for_logs)
 }
 
 /// The defaults with the overrides of `$SLAMLAB_LOG_SLAM`.
@@ -285,7 +286,7 @@ pub fn config_from_env() -> LogSlamConfig {
             "key_distance_m" => cfg.key_distance_m = v,
             "key_angle_deg" => cfg.key_angle_rad = v.to_radians(),
             "point_spacing_m" => cfg.point_spacing_m = v,
-            "manhattan" => cfg.manhattan = (v != 0.0).then(ManhattanConfig::default),
+            "manhattan" => cfg.manhattan = (v != 0.0).then(ManhattanConfig::for_logs),
             "manhattan_sigma_deg" => manhattan(&mut cfg).sigma_rad = v.to_radians(),
             "manhattan_rounds" => manhattan(&mut cfg).rounds = v as usize,
             "manhattan_gate_deg" => manhattan(&mut cfg).gate_rad = v.to_radians(),
