@@ -265,6 +265,7 @@ pub fn config_from_env() -> LogSlamConfig {
             "loop_window_m" => cfg.loops.window.linear_m = v,
             "loop_window_per_m" => cfg.loops.window_per_m = v,
             "loop_max_window_m" => cfg.loops.max_window_m = v,
+            "grown_every" => cfg.grown_every = v as usize,
             "far_min_score" => cfg.far_min_score = v,
             "unique_ratio" => cfg.loops.unique_ratio = v,
             "loop_window_deg" => cfg.loops.window.angular_rad = v.to_radians(),

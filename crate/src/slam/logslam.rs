@@ -62,7 +62,15 @@
 //!    `loop_loosen_ratio` (10) times the variance; a corridor's closure
 //!    then holds the corridor's two walls without pinning where along it
 //!    the key lies (relation errors lower on all five logs on average over
-//!    four drift seeds, BENCHMARKS.md, session 29).
+//!    four drift seeds, BENCHMARKS.md, session 29). The search window
+//!    reaches ±1.5 m, and on one try in `grown_every` (4) further, by
+//!    0.03 m for every metre of the shortest path from the old key through
+//!    the chain and the closures accepted so far, up to 8 m
+//!    ([`super::loop_closure::closure_window`]): in a convention hall or
+//!    around a campus the drift a revisit must undo reaches metres. A
+//!    match found only in the grown reach must score `far_min_score` and
+//!    have no rival near as good; after one, every try searches the grown
+//!    window for `confirm_keys` keys so that a second can confirm it.
 //! 5. **Chain of recent keys** (Karto's scan-to-scan links, off unless
 //!    `chain_keys` > 0): the new key's scan is also matched against each of
 //!    the `chain_keys` keys before the previous one, alone, and every match
@@ -98,8 +106,8 @@ use super::grid::{GridConfig, OccupancyGrid, GROW_STEP_CELLS};
 use super::likelihood::LikelihoodField;
 use super::log_refine::{refine, RefineConfig};
 use super::loop_closure::{
-    closure_fit, closure_window, closures_agree, find_closure_among, loosened_along_weak,
-    on_window_edge, paths_to, Closure, LoopConfig,
+    closure_fit, closures_agree, find_closure_among, loosened_along_weak, on_window_edge, Closure,
+    LoopConfig,
 };
 use super::manhattan::{scan_direction, settle_priors, ManhattanConfig};
 use super::match_covariance::{edge_information, response_covariance, ResponseWindow};
@@ -187,6 +195,14 @@ pub struct LogSlamConfig {
     /// it ([`super::loop_closure::closure_fit`]; 0: off). A corridor pins a scan only across
     /// itself, and a closure there can slide along it by metres.
     pub loop_min_weak: f64,
+    /// With a closure window that grows with the path
+    /// (`loops.window_per_m` > 0): the grown window is searched on one try
+    /// in this many (tries are `loop_every` keys apart), and on every try
+    /// for `confirm_keys` keys after a try found a match in it, so that a
+    /// second can confirm the first. A revisit lasts many keys, so a hall's
+    /// loop still closes; an outdoor tour that rarely closes one stops
+    /// paying the wide search on every key. 1: every try.
+    pub grown_every: usize,
     /// The score a closure must reach when it moves its key beyond the
     /// fixed window (`loops.window`): a search grown with the path sees
     /// more of a building, and a corridor's doors repeat.
@@ -250,6 +266,7 @@ impl Default for LogSlamConfig {
             loop_visits: 1,
             loop_edge_reject: true,
             loop_min_weak: 0.0,
+            grown_every: 4,
             far_min_score: 0.7,
             loop_loosen_ratio: 10.0,
             refine: RefineConfig::default(),
@@ -326,6 +343,9 @@ pub struct LogSlam {
     /// The covariance of the match that made the next key (world frame).
     key_cov: Option<[[f64; 3]; 3]>,
     pending: Vec<Closure>,
+    /// The grown closure window is searched on every try up to this key:
+    /// a try there found a match beyond the fixed window (`grown_every`).
+    grow_until: usize,
     pub closures: Vec<ClosureInfo>,
     pub stats: LogSlamStats,
 }
@@ -396,6 +416,7 @@ impl LogSlam {
             unmatched_since_key: false,
             key_cov: None,
             pending: Vec::new(),
+            grow_until: 0,
             closures: Vec::new(),
             stats: LogSlamStats::default(),
         }
@@ -585,6 +606,7 @@ impl LogSlam {
     /// two agree.
     fn try_close(&mut self, id: usize) {
         self.stats.closures_tried += 1;
+        let links = self.grow_window(id).then(|| self.links());
         let Some(found) = find_closure_among(
             &self.graph.nodes,
             &self.key_points,
@@ -593,11 +615,14 @@ impl LogSlam {
             &self.config.loops,
             Some(&self.config.response).filter(|_| self.config.loop_covariance),
             self.config.loop_visits,
-            &self.links(),
+            links.as_deref(),
         ) else {
             return;
         };
         self.stats.closures_found += 1;
+        if found.window.linear_m > self.config.loops.window.linear_m {
+            self.grow_until = id + self.config.confirm_keys;
+        }
         if found.score < self.config.far_min_score && self.beyond_base_window(&found) {
             self.stats.closures_far_weak += 1;
             return;
@@ -655,6 +680,15 @@ impl LogSlam {
         }
     }
 
+    /// Whether the try at key `id` searches the grown closure window
+    /// (`grown_every`).
+    fn grow_window(&self, id: usize) -> bool {
+        let cfg = &self.config;
+        cfg.loops.window_per_m > 0.0
+            && ((id / cfg.loop_every.max(1)).is_multiple_of(cfg.grown_every.max(1))
+                || id <= self.grow_until)
+    }
+
     /// The accepted closures' keys, `(older, newer)`.
     fn links(&self) -> Vec<(usize, usize)> {
         self.closures
@@ -671,18 +705,18 @@ impl LogSlam {
         on_window_edge(&self.graph.nodes, c, window, 0.0, 0.0)
     }
 
-    /// Whether closure `c`'s match lies on the edge of the search window
-    /// (within two cells of a side, half a degree of the heading range).
+    /// Whether closure `c`'s match lies on the edge of the window it was
+    /// searched in (within two cells of a side, half a degree of the
+    /// heading range).
     fn on_window_edge(&self, c: &Closure) -> bool {
         let res = self.config.resolution_m;
-        let (nodes, loops) = (&self.graph.nodes, &self.config.loops);
-        let path_m = if loops.window_per_m > 0.0 {
-            paths_to(nodes, &self.links(), c.edge.to)[c.edge.from]
-        } else {
-            0.0
-        };
-        let window = closure_window(loops, path_m);
-        on_window_edge(nodes, c, &window, 2.0 * res, 0.5f64.to_radians())
+        on_window_edge(
+            &self.graph.nodes,
+            c,
+            &c.window,
+            2.0 * res,
+            0.5f64.to_radians(),
+        )
     }
 
     /// Adds confirmed closures, optimises, and undoes it all if a closure

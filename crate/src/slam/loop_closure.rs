@@ -85,11 +85,13 @@ impl Default for LoopConfig {
     }
 }
 
-/// A loop closure found: the edge and its match score.
+/// A loop closure found: the edge, its match score and the window it was
+/// found in (the fixed one or one grown with the path, [`closure_window`]).
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Closure {
     pub edge: Edge,
     pub score: f64,
+    pub window: Window,
 }
 
 /// Looks for a closure of key `i` (pose `nodes[i]`, points `key_points[i]`
@@ -105,7 +107,7 @@ pub fn find_closure(
     cfg: &LoopConfig,
     response: Option<&ResponseWindow>,
 ) -> Option<Closure> {
-    find_closure_among(nodes, key_points, i, resolution_m, cfg, response, 1, &[])
+    find_closure_among(nodes, key_points, i, resolution_m, cfg, response, 1, None)
 }
 
 /// [`find_closure`] against up to `visits` earlier passes through the
@@ -115,7 +117,9 @@ pub fn find_closure(
 /// best-scoring match of the `visits` nearest centres is returned.
 /// `links` are the closures accepted so far (`(older key, newer key)`):
 /// with a window that grows with the path ([`closure_window`]), the path
-/// is the shortest through them ([`paths_to`]).
+/// is the shortest through them ([`paths_to`]). `None` searches the fixed
+/// window only, whatever `cfg.window_per_m` says: the driver grows the
+/// window on some tries only.
 #[allow(clippy::too_many_arguments)]
 pub fn find_closure_among(
     nodes: &[Pose2],
@@ -125,13 +129,12 @@ pub fn find_closure_among(
     cfg: &LoopConfig,
     response: Option<&ResponseWindow>,
     visits: usize,
-    links: &[(usize, usize)],
+    links: Option<&[(usize, usize)]>,
 ) -> Option<Closure> {
     // The path from each key to key i, only when the reach grows with it.
-    let paths = if cfg.window_per_m > 0.0 {
-        paths_to(nodes, links, i)
-    } else {
-        Vec::new()
+    let paths = match links {
+        Some(links) if cfg.window_per_m > 0.0 => paths_to(nodes, links, i),
+        _ => Vec::new(),
     };
     let path = |j: usize| paths.get(j).copied().unwrap_or(0.0);
     visit_centres(nodes, i, cfg, &paths)
@@ -276,10 +279,15 @@ fn widening_m(cfg: &LoopConfig, path_m: f64) -> f64 {
 /// must have no rival: no pose more than [`RIVAL_EXCLUDE_M`] from it may
 /// score `unique_ratio` of its score (a corridor's doors repeat, and a
 /// window that reaches several metres along one finds the wrong door as
-/// readily as the right one). It is a setting, off by default (0 per
-/// metre): measured on fourteen logs (BENCHMARKS.md, issue 21, session
-/// 32) it adds no wrong closure and closes the halls' loops, but makes one
-/// of the tuned logs worse by a centimetre and the replays 4–10× slower.
+/// readily as the right one). `LoopConfig::default` keeps it off (0 per
+/// metre), as the simulated robots' back end does. A replayed log's driver
+/// ([`super::logslam`]) turns it on (0.03 per metre, 8 m at most) and
+/// grows it on one try in four only (`grown_every`; `links: None` to
+/// [`find_closure_among`] on the other tries). Grown on every try it made
+/// one of the tuned logs worse by a centimetre and the replays 4–10×
+/// slower; one try in four keeps most of the halls' gains at a third of
+/// that cost and leaves the five shared logs as they were (BENCHMARKS.md,
+/// issue 21, sessions 32–34).
 pub fn closure_window(cfg: &LoopConfig, path_m: f64) -> Window {
     Window {
         linear_m: cfg.window.linear_m + widening_m(cfg, path_m),
@@ -338,8 +346,8 @@ pub(super) fn match_visit(
     let points = &key_points[i];
     let field = field_from_points(&world, resolution_m, 8, cfg.window.linear_m + 1.0);
     let found = match_scan(&field, points, &nodes[i], &cfg.window);
-    let (field, m) = match found.filter(|m| m.score >= cfg.min_score) {
-        Some(m) => (field, m),
+    let (field, m, window) = match found.filter(|m| m.score >= cfg.min_score) {
+        Some(m) => (field, m, cfg.window.clone()),
         None => {
             let window = closure_window(cfg, path_m);
             if window.linear_m <= cfg.window.linear_m {
@@ -354,7 +362,7 @@ pub(super) fn match_visit(
             if rival > cfg.unique_ratio * m.search_score {
                 return None;
             }
-            (field, m)
+            (field, m, window)
         }
     };
     let mut edge = Edge::new(
@@ -374,6 +382,7 @@ pub(super) fn match_visit(
     Some(Closure {
         edge,
         score: m.score,
+        window,
     })
 }
 
@@ -486,7 +495,13 @@ mod tests {
             .collect();
         let i = nodes.len() - 1;
         let edge = Edge::new(0, i, nodes[0].between(&nodes[i]), 0.05, 0.02);
-        (nodes, key_points, Closure { edge, score: 1.0 }, cfg)
+        let window = cfg.window.clone();
+        let closure = Closure {
+            edge,
+            score: 1.0,
+            window,
+        };
+        (nodes, key_points, closure, cfg)
     }
 
     /// A room pins a closure in every direction: tens of points' worth
@@ -567,6 +582,58 @@ mod tests {
     /// The path to a key runs along the chain, or across an accepted
     /// closure where that is shorter: a tour out along a corridor and back
     /// beside it, tied once near its start.
+    /// A room left and come back to after about 100 m of path, the
+    /// estimate 2.5 m off: the window grown with the path (reach 4 m)
+    /// finds the true pose; without the accepted closures' list
+    /// (`links: None`, a try the driver does not grow) the search is the
+    /// fixed window's, exactly as with the growth switched off.
+    #[test]
+    fn a_grown_window_reaches_a_revisit_the_fixed_one_cannot() {
+        let walls = scenes::room();
+        // The first visit along the room, then keys far outside it.
+        let mut nodes: Vec<Pose2> = (0..12)
+            .map(|k| Pose2::new(2.0 + 0.3 * k as f64, 3.0, 0.0))
+            .collect();
+        nodes.extend((0..48).map(|k| Pose2::new(30.0 + 0.5 * k as f64, 3.0, 0.0)));
+        let truth = Pose2::new(2.6, 3.1, 0.0);
+        nodes.push(Pose2::new(truth.x + 2.5, truth.y + 0.4, 0.0));
+        let i = nodes.len() - 1;
+        let mut key_points: Vec<Vec<DVec2>> = nodes
+            .iter()
+            .map(|p| scenes::scan(p, &walls, 10.0))
+            .collect();
+        key_points[i] = scenes::scan(&truth, &walls, 10.0);
+        let cfg = LoopConfig {
+            min_key_gap: 10,
+            submap_half: 2,
+            window: Window {
+                linear_m: 1.5,
+                angular_rad: 3f64.to_radians(),
+            },
+            window_per_m: 0.03,
+            max_window_m: 4.0,
+            ..LoopConfig::default()
+        };
+        let find = |cfg: &LoopConfig, links: Option<&[(usize, usize)]>| {
+            find_closure_among(&nodes, &key_points, i, 0.05, cfg, None, 1, links)
+        };
+        let grown = find(&cfg, Some(&[])).expect("a closure in the grown window");
+        assert_eq!(grown.window.linear_m, 4.0);
+        let found = nodes[grown.edge.from].compose(&grown.edge.measurement);
+        assert!(
+            found.position().distance(truth.position()) < 0.1,
+            "{found:?}"
+        );
+        assert!(wrap_angle(found.theta - truth.theta).abs() < 0.5f64.to_radians());
+        let fixed = LoopConfig {
+            window_per_m: 0.0,
+            ..cfg.clone()
+        };
+        let not_grown = find(&cfg, None);
+        assert_eq!(not_grown, find(&fixed, Some(&[])));
+        assert!(not_grown.is_none_or(|c| c.window.linear_m == 1.5));
+    }
+
     #[test]
     fn paths_run_along_the_chain_or_across_a_closure() {
         // Keys 0–5 out along y = 0, 1 m apart; keys 6–10 back along y = 0.5.
