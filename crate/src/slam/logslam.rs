@@ -241,7 +241,12 @@ impl Default for LogSlamConfig {
             },
             min_match_score: 0.35,
             close_loops: true,
-            loops: LoopConfig::default(),
+            // The closure window grows with the path (on one try in
+            // `grown_every`): a hall's loop needs a correction of metres.
+            loops: LoopConfig {
+                window_per_m: 0.03,
+                ..LoopConfig::default()
+            },
             loop_every: 2,
             confirm_keys: 12,
             confirm_m: 0.3,
