@@ -18,6 +18,15 @@
 //! Ties go to the candidate nearest the prior, so a flat response (a
 //! featureless corridor) does not pull the pose anywhere.
 //!
+//! A window metres wide (a loop closure's, grown with the path since the
+//! place was seen) has thousands of coarse blocks at each rotation, and
+//! scoring them all becomes the cost. Such a search adds a third level, as
+//! Cartographer's branch and bound stacks several (Hess et al., *Real-Time
+//! Loop Closure in 2D LIDAR SLAM*, ICRA 2016, §V-C): groups of 4 × 4 coarse
+//! blocks bounded by one table of maxima, whose blocks are scored only when
+//! the group's bound can still win. A priority queue hands the blocks out
+//! in exactly the flat search's order, so both return the same pose.
+//!
 //! The result is accurate to one cell and `angular_step`; the mapper
 //! refines it with [`super::surface`] (or, on a grid without surface means,
 //! [`super::gauss_newton`]). The mapper searches only when refining from
@@ -93,6 +102,19 @@ pub fn search_outside(
     cfg: &CorrelativeConfig,
     exclude: Option<Exclusion>,
 ) -> Option<CorrelativeMatch> {
+    search_blocks(field, points, prior, cfg, exclude, DEEP_MIN_BLOCKS)
+}
+
+/// [`search_outside`], with the third level from `deep_from` coarse blocks
+/// along each axis on.
+fn search_blocks(
+    field: &LikelihoodField,
+    points: &[DVec2],
+    prior: &Pose2,
+    cfg: &CorrelativeConfig,
+    exclude: Option<Exclusion>,
+    deep_from: usize,
+) -> Option<CorrelativeMatch> {
     if points.is_empty() {
         return None;
     }
@@ -141,48 +163,30 @@ pub fn search_outside(
             .iter()
             .fold(0f32, |a, &i| a + table[(i + off) as usize])
     };
-    // Coarse candidates.
-    struct Candidate {
-        score: f32,
-        t: i64,
-        ox: i64,
-        oy: i64,
-        order: u32,
-    }
-    let mut candidates = Vec::new();
+    // Coarse candidates: every block of `k × k` translations at every
+    // rotation, bounded by the coarse table.
     let starts: Vec<i64> = (0..).map(|i| -w + i * k).take_while(|&o| o <= w).collect();
-    for (ti, t) in (-nt..=nt).enumerate() {
-        let pc = &cells[ti * n..(ti + 1) * n];
-        for &oy in &starts {
-            for &ox in &starts {
-                let score: f32 = if inside[ti] {
-                    score_at(&field.coarse, ti, ox, oy)
-                } else {
-                    pc.iter()
-                        .map(|c| field.coarse_at(c[0] + ox, c[1] + oy))
-                        .sum()
-                };
-                let order = candidates.len() as u32;
-                candidates.push(Candidate {
-                    score,
-                    t,
-                    ox,
-                    oy,
-                    order,
-                });
-            }
+    let per_axis = starts.len();
+    let coarse_score = |ti: usize, ox: i64, oy: i64| -> f32 {
+        if inside[ti] {
+            score_at(&field.coarse, ti, ox, oy)
+        } else {
+            cells[ti * n..(ti + 1) * n]
+                .iter()
+                .map(|c| field.coarse_at(c[0] + ox, c[1] + oy))
+                .sum()
         }
-    }
-    // Best first; equal scores in the order scored (as a stable sort would).
-    candidates.sort_unstable_by(|a, b| b.score.total_cmp(&a.score).then(a.order.cmp(&b.order)));
-    // Branch and bound at fine resolution.
+    };
+    // Branch and bound at fine resolution, the blocks taken best first
+    // (equal scores in the order scored, as a stable sort would).
     let dist = |t: i64, x: i64, y: i64| t.abs() + x.abs() + y.abs();
-    let mut best: Option<(f32, i64, i64, i64)> = None;
+    type Best = Option<(f32, i64, i64, i64)>;
+    let mut best: Best = None;
     let mut evaluations = 0;
-    for c in &candidates {
-        if let Some((b, ..)) = best {
+    let visit = |c: &Candidate, best: &mut Best, evaluations: &mut usize| -> bool {
+        if let Some((b, ..)) = *best {
             if c.score < b - 1e-4 {
-                break;
+                return false;
             }
         }
         let ti = (c.t + nt) as usize;
@@ -203,15 +207,105 @@ pub fn search_outside(
                 } else {
                     pc.iter().map(|q| field.fine_at(q[0] + ox, q[1] + oy)).sum()
                 };
-                evaluations += 1;
-                let better = match best {
+                *evaluations += 1;
+                let better = match *best {
                     None => true,
                     Some((b, bt, bx, by)) => {
                         s > b + 1e-4 || (s >= b - 1e-4 && dist(c.t, ox, oy) < dist(bt, bx, by))
                     }
                 };
                 if better {
-                    best = Some((s, c.t, ox, oy));
+                    *best = Some((s, c.t, ox, oy));
+                }
+            }
+        }
+        true
+    };
+    if per_axis < deep_from {
+        let mut candidates = Vec::with_capacity(n_theta * per_axis * per_axis);
+        for (ti, t) in (-nt..=nt).enumerate() {
+            for &oy in &starts {
+                for &ox in &starts {
+                    let order = candidates.len() as u32;
+                    let score = coarse_score(ti, ox, oy);
+                    candidates.push(Candidate {
+                        score,
+                        t,
+                        ox,
+                        oy,
+                        order,
+                    });
+                }
+            }
+        }
+        candidates.sort_unstable_by(|a, b| b.score.total_cmp(&a.score).then(a.order.cmp(&b.order)));
+        for c in &candidates {
+            if !visit(c, &mut best, &mut evaluations) {
+                break;
+            }
+        }
+    } else {
+        // A wide window: a third level over the coarse one, so most blocks
+        // are never scored (see [`DEEP_MIN_BLOCKS`]).
+        let top = top_table(field);
+        let top_score = |ti: usize, ox: i64, oy: i64| -> f32 {
+            if inside[ti] {
+                score_at(&top, ti, ox, oy)
+            } else {
+                cells[ti * n..(ti + 1) * n]
+                    .iter()
+                    .map(|c| table_at(&top, field, c[0] + ox, c[1] + oy))
+                    .sum()
+            }
+        };
+        let groups = per_axis.div_ceil(TOP_BLOCKS);
+        let mut queue = std::collections::BinaryHeap::new();
+        for ti in 0..n_theta {
+            for gy in 0..groups {
+                for gx in 0..groups {
+                    let (ox, oy) = (starts[gx * TOP_BLOCKS], starts[gy * TOP_BLOCKS]);
+                    queue.push(Queued {
+                        score: top_score(ti, ox, oy),
+                        group: true,
+                        order: ((ti * groups + gy) * groups + gx) as u32,
+                    });
+                }
+            }
+        }
+        while let Some(q) = queue.pop() {
+            if let Some((b, ..)) = best {
+                if q.score < b - 1e-4 {
+                    break;
+                }
+            }
+            if q.group {
+                let o = q.order as usize;
+                let (ti, gy, gx) = (o / (groups * groups), o / groups % groups, o % groups);
+                for iy in gy * TOP_BLOCKS..((gy + 1) * TOP_BLOCKS).min(per_axis) {
+                    for ix in gx * TOP_BLOCKS..((gx + 1) * TOP_BLOCKS).min(per_axis) {
+                        queue.push(Queued {
+                            score: coarse_score(ti, starts[ix], starts[iy]),
+                            group: false,
+                            order: ((ti * per_axis + iy) * per_axis + ix) as u32,
+                        });
+                    }
+                }
+            } else {
+                let o = q.order as usize;
+                let (ti, iy, ix) = (
+                    o / (per_axis * per_axis),
+                    o / per_axis % per_axis,
+                    o % per_axis,
+                );
+                let c = Candidate {
+                    score: q.score,
+                    t: ti as i64 - nt,
+                    ox: starts[ix],
+                    oy: starts[iy],
+                    order: q.order,
+                };
+                if !visit(&c, &mut best, &mut evaluations) {
+                    break;
                 }
             }
         }
@@ -226,4 +320,192 @@ pub fn search_outside(
         score: s as f64 / n as f64,
         fine_evaluations: evaluations,
     })
+}
+
+/// A coarse block of [`search_outside`]'s branch and bound.
+struct Candidate {
+    score: f32,
+    t: i64,
+    ox: i64,
+    oy: i64,
+    order: u32,
+}
+
+/// From this many coarse blocks along each axis of the window on, the
+/// search adds a third level: groups of [`TOP_BLOCKS`] × [`TOP_BLOCKS`]
+/// coarse blocks bounded by one table ([`top_table`]), and scores a group's
+/// coarse blocks only when the group's bound can still beat the best pose.
+/// A loop closure's window grown to ±8 m at 5 cm holds 41 × 41 coarse
+/// blocks at each of some 170 rotations; scoring them all was most of the
+/// search. The blocks are then taken from a priority queue in exactly the
+/// order the flat search sorts them (score, then the order scored; a group
+/// before a block of equal score, since its blocks may score that too), so
+/// both searches visit the same blocks and return the same pose.
+const DEEP_MIN_BLOCKS: usize = 12;
+
+/// Coarse blocks per group along each axis (see [`DEEP_MIN_BLOCKS`]).
+const TOP_BLOCKS: usize = 4;
+
+/// A group or a coarse block in the queue of the three-level search: best
+/// score first, a group before a block of equal score, then the lower
+/// order.
+struct Queued {
+    score: f32,
+    group: bool,
+    order: u32,
+}
+
+impl PartialEq for Queued {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == std::cmp::Ordering::Equal
+    }
+}
+
+impl Eq for Queued {}
+
+impl PartialOrd for Queued {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Queued {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.score
+            .total_cmp(&other.score)
+            .then(self.group.cmp(&other.group))
+            .then(other.order.cmp(&self.order))
+    }
+}
+
+/// The maximum of the coarse table over [`TOP_BLOCKS`] × [`TOP_BLOCKS`]
+/// blocks from each cell: `top[x, y]` bounds the fine table over
+/// `[x, x + TOP_BLOCKS · k)` on both axes (cells beyond the table count 0).
+fn top_table(field: &LikelihoodField) -> Vec<f32> {
+    let (wd, ht, k) = (field.width, field.height, field.k);
+    let mut rows = vec![0f32; wd * ht];
+    for y in 0..ht {
+        let src = &field.coarse[y * wd..(y + 1) * wd];
+        let dst = &mut rows[y * wd..(y + 1) * wd];
+        for (x, d) in dst.iter_mut().enumerate() {
+            *d = (0..TOP_BLOCKS)
+                .map(|i| x + i * k)
+                .take_while(|&xi| xi < wd)
+                .fold(0f32, |m, xi| m.max(src[xi]));
+        }
+    }
+    let mut top = vec![0f32; wd * ht];
+    for y in 0..ht {
+        for i in 0..TOP_BLOCKS {
+            let yi = y + i * k;
+            if yi >= ht {
+                break;
+            }
+            let (src, dst) = (
+                &rows[yi * wd..(yi + 1) * wd],
+                &mut top[y * wd..(y + 1) * wd],
+            );
+            for (d, &v) in dst.iter_mut().zip(src) {
+                *d = d.max(v);
+            }
+        }
+    }
+    top
+}
+
+/// `table` (laid out as `field`'s) at window cell `(x, y)`, 0 outside.
+fn table_at(table: &[f32], field: &LikelihoodField, x: i64, y: i64) -> f32 {
+    if x < 0 || y < 0 || x >= field.width as i64 || y >= field.height as i64 {
+        0.0
+    } else {
+        table[y as usize * field.width + x as usize]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::slam::multires::field_from_points;
+    use crate::slam::scenes;
+
+    /// A window of ±6 m (31 coarse blocks a side): the three-level search
+    /// visits the same blocks as the flat one and returns the same pose,
+    /// with a box left out or not, and that pose is the truth's.
+    #[test]
+    fn the_three_level_search_is_the_flat_one() {
+        let walls = scenes::room();
+        let truth = Pose2::new(6.2, 2.9, 0.1);
+        let map_from = Pose2::new(5.0, 3.0, 0.0);
+        let f = map_from.frame();
+        let world: Vec<DVec2> = scenes::scan(&map_from, &walls, 10.0)
+            .into_iter()
+            .map(|p| f.to_parent(p))
+            .collect();
+        let field = field_from_points(&world, 0.05, 8, 7.0);
+        let points = scenes::scan(&truth, &walls, 10.0);
+        let prior = Pose2::new(truth.x - 3.7, truth.y + 1.6, truth.theta + 0.03);
+        let cfg = CorrelativeConfig {
+            linear_window_m: 6.0,
+            angular_window_rad: 4f64.to_radians(),
+            angular_step_rad: 0.5f64.to_radians(),
+            coarse_cells: 8,
+        };
+        let exclusions = [
+            None,
+            Some(Exclusion {
+                centre: truth.position(),
+                radius_m: 0.5,
+            }),
+        ];
+        for exclude in exclusions {
+            let deep = search_blocks(&field, &points, &prior, &cfg, exclude, DEEP_MIN_BLOCKS);
+            let flat = search_blocks(&field, &points, &prior, &cfg, exclude, usize::MAX);
+            assert_eq!(deep, flat);
+        }
+        let m = search_outside(&field, &points, &prior, &cfg, None).unwrap();
+        assert!(m.pose.position().distance(truth.position()) < 0.08, "{m:?}");
+        assert!(wrap_angle(m.pose.theta - truth.theta).abs() < 0.5f64.to_radians());
+        // A corridor: along it every block scores alike, and the order of
+        // equal scores decides.
+        let walls = scenes::corridor();
+        let world: Vec<DVec2> = scenes::scan(&map_from, &walls, 10.0)
+            .into_iter()
+            .map(|p| f.to_parent(p))
+            .collect();
+        let field = field_from_points(&world, 0.05, 8, 7.0);
+        let points = scenes::scan(&Pose2::new(5.3, 0.9, 0.0), &walls, 10.0);
+        let prior = Pose2::new(3.1, 1.2, 0.02);
+        for exclude in exclusions {
+            let deep = search_blocks(&field, &points, &prior, &cfg, exclude, DEEP_MIN_BLOCKS);
+            let flat = search_blocks(&field, &points, &prior, &cfg, exclude, usize::MAX);
+            assert_eq!(deep, flat);
+        }
+    }
+
+    /// The top table is the maximum of the coarse one over 4 × 4 blocks
+    /// from each cell, cells beyond the table left out.
+    #[test]
+    fn the_top_table_bounds_its_blocks() {
+        let walls = scenes::room();
+        let pose = Pose2::new(5.0, 3.0, 0.0);
+        let f = pose.frame();
+        let world: Vec<DVec2> = scenes::scan(&pose, &walls, 10.0)
+            .into_iter()
+            .map(|p| f.to_parent(p))
+            .collect();
+        let field = field_from_points(&world, 0.05, 8, 1.0);
+        let top = top_table(&field);
+        let (wd, ht, k) = (field.width, field.height, field.k);
+        for y in (0..ht).step_by(7) {
+            for x in (0..wd).step_by(5) {
+                let mut m = 0f32;
+                for j in 0..TOP_BLOCKS {
+                    for i in 0..TOP_BLOCKS {
+                        m = m.max(field.coarse_at((x + i * k) as i64, (y + j * k) as i64));
+                    }
+                }
+                assert_eq!(top[y * wd + x], m, "cell ({x}, {y})");
+            }
+        }
+    }
 }

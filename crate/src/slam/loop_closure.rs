@@ -34,7 +34,7 @@
 use super::degeneracy::scan_normals_within;
 use super::icp::{IcpFit, IcpTarget};
 use super::match_covariance::{edge_information, response_covariance, ResponseWindow};
-use super::multires::{field_from_points, match_scan, rival_score, Window};
+use super::multires::{field_covering, field_from_points, match_scan, rival_score, Window};
 use super::posegraph::Edge;
 use crate::geom::{wrap_angle, Pose2};
 use glam::DVec2;
@@ -353,7 +353,13 @@ pub(super) fn match_visit(
             if window.linear_m <= cfg.window.linear_m {
                 return None;
             }
-            let field = field_from_points(&world, resolution_m, 8, window.linear_m + 1.0);
+            // Wide enough for the new scan at every pose searched: the
+            // search then reads its tables without bounds tests (on the
+            // fixed window's smaller field that gains nothing).
+            let reach = points.iter().map(|p| p.length()).fold(0.0, f64::max);
+            let around = Some((nodes[i].position(), reach));
+            let margin = window.linear_m + 1.0;
+            let field = field_covering(&world, resolution_m, 8, margin, around);
             let m = match_scan(&field, points, &nodes[i], &window)?;
             if m.score < cfg.min_score {
                 return None;
