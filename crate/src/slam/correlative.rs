@@ -119,207 +119,273 @@ fn search_blocks(
         return None;
     }
     let res = field.resolution_m;
-    // The excluded box in cell offsets from the prior (none: an empty box).
-    let (ex, ey, er) = match exclude {
-        Some(e) => {
-            let c = (e.centre - prior.position()) / res;
-            (
-                c.x.round() as i64,
-                c.y.round() as i64,
-                (e.radius_m / res).ceil() as i64,
-            )
-        }
-        None => (0, 0, -1),
-    };
     let w = (cfg.linear_window_m / res).round() as i64;
     let k = field.k as i64;
     let nt = (cfg.angular_window_rad / cfg.angular_step_rad).round() as i64;
-    let n_theta = (2 * nt + 1) as usize;
-    let n = points.len();
-    // Window cells of every point for every rotation, as indices into the
-    // tables when every offset the search reads (±w cells, plus a coarse
-    // block) stays inside the window, so the sums below need no bounds
-    // tests; rotations where some point comes nearer an edge keep the
-    // checked reads. Both read the same values in the same order.
-    let mut cells = Vec::with_capacity(n * n_theta);
-    let mut inside = Vec::with_capacity(n_theta);
-    let mut index = Vec::with_capacity(n * n_theta);
-    let (wd, ht) = (field.width as i64, field.height as i64);
-    for t in -nt..=nt {
-        let theta = prior.theta + t as f64 * cfg.angular_step_rad;
-        let frame = Pose2::new(prior.x, prior.y, theta).frame();
-        let mut all = true;
-        for &p in points {
-            let c = field.cell_of(frame.to_parent(p));
-            all &= c[0] - w >= 0 && c[1] - w >= 0 && c[0] + w + k < wd && c[1] + w + k < ht;
-            cells.push(c);
-            index.push(c[1] * wd + c[0]);
-        }
-        inside.push(all);
-    }
-    let score_at = |table: &[f32], ti: usize, ox: i64, oy: i64| -> f32 {
-        let off = oy * wd + ox;
-        index[ti * n..(ti + 1) * n]
-            .iter()
-            .fold(0f32, |a, &i| a + table[(i + off) as usize])
-    };
+    let scan = Rotated::new(field, points, prior, cfg.angular_step_rad, nt, w);
     // Coarse candidates: every block of `k × k` translations at every
     // rotation, bounded by the coarse table.
     let starts: Vec<i64> = (0..).map(|i| -w + i * k).take_while(|&o| o <= w).collect();
-    let per_axis = starts.len();
-    let coarse_score = |ti: usize, ox: i64, oy: i64| -> f32 {
-        if inside[ti] {
-            score_at(&field.coarse, ti, ox, oy)
-        } else {
-            cells[ti * n..(ti + 1) * n]
-                .iter()
-                .map(|c| field.coarse_at(c[0] + ox, c[1] + oy))
-                .sum()
-        }
+    let mut bnb = BranchAndBound {
+        best: None,
+        evaluations: 0,
+        w,
+        k,
+        nt,
+        excluded: Excluded::new(exclude, prior, res),
     };
-    // Branch and bound at fine resolution, the blocks taken best first
-    // (equal scores in the order scored, as a stable sort would).
-    let dist = |t: i64, x: i64, y: i64| t.abs() + x.abs() + y.abs();
-    type Best = Option<(f32, i64, i64, i64)>;
-    let mut best: Best = None;
-    let mut evaluations = 0;
-    let visit = |c: &Candidate, best: &mut Best, evaluations: &mut usize| -> bool {
-        if let Some((b, ..)) = *best {
-            if c.score < b - 1e-4 {
-                return false;
-            }
-        }
-        let ti = (c.t + nt) as usize;
-        let pc = &cells[ti * n..(ti + 1) * n];
-        // Whether this block meets the excluded box (never without one).
-        let meets = er >= 0
-            && c.ox <= ex + er
-            && c.ox + k > ex - er
-            && c.oy <= ey + er
-            && c.oy + k > ey - er;
-        for oy in c.oy..(c.oy + k).min(w + 1) {
-            for ox in c.ox..(c.ox + k).min(w + 1) {
-                if meets && (ox - ex).abs() <= er && (oy - ey).abs() <= er {
-                    continue;
-                }
-                let s: f32 = if inside[ti] {
-                    score_at(&field.fine, ti, ox, oy)
-                } else {
-                    pc.iter().map(|q| field.fine_at(q[0] + ox, q[1] + oy)).sum()
-                };
-                *evaluations += 1;
-                let better = match *best {
-                    None => true,
-                    Some((b, bt, bx, by)) => {
-                        s > b + 1e-4 || (s >= b - 1e-4 && dist(c.t, ox, oy) < dist(bt, bx, by))
-                    }
-                };
-                if better {
-                    *best = Some((s, c.t, ox, oy));
-                }
-            }
-        }
-        true
-    };
-    if per_axis < deep_from {
-        let mut candidates = Vec::with_capacity(n_theta * per_axis * per_axis);
-        for (ti, t) in (-nt..=nt).enumerate() {
-            for &oy in &starts {
-                for &ox in &starts {
-                    let order = candidates.len() as u32;
-                    let score = coarse_score(ti, ox, oy);
-                    candidates.push(Candidate {
-                        score,
-                        t,
-                        ox,
-                        oy,
-                        order,
-                    });
-                }
-            }
-        }
-        candidates.sort_unstable_by(|a, b| b.score.total_cmp(&a.score).then(a.order.cmp(&b.order)));
-        for c in &candidates {
-            if !visit(c, &mut best, &mut evaluations) {
-                break;
-            }
-        }
+    if starts.len() < deep_from {
+        blocks_flat(&scan, &starts, &mut bnb);
     } else {
-        // A wide window: a third level over the coarse one, so most blocks
-        // are never scored (see [`DEEP_MIN_BLOCKS`]).
-        let top = top_table(field);
-        let top_score = |ti: usize, ox: i64, oy: i64| -> f32 {
-            if inside[ti] {
-                score_at(&top, ti, ox, oy)
-            } else {
-                cells[ti * n..(ti + 1) * n]
-                    .iter()
-                    .map(|c| table_at(&top, field, c[0] + ox, c[1] + oy))
-                    .sum()
-            }
-        };
-        let groups = per_axis.div_ceil(TOP_BLOCKS);
-        let mut queue = std::collections::BinaryHeap::new();
-        for ti in 0..n_theta {
-            for gy in 0..groups {
-                for gx in 0..groups {
-                    let (ox, oy) = (starts[gx * TOP_BLOCKS], starts[gy * TOP_BLOCKS]);
-                    queue.push(Queued {
-                        score: top_score(ti, ox, oy),
-                        group: true,
-                        order: ((ti * groups + gy) * groups + gx) as u32,
-                    });
-                }
-            }
-        }
-        while let Some(q) = queue.pop() {
-            if let Some((b, ..)) = best {
-                if q.score < b - 1e-4 {
-                    break;
-                }
-            }
-            if q.group {
-                let o = q.order as usize;
-                let (ti, gy, gx) = (o / (groups * groups), o / groups % groups, o % groups);
-                for iy in gy * TOP_BLOCKS..((gy + 1) * TOP_BLOCKS).min(per_axis) {
-                    for ix in gx * TOP_BLOCKS..((gx + 1) * TOP_BLOCKS).min(per_axis) {
-                        queue.push(Queued {
-                            score: coarse_score(ti, starts[ix], starts[iy]),
-                            group: false,
-                            order: ((ti * per_axis + iy) * per_axis + ix) as u32,
-                        });
-                    }
-                }
-            } else {
-                let o = q.order as usize;
-                let (ti, iy, ix) = (
-                    o / (per_axis * per_axis),
-                    o / per_axis % per_axis,
-                    o % per_axis,
-                );
-                let c = Candidate {
-                    score: q.score,
-                    t: ti as i64 - nt,
-                    ox: starts[ix],
-                    oy: starts[iy],
-                    order: q.order,
-                };
-                if !visit(&c, &mut best, &mut evaluations) {
-                    break;
-                }
-            }
-        }
+        blocks_deep(&scan, &starts, &mut bnb);
     }
-    let (s, t, ox, oy) = best?;
+    let (s, t, ox, oy) = bnb.best?;
     Some(CorrelativeMatch {
         pose: Pose2::new(
             prior.x + ox as f64 * res,
             prior.y + oy as f64 * res,
             wrap_angle(prior.theta + t as f64 * cfg.angular_step_rad),
         ),
-        score: s as f64 / n as f64,
-        fine_evaluations: evaluations,
+        score: s as f64 / points.len() as f64,
+        fine_evaluations: bnb.evaluations,
     })
+}
+
+/// The points of a search turned to each of its `2 nt + 1` rotations, as
+/// window cells of the field.
+struct Rotated<'a> {
+    field: &'a LikelihoodField,
+    n: usize,
+    cells: Vec<[i64; 2]>,
+    /// The cells as indices into the tables.
+    index: Vec<i64>,
+    /// Per rotation: every offset the search reads (±w cells, plus a
+    /// coarse block) stays inside the window, so its sums need no bounds
+    /// tests. Rotations where some point comes nearer an edge keep the
+    /// checked reads. Both read the same values in the same order.
+    inside: Vec<bool>,
+}
+
+impl<'a> Rotated<'a> {
+    fn new(
+        field: &'a LikelihoodField,
+        points: &[DVec2],
+        prior: &Pose2,
+        step_rad: f64,
+        nt: i64,
+        w: i64,
+    ) -> Self {
+        let n_theta = (2 * nt + 1) as usize;
+        let n = points.len();
+        let k = field.k as i64;
+        let mut cells = Vec::with_capacity(n * n_theta);
+        let mut inside = Vec::with_capacity(n_theta);
+        let mut index = Vec::with_capacity(n * n_theta);
+        let (wd, ht) = (field.width as i64, field.height as i64);
+        for t in -nt..=nt {
+            let theta = prior.theta + t as f64 * step_rad;
+            let frame = Pose2::new(prior.x, prior.y, theta).frame();
+            let mut all = true;
+            for &p in points {
+                let c = field.cell_of(frame.to_parent(p));
+                all &= c[0] - w >= 0 && c[1] - w >= 0 && c[0] + w + k < wd && c[1] + w + k < ht;
+                cells.push(c);
+                index.push(c[1] * wd + c[0]);
+            }
+            inside.push(all);
+        }
+        Rotated {
+            field,
+            n,
+            cells,
+            index,
+            inside,
+        }
+    }
+
+    fn rotations(&self) -> usize {
+        self.inside.len()
+    }
+
+    /// The sum of `table` (laid out as the field's) over the points at
+    /// rotation `ti`, shifted by `(ox, oy)` cells.
+    fn sum(&self, table: &[f32], ti: usize, ox: i64, oy: i64) -> f32 {
+        let n = self.n;
+        if self.inside[ti] {
+            let off = oy * self.field.width as i64 + ox;
+            self.index[ti * n..(ti + 1) * n]
+                .iter()
+                .fold(0f32, |a, &i| a + table[(i + off) as usize])
+        } else {
+            self.cells[ti * n..(ti + 1) * n]
+                .iter()
+                .map(|c| table_at(table, self.field, c[0] + ox, c[1] + oy))
+                .sum()
+        }
+    }
+}
+
+/// The box a search leaves out, in cell offsets from the prior (none: an
+/// empty box, radius −1).
+#[derive(Clone, Copy)]
+struct Excluded {
+    x: i64,
+    y: i64,
+    r: i64,
+}
+
+impl Excluded {
+    fn new(exclude: Option<Exclusion>, prior: &Pose2, res: f64) -> Self {
+        match exclude {
+            Some(e) => {
+                let c = (e.centre - prior.position()) / res;
+                Excluded {
+                    x: c.x.round() as i64,
+                    y: c.y.round() as i64,
+                    r: (e.radius_m / res).ceil() as i64,
+                }
+            }
+            None => Excluded { x: 0, y: 0, r: -1 },
+        }
+    }
+}
+
+/// The fine level of the branch and bound: the best pose so far (score,
+/// rotation, offsets) and the poses scored.
+struct BranchAndBound {
+    best: Option<(f32, i64, i64, i64)>,
+    evaluations: usize,
+    w: i64,
+    k: i64,
+    nt: i64,
+    excluded: Excluded,
+}
+
+impl BranchAndBound {
+    /// Whether a block bounded by `score` can still beat the best pose.
+    fn open(&self, score: f32) -> bool {
+        self.best.is_none_or(|(b, ..)| score >= b - 1e-4)
+    }
+
+    /// Scores every pose of block `c` at fine resolution; false (and
+    /// nothing scored) once the blocks left cannot win.
+    fn visit(&mut self, scan: &Rotated, c: &Candidate) -> bool {
+        if !self.open(c.score) {
+            return false;
+        }
+        let (w, k, e) = (self.w, self.k, self.excluded);
+        let dist = |t: i64, x: i64, y: i64| t.abs() + x.abs() + y.abs();
+        let ti = (c.t + self.nt) as usize;
+        // Whether this block meets the excluded box (never without one).
+        let meets = e.r >= 0
+            && c.ox <= e.x + e.r
+            && c.ox + k > e.x - e.r
+            && c.oy <= e.y + e.r
+            && c.oy + k > e.y - e.r;
+        for oy in c.oy..(c.oy + k).min(w + 1) {
+            for ox in c.ox..(c.ox + k).min(w + 1) {
+                if meets && (ox - e.x).abs() <= e.r && (oy - e.y).abs() <= e.r {
+                    continue;
+                }
+                let s = scan.sum(&scan.field.fine, ti, ox, oy);
+                self.evaluations += 1;
+                let better = match self.best {
+                    None => true,
+                    Some((b, bt, bx, by)) => {
+                        s > b + 1e-4 || (s >= b - 1e-4 && dist(c.t, ox, oy) < dist(bt, bx, by))
+                    }
+                };
+                if better {
+                    self.best = Some((s, c.t, ox, oy));
+                }
+            }
+        }
+        true
+    }
+}
+
+/// The two-level search: every coarse block scored, sorted best first
+/// (equal scores in the order scored, as a stable sort would), and
+/// expanded until the next cannot win.
+fn blocks_flat(scan: &Rotated, starts: &[i64], bnb: &mut BranchAndBound) {
+    let per_axis = starts.len();
+    let mut candidates = Vec::with_capacity(scan.rotations() * per_axis * per_axis);
+    for ti in 0..scan.rotations() {
+        for &oy in starts {
+            for &ox in starts {
+                let order = candidates.len() as u32;
+                candidates.push(Candidate {
+                    score: scan.sum(&scan.field.coarse, ti, ox, oy),
+                    t: ti as i64 - bnb.nt,
+                    ox,
+                    oy,
+                    order,
+                });
+            }
+        }
+    }
+    candidates.sort_unstable_by(|a, b| b.score.total_cmp(&a.score).then(a.order.cmp(&b.order)));
+    for c in &candidates {
+        if !bnb.visit(scan, c) {
+            break;
+        }
+    }
+}
+
+/// The three-level search (see [`DEEP_MIN_BLOCKS`]): groups of coarse
+/// blocks bounded by the top table, a group's blocks scored only when it
+/// is taken from the queue, the blocks taken in [`blocks_flat`]'s order.
+fn blocks_deep(scan: &Rotated, starts: &[i64], bnb: &mut BranchAndBound) {
+    let top = top_table(scan.field);
+    let per_axis = starts.len();
+    let groups = per_axis.div_ceil(TOP_BLOCKS);
+    let mut queue = std::collections::BinaryHeap::new();
+    for ti in 0..scan.rotations() {
+        for gy in 0..groups {
+            for gx in 0..groups {
+                let (ox, oy) = (starts[gx * TOP_BLOCKS], starts[gy * TOP_BLOCKS]);
+                queue.push(Queued {
+                    score: scan.sum(&top, ti, ox, oy),
+                    group: true,
+                    order: ((ti * groups + gy) * groups + gx) as u32,
+                });
+            }
+        }
+    }
+    while let Some(q) = queue.pop() {
+        if !bnb.open(q.score) {
+            break;
+        }
+        let o = q.order as usize;
+        if q.group {
+            let (ti, gy, gx) = (o / (groups * groups), o / groups % groups, o % groups);
+            for iy in gy * TOP_BLOCKS..((gy + 1) * TOP_BLOCKS).min(per_axis) {
+                for ix in gx * TOP_BLOCKS..((gx + 1) * TOP_BLOCKS).min(per_axis) {
+                    queue.push(Queued {
+                        score: scan.sum(&scan.field.coarse, ti, starts[ix], starts[iy]),
+                        group: false,
+                        order: ((ti * per_axis + iy) * per_axis + ix) as u32,
+                    });
+                }
+            }
+        } else {
+            let (ti, iy, ix) = (
+                o / (per_axis * per_axis),
+                o / per_axis % per_axis,
+                o % per_axis,
+            );
+            let c = Candidate {
+                score: q.score,
+                t: ti as i64 - bnb.nt,
+                ox: starts[ix],
+                oy: starts[iy],
+                order: q.order,
+            };
+            if !bnb.visit(scan, &c) {
+                break;
+            }
+        }
+    }
 }
 
 /// A coarse block of [`search_outside`]'s branch and bound.
