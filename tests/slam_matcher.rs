@@ -294,6 +294,7 @@ fn the_motion_filter_processes_a_scan_after_a_distance_a_turn_or_a_time() {
             min_distance_m: 0.1,
             min_angle_rad: 3f64.to_radians(),
             max_interval_s: 2.0,
+            every_scan_first_s: 0.0,
         },
         ..SlamConfig::default()
     };
@@ -323,7 +324,7 @@ fn the_motion_filter_processes_a_scan_after_a_distance_a_turn_or_a_time() {
     assert_eq!(processed_steps(&mut m, &turning), vec![1, 4, 7]);
     // Standing still: one scan every 2 s (20 steps of 0.1 s).
     let still = vec![Pose2::IDENTITY; 45];
-    let mut m = RobotMapping::new(cfg);
+    let mut m = RobotMapping::new(cfg.clone());
     assert_eq!(processed_steps(&mut m, &still), vec![1, 21, 41]);
     // Without the filter every scan is processed.
     let mut m = RobotMapping::new(SlamConfig {
@@ -334,6 +335,38 @@ fn the_motion_filter_processes_a_scan_after_a_distance_a_turn_or_a_time() {
         processed_steps(&mut m, &straight),
         (1..=12).collect::<Vec<_>>()
     );
+    // The same filter after the run's first 0.5 s: steps 1–5 all, then one
+    // 12 cm after the last (step 9).
+    let mut m = RobotMapping::new(SlamConfig {
+        motion: MotionFilter {
+            every_scan_first_s: 0.5,
+            ..cfg.motion
+        },
+        ..SlamConfig::default()
+    });
+    assert_eq!(processed_steps(&mut m, &straight), vec![1, 2, 3, 4, 5, 9]);
+}
+
+/// By default a robot's first ten minutes process every scan (every
+/// preset lies within them), and after that a scan 0.2 m, 5° or 2 s on.
+#[wasm_bindgen_test(unsupported = test)]
+fn the_default_motion_filter_starts_after_ten_minutes() {
+    let m = SlamConfig::default().motion;
+    assert_eq!(m.every_scan_first_s, 600.0);
+    let still = Pose2::IDENTITY;
+    assert!(m.passes(&still, 1, 6000), "600 s: every scan");
+    assert!(
+        !m.passes(&still, 1, 6001),
+        "600.1 s standing still: filtered"
+    );
+    assert!(
+        !m.passes(&Pose2::new(0.19, 0.0, 0.0), 19, 6001),
+        "0.19 m, 1.9 s"
+    );
+    assert!(m.passes(&Pose2::new(0.2, 0.0, 0.0), 1, 6001), "after 0.2 m");
+    assert!(!m.passes(&Pose2::new(0.0, 0.0, 0.08), 1, 6001), "4.6°");
+    assert!(m.passes(&Pose2::new(0.0, 0.0, 0.09), 1, 6001), "after 5.2°");
+    assert!(m.passes(&still, 20, 6001), "after 2 s");
 }
 
 /// `squared_bound(c)` is where a square root stops being at most `c`: the

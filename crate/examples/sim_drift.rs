@@ -88,6 +88,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             m.min_distance_m = env("SLAM_MOTION_M").unwrap_or(m.min_distance_m);
             m.min_angle_rad = env("SLAM_MOTION_DEG").map_or(m.min_angle_rad, f64::to_radians);
             m.max_interval_s = env("SLAM_MOTION_S").unwrap_or(m.max_interval_s);
+            m.every_scan_first_s = env("SLAM_MOTION_FIRST_S").unwrap_or(m.every_scan_first_s);
             back_end_support::config_from_env(&mut config.graph);
             let mapping = RobotMapping::new(config);
             Ok(Traced {

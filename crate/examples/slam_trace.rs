@@ -114,6 +114,9 @@ fn config_from_env() -> SlamConfig {
     if let Some(v) = env("SLAM_MOTION_S") {
         cfg.motion.max_interval_s = v;
     }
+    if let Some(v) = env("SLAM_MOTION_FIRST_S") {
+        cfg.motion.every_scan_first_s = v;
+    }
     // The loop-closing back end: 1 on (the default), 0 off; its settings.
     if let Some(v) = env("SLAM_BACK_END") {
         cfg.back_end = v != 0.0;

@@ -22,9 +22,10 @@
 //! 6. **map** — each robot's two mappers ([`crate::slam::RobotMapping`])
 //!    take the odometry pose and the laser scan (never the truth): SLAM
 //!    matches the scan to its map and integrates it at the matched pose; the
-//!    odometry-only map, the thesis's baseline, at the odometry pose. Both
-//!    skip the scans their motion filter drops (under 0.1 m, 3° and 2 s
-//!    since the last one used; [`crate::slam::mapper::MotionFilter`]).
+//!    odometry-only map, the thesis's baseline, at the odometry pose. After
+//!    a robot's first ten minutes both skip the scans their motion filter
+//!    drops (under 0.2 m, 5° and 2 s since the last one used;
+//!    [`crate::slam::mapper::MotionFilter`]).
 //!    The laser is still cast every step: the follower steers by it and
 //!    the log and the page show it. Off with [`Simulation::set_mapping`].
 //! 7. **capture** — once per camera period, each robot stores a camera frame
