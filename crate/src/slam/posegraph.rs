@@ -34,6 +34,7 @@
 
 use crate::geom::{wrap_angle, Pose2};
 use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, Side};
 use std::collections::BTreeMap;
@@ -196,6 +197,10 @@ impl PoseGraph {
         if n < 2 {
             return Ok(0);
         }
+        // `H`'s pattern (a block per node and per edge) is the same at every
+        // step, so its symbolic factorisation (the AMD ordering and the
+        // elimination tree) is made once and only the numbers are redone.
+        let mut symbolic: Option<SymbolicLlt<usize>> = None;
         for it in 0..iterations {
             let (h, b) = self.normal_equations(phi);
             let dim = 3 * (n - 1);
@@ -209,8 +214,15 @@ impl PoseGraph {
                 .collect();
             let m = SparseColMat::<usize, f64>::try_new_from_triplets(dim, dim, &triplets)
                 .map_err(|e| format!("pose graph: {e:?}"))?;
-            let llt = m
-                .sp_cholesky(Side::Lower)
+            let pattern = match &symbolic {
+                Some(done) => done.clone(),
+                None => {
+                    let made = SymbolicLlt::try_new(m.symbolic(), Side::Lower)
+                        .map_err(|e| format!("pose graph: {e:?}"))?;
+                    symbolic.insert(made).clone()
+                }
+            };
+            let llt = Llt::try_new_with_symbolic(pattern, m.as_ref(), Side::Lower)
                 .map_err(|e| format!("pose graph is not positive definite: {e:?}"))?;
             let mut rhs = Mat::<f64>::from_fn(dim, 1, |r, _| -b[r]);
             llt.solve_in_place(rhs.as_mut());
