@@ -31,13 +31,15 @@
 //! Cholesky factorisation with a fill-reducing ordering (the `faer` crate's
 //! supernodal LLᵀ with AMD): a trajectory with loop closures factorises in
 //! milliseconds where a dense solve of 3n unknowns would take seconds.
+//! `H`'s pattern does not change while the poses move, so one optimisation
+//! lays out its blocks (`BlockPattern`) and orders its elimination once;
+//! each Gauss–Newton step only refills the numbers and factorises them.
 
 use crate::geom::{wrap_angle, Pose2};
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::{SparseColMat, Triplet};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Mat, Side};
-use std::collections::BTreeMap;
 
 /// A measured relative pose between two nodes.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -198,33 +200,20 @@ impl PoseGraph {
             return Ok(0);
         }
         // `H`'s pattern (a block per node and per edge) is the same at every
-        // step, so its symbolic factorisation (the AMD ordering and the
-        // elimination tree) is made once and only the numbers are redone.
-        let mut symbolic: Option<SymbolicLlt<usize>> = None;
+        // step: its blocks' places, and its symbolic factorisation (the AMD
+        // ordering and the elimination tree), are made once, and each step
+        // only fills in and factorises the numbers.
+        let pattern = BlockPattern::new(n, &self.edges);
+        let symbolic = SymbolicLlt::try_new(pattern.symbolic.as_ref(), Side::Lower)
+            .map_err(|e| format!("pose graph: {e:?}"))?;
+        let mut values = Vec::with_capacity(pattern.symbolic.row_idx().len());
         for it in 0..iterations {
-            let (h, b) = self.normal_equations(phi);
-            let dim = 3 * (n - 1);
-            let triplets: Vec<Triplet<usize, usize, f64>> = h
-                .iter()
-                .flat_map(|(&(i, j), blk)| {
-                    (0..3).flat_map(move |r| {
-                        (0..3).map(move |c| Triplet::new(3 * i + r, 3 * j + c, blk[r][c]))
-                    })
-                })
-                .collect();
-            let m = SparseColMat::<usize, f64>::try_new_from_triplets(dim, dim, &triplets)
-                .map_err(|e| format!("pose graph: {e:?}"))?;
-            let pattern = match &symbolic {
-                Some(done) => done.clone(),
-                None => {
-                    let made = SymbolicLlt::try_new(m.symbolic(), Side::Lower)
-                        .map_err(|e| format!("pose graph: {e:?}"))?;
-                    symbolic.insert(made).clone()
-                }
-            };
-            let llt = Llt::try_new_with_symbolic(pattern, m.as_ref(), Side::Lower)
+            let (h, b) = self.normal_equations(&pattern, phi);
+            pattern.column_major(&h, &mut values);
+            let m = SparseColMatRef::new(pattern.symbolic.as_ref(), &values);
+            let llt = Llt::try_new_with_symbolic(symbolic.clone(), m, Side::Lower)
                 .map_err(|e| format!("pose graph is not positive definite: {e:?}"))?;
-            let mut rhs = Mat::<f64>::from_fn(dim, 1, |r, _| -b[r]);
+            let mut rhs = Mat::<f64>::from_fn(b.len(), 1, |r, _| -b[r]);
             llt.solve_in_place(rhs.as_mut());
             let mut largest = 0f64;
             for k in 1..n {
@@ -247,29 +236,28 @@ impl PoseGraph {
         Ok(iterations)
     }
 
-    /// `H` as 3 × 3 blocks (lower triangle, unknown `k − 1` for node `k`)
-    /// and `b`.
-    #[allow(clippy::type_complexity)]
+    /// `H`'s 3 × 3 blocks in `pattern`'s order (lower triangle, unknown
+    /// `k − 1` for node `k`) and `b`.
     fn normal_equations(
         &self,
+        pattern: &BlockPattern,
         phi: Option<f64>,
-    ) -> (BTreeMap<(usize, usize), [[f64; 3]; 3]>, Vec<f64>) {
+    ) -> (Vec<[[f64; 3]; 3]>, Vec<f64>) {
         let n = self.nodes.len();
-        let mut h: BTreeMap<(usize, usize), [[f64; 3]; 3]> = BTreeMap::new();
+        let mut h = vec![[[0.0; 3]; 3]; pattern.blocks.len()];
         let mut b = vec![0.0; 3 * (n - 1)];
         // A tiny diagonal keeps a node that only the fixed one constrains
         // in one direction from making H singular; it moves nothing.
-        for k in 0..n - 1 {
-            let blk = h.entry((k, k)).or_insert([[0.0; 3]; 3]);
-            for (d, row) in blk.iter_mut().enumerate() {
+        for &slot in &pattern.diagonal {
+            for (d, row) in h[slot].iter_mut().enumerate() {
                 row[d] += 1e-9;
             }
         }
-        for e in &self.edges {
+        for (e, slots) in self.edges.iter().zip(&pattern.edge_slots) {
             let (err, ja, jb) = linearise(&self.nodes, e);
             let w = &dcs_information(e, &err, phi);
             let parts = [(e.from, ja), (e.to, jb)];
-            for &(p, jp) in &parts {
+            for (pi, &(p, jp)) in parts.iter().enumerate() {
                 if p == 0 {
                     continue;
                 }
@@ -284,12 +272,12 @@ impl PoseGraph {
                     }
                     b[3 * ip + r] += s;
                 }
-                for &(q, jq) in &parts {
-                    if q == 0 || q > p {
+                for (qi, &(_, jq)) in parts.iter().enumerate() {
+                    let Some(slot) = slots[pi][qi] else {
                         continue;
-                    }
+                    };
                     let blk = mul_t(&jp, w, &jq);
-                    let acc = h.entry((ip, q - 1)).or_insert([[0.0; 3]; 3]);
+                    let acc = &mut h[slot];
                     for r in 0..3 {
                         for c in 0..3 {
                             acc[r][c] += blk[r][c];
@@ -299,5 +287,90 @@ impl PoseGraph {
             }
         }
         (h, b)
+    }
+}
+
+/// Where `H`'s 3 × 3 blocks lie, for one set of nodes and edges: the blocks
+/// of its lower triangle (unknown `k − 1` for node `k`; node 0 is fixed),
+/// column by column, and the column-compressed pattern of their entries
+/// that the sparse Cholesky factorisation reads.
+struct BlockPattern {
+    /// `(column block, row block)` of each block, sorted: column-major,
+    /// rows ascending within a column.
+    blocks: Vec<(usize, usize)>,
+    /// Where each block column's blocks begin in `blocks` (one more entry
+    /// than there are columns).
+    column_start: Vec<usize>,
+    /// The slot of each unknown's diagonal block.
+    diagonal: Vec<usize>,
+    /// Per edge, the slot of block `(p, q)` for `p`, `q` its `from` (0) and
+    /// `to` (1); `None` where one is the fixed node or `q`'s node comes
+    /// after `p`'s (the upper triangle).
+    edge_slots: Vec<[[Option<usize>; 2]; 2]>,
+    /// Every entry of every block, column by column.
+    symbolic: SymbolicSparseColMat<usize>,
+}
+
+impl BlockPattern {
+    fn new(n: usize, edges: &[Edge]) -> BlockPattern {
+        let lower = |p: usize, q: usize| (p != 0 && q != 0 && q <= p).then(|| (q - 1, p - 1));
+        let mut blocks: Vec<(usize, usize)> = (0..n - 1).map(|k| (k, k)).collect();
+        for e in edges {
+            for p in [e.from, e.to] {
+                blocks.extend([e.from, e.to].into_iter().filter_map(|q| lower(p, q)));
+            }
+        }
+        blocks.sort_unstable();
+        blocks.dedup();
+        let slot = |key: (usize, usize)| blocks.binary_search(&key).ok();
+        let diagonal = (0..n - 1).filter_map(|k| slot((k, k))).collect();
+        let edge_slots = edges
+            .iter()
+            .map(|e| {
+                let ends = [e.from, e.to];
+                ends.map(|p| ends.map(|q| lower(p, q).and_then(slot)))
+            })
+            .collect();
+        let mut column_start = Vec::with_capacity(n);
+        let mut col_ptr = Vec::with_capacity(3 * (n - 1) + 1);
+        let mut row_idx = Vec::with_capacity(9 * blocks.len());
+        col_ptr.push(0);
+        let mut next = 0;
+        for c in 0..n - 1 {
+            column_start.push(next);
+            let run = blocks[next..]
+                .iter()
+                .take_while(|&&(col, _)| col == c)
+                .count();
+            for _ in 0..3 {
+                for &(_, r) in &blocks[next..next + run] {
+                    row_idx.extend(3 * r..3 * r + 3);
+                }
+                col_ptr.push(row_idx.len());
+            }
+            next += run;
+        }
+        column_start.push(next);
+        let dim = 3 * (n - 1);
+        BlockPattern {
+            symbolic: SymbolicSparseColMat::new_checked(dim, dim, col_ptr, None, row_idx),
+            blocks,
+            column_start,
+            diagonal,
+            edge_slots,
+        }
+    }
+
+    /// The entries of `h` (blocks in this pattern's order) in the order of
+    /// [`BlockPattern::symbolic`], into `values`.
+    fn column_major(&self, h: &[[[f64; 3]; 3]], values: &mut Vec<f64>) {
+        values.clear();
+        for run in self.column_start.windows(2) {
+            for c in 0..3 {
+                for blk in &h[run[0]..run[1]] {
+                    values.extend([blk[0][c], blk[1][c], blk[2][c]]);
+                }
+            }
+        }
     }
 }
