@@ -20,6 +20,14 @@ const state = (page) => page.evaluate(() => window.slamlab.state());
 const scenario = (page) => page.evaluate(() => window.slamlab.scenario());
 const statusText = (page) => page.locator('#status').innerText();
 
+/** Picks preset `name` through the select and waits until it has loaded:
+ *  the page may show that preset already, so its name alone says nothing,
+ *  and a load still under way would replace what the test does next. */
+async function choosePreset(page, name) {
+  await page.selectOption('#preset', name);
+  await page.waitForFunction((n) => document.querySelector('#status').textContent.includes(`Loaded the ${n} preset`), name);
+}
+
 /** A left-button drag between two world points (m), with intermediate moves. */
 async function dragWorld(page, from, to) {
   const a = await page.evaluate(([x, y]) => window.slamlab.worldToClient(x, y), from);
@@ -166,8 +174,7 @@ test('merging in the page: the table fills, a pair shows its matches, the verdic
   const { context, page, problems } = await newPage(env.browser);
   await page.goto(env.baseUrl);
   await waitReady(page);
-  await page.selectOption('#preset', 'thesis');
-  await page.waitForFunction(() => window.slamlab.scenario().name === 'thesis');
+  await choosePreset(page, 'thesis');
   const mergeButton = page.getByRole('button', { name: 'Merge maps' });
   assert.equal(await mergeButton.isDisabled(), true, 'nothing to merge before a run');
 
@@ -244,8 +251,7 @@ async function runToEnd(page, duration) {
 
 test('issue 23: a finished run shows its final figures, points to Merge, and is short to Tab through', { timeout: 300000 }, async () => {
   const { context, page, problems } = await pageWith({ width: 1366, height: 768 });
-  await page.selectOption('#preset', 'thesis');
-  await page.waitForFunction(() => window.slamlab.scenario().name === 'thesis');
+  await choosePreset(page, 'thesis');
 
   // Item 10: the canvas hint sits above the maze, not on it (the fit keeps a band free).
   const top = await page.evaluate(() => {
