@@ -170,6 +170,43 @@ test('the lab page: edit, run, step, read sensors, reset, autosave, corrupt save
   await context.close();
 });
 
+test('a preset that arrives after an edit leaves the edit alone; choosing it again loads it', { timeout: 60000 }, async () => {
+  const { context, page, problems } = await newPage(env.browser);
+  await page.goto(env.baseUrl);
+  await waitReady(page);
+  await choosePreset(page, 'thesis');
+  const thesis = await scenario(page);
+
+  // Hold the maze preset's fetch, and add a robot while it is on its way.
+  let release;
+  const held = new Promise((resolve) => { release = resolve; });
+  await page.route('**/scenarios/maze.json', async (route) => {
+    await held;
+    await route.continue();
+  });
+  await page.selectOption('#preset', 'maze');
+  await page.getByRole('button', { name: 'Add a robot' }).click();
+  assert.equal((await scenario(page)).robots.length, thesis.robots.length + 1);
+  release();
+  await page.waitForFunction(() => document.querySelector('#status').textContent.includes('Did not load the maze preset'));
+  await page.screenshot({ path: path.join(ARTIFACTS, 'preset-superseded.png') });
+  const kept = await scenario(page);
+  assert.equal(kept.robots.length, thesis.robots.length + 1, 'the robot added meanwhile is still there');
+  assert.deepEqual(kept.walls, thesis.walls, 'the walls are still the thesis preset\'s');
+  assert.equal(await page.locator('#preset').inputValue(), '', 'the select shows "(your scenario)"');
+
+  // Asked again, with nothing happening meanwhile, the preset loads; Ctrl+Z brings the edit back.
+  await page.unroute('**/scenarios/maze.json');
+  await choosePreset(page, 'maze');
+  const maze = JSON.parse(await readFile(path.join(ROOT, 'scenarios', 'maze.json'), 'utf8'));
+  assert.equal((await scenario(page)).walls.length, maze.walls.length);
+  await page.keyboard.press('Control+z');
+  assert.equal((await scenario(page)).robots.length, thesis.robots.length + 1);
+
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});
+
 test('merging in the page: the table fills, a pair shows its matches, the verdict and transform appear', { timeout: 180000 }, async () => {
   const { context, page, problems } = await newPage(env.browser);
   await page.goto(env.baseUrl);

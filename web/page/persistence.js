@@ -14,6 +14,14 @@ const STORAGE_KEY = 'slamlab.scenario.v1';
 const DEFAULT_PRESET = 'thesis';
 const SHARE_DEBOUNCE_MS = 250;
 
+/** A load given up because the scenario was edited while it was loading; the edit is kept. */
+export class Superseded extends Error {
+  constructor(what) {
+    super(`the scenario was edited while ${what} was loading, and that edit is kept; ask again to load it`);
+    this.name = 'Superseded';
+  }
+}
+
 export class Persistence {
   /**
    * @param {import('./state.js').Store} store
@@ -33,11 +41,18 @@ export class Persistence {
     window.addEventListener('hashchange', () => this.openPasted());
   }
 
-  /** Loads preset `name` from scenarios/ (undo goes back to what was there). */
+  /**
+   * Loads preset `name` from scenarios/ (undo goes back to what was there).
+   * If the scenario changed while the preset was on its way (the user drew,
+   * added a robot, changed the seed), that change is newer than the request:
+   * it is kept and the load throws a {@link Superseded}.
+   */
   async loadPreset(name) {
+    const asked = this.store.changes;
     const res = await fetch(`scenarios/${name}.json`);
     if (!res.ok) throw new Error(`could not fetch scenarios/${name}.json (HTTP ${res.status})`);
     const text = await res.text();
+    if (this.store.changes !== asked) throw new Superseded(`the ${name} preset`);
     this.store.pushUndo();
     this.store.load(text, { preset: name });
     this.store.presetDurations[name] = this.store.scenario.duration_s;

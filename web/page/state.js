@@ -56,6 +56,8 @@ export class Store {
     this.selection = null;
     this.undoStack = [];
     this.listeners = [];
+    /** Counts every change; a load that waited on the network checks it did not miss one. */
+    this.changes = 0;
   }
 
   /** Calls `fn(kind)` after every change. */
@@ -64,6 +66,7 @@ export class Store {
   }
 
   changed(kind) {
+    this.changes += 1;
     this.problems = problemsInWords(this.lab.problems());
     const sel = this.selection;
     if (sel) {

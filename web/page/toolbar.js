@@ -6,6 +6,7 @@
 // call the controllers (web/page/run.js, editor.js, persistence.js); this
 // module holds no state of the run or the scenario.
 import { fmt } from './dom.js';
+import { Superseded } from './persistence.js';
 import { MAX_ROBOTS } from './state.js';
 import { message, setStatus } from './status.js';
 
@@ -171,7 +172,11 @@ export class Toolbar {
       setStatus(`Loaded the ${name} preset (Ctrl+Z goes back to what you had).`, 'ok');
     } catch (err) {
       $('preset').value = this.page.store.preset;
-      setStatus(`Could not load the ${name} preset: ${message(err)}`, 'error');
+      if (err instanceof Superseded) {
+        setStatus(`Did not load the ${name} preset: you edited meanwhile. Choose it again to load it.`, 'warn');
+      } else {
+        setStatus(`Could not load the ${name} preset: ${message(err)}`, 'error');
+      }
     }
   }
 
@@ -185,7 +190,9 @@ export class Toolbar {
   async importScenario(file) {
     const { store, editor } = this.page;
     try {
+      const asked = store.changes;
       const text = await file.text();
+      if (store.changes !== asked) throw new Superseded(file.name);
       const before = JSON.stringify(store.scenario);
       store.load(text, { preset: '' });
       store.pushUndo(before);
