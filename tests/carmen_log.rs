@@ -1,7 +1,8 @@
 //! The CARMEN log reader on hand-written logs: FLASER geometry and the
 //! no-return value, ROBOTLASER1's own geometry and laser offset, RAWLASER1
 //! odometry interpolated from ODOM records, gzip, skipped records counted,
-//! and malformed lines refused with their line number.
+//! and malformed lines refused with their line number; the log SLAM's map
+//! resolution and its weak matches.
 
 use slamlab::carmen::{parse_bytes, parse_str};
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -230,5 +231,102 @@ fn the_log_map_resolution_grows_with_the_tour() {
     assert_eq!(
         map_resolution(0.05, std::iter::empty(), 20.0, MAP_MAX_CELLS),
         0.05
+    );
+}
+
+/// A scan of the box room `x ∈ [−3, 5]`, `y ∈ [−2, 3]` from `pose`, 181
+/// beams over 180°; beams with `cluttered(i)` instead hit something 0.6–0.9 m
+/// away that no earlier scan saw (people around the robot).
+fn room_scan(
+    index: usize,
+    pose: slamlab::geom::Pose2,
+    odometry: slamlab::geom::Pose2,
+    cluttered: impl Fn(usize) -> bool,
+) -> slamlab::carmen::LogScan {
+    let ranges = (0..181)
+        .map(|i| {
+            if cluttered(i) {
+                return 0.6 + 0.3 * (i as f64 * 0.7).sin().abs();
+            }
+            let a = pose.theta + (i as f64 - 90.0).to_radians();
+            let (c, s) = (a.cos(), a.sin());
+            // The nearest of the four walls along the beam.
+            let mut r = f64::INFINITY;
+            for (d, p, wall) in [
+                (c, pose.x, 5.0),
+                (c, pose.x, -3.0),
+                (s, pose.y, 3.0),
+                (s, pose.y, -2.0),
+            ] {
+                let t = (wall - p) / d;
+                if t > 0.0 {
+                    r = r.min(t);
+                }
+            }
+            r
+        })
+        .collect();
+    slamlab::carmen::LogScan {
+        index,
+        line: index + 1,
+        time: index as f64,
+        start_angle: -FRAC_PI_2,
+        angle_step: PI / 180.0,
+        max_range: 81.91,
+        ranges,
+        odometry,
+        logged_pose: None,
+        laser_offset: slamlab::geom::Pose2::IDENTITY,
+    }
+}
+
+/// A scan that fits the map only poorly (most of its beams on clutter no
+/// earlier scan saw, its match scoring under `min_match_score`) but near
+/// where the odometry put it is placed by its match, not left on the
+/// odometry's error; with `weak_match_score` 0 it keeps the odometry's pose.
+#[wasm_bindgen_test(unsupported = test)]
+fn a_weak_match_near_the_prediction_beats_the_odometry() {
+    use slamlab::geom::Pose2;
+    use slamlab::slam::logslam::{LogSlam, LogSlamConfig};
+    let truth = |k: usize| Pose2::new(0.4 * k as f64, 0.0, 0.0);
+    // The odometry is right but at the last scan, 0.12 m and 2° off.
+    let odometry = |k: usize| {
+        if k == 4 {
+            Pose2::new(1.7, -0.05, 2f64.to_radians())
+        } else {
+            truth(k)
+        }
+    };
+    let place = |weak: f64| {
+        let mut slam = LogSlam::new(LogSlamConfig {
+            weak_match_score: weak,
+            ..LogSlamConfig::default()
+        });
+        for k in 0..4 {
+            slam.add_scan(&room_scan(k, truth(k), odometry(k), |_| false));
+        }
+        // Seven beams in ten on clutter.
+        slam.add_scan(&room_scan(4, truth(4), odometry(4), |i| i % 10 < 7));
+        slam.finish().unwrap();
+        // The last step as the SLAM has it.
+        let p = slam.poses();
+        p[3].between(&p[4])
+    };
+    // The true step is 0.4 m straight ahead; the odometry's 0.5 m, 0.05 m
+    // aside and 2° turned.
+    let matched = place(LogSlamConfig::default().weak_match_score);
+    assert!(
+        (matched.x - 0.4).abs() < 0.01
+            && matched.y.abs() < 0.01
+            && matched.theta.abs() < 0.3f64.to_radians(),
+        "weak match: {matched:?}"
+    );
+    let kept = place(0.0);
+    let step = odometry(3).between(&odometry(4));
+    assert!(
+        (kept.x - step.x).abs() < 1e-9
+            && (kept.y - step.y).abs() < 1e-9
+            && (kept.theta - step.theta).abs() < 1e-9,
+        "without weak matches the odometry's step is kept: {kept:?}, odometry {step:?}"
     );
 }

@@ -5,11 +5,14 @@
 //! The raw MIT CSAIL log is scored against GMapping's poses for 406 of its
 //! scans; each corrected log (GMapping's poses) is replayed with drifting
 //! odometry made from those poses (seeded, `slam::relations::DriftModel`)
-//! and scored against them. Bounds are the figures measured on this code
-//! (BENCHMARKS.md, "Real laser logs") with a small margin (the replay is
-//! deterministic); the targets (0.10 m, 1 deg, a quarter of
-//! odometry's) are not met yet on most logs, so the bounds are honest ones;
-//! every log must beat its odometry. On the corrected logs the scans must
+//! and scored against them, at four drift seeds. One seed's figure moves by
+//! several centimetres with which loop closures a small change lets the
+//! replay find (BENCHMARKS.md, sessions 18–37), so the bounds hold the mean
+//! over the seeds; each seed must beat its odometry. Bounds are the figures
+//! measured on this code (BENCHMARKS.md, "Real laser logs") with a small
+//! margin (the replay is deterministic); the targets (0.10 m, 1 deg,
+//! a quarter of odometry's) are not met yet on most logs, so the bounds are
+//! honest ones. On the corrected logs the scans must
 //! also agree with each other at our poses about as well as at the
 //! reference's, by a measure that needs no reference
 //! (`support::cells_hit`).
@@ -19,17 +22,48 @@ mod support;
 
 use support::{pooled, Outcome};
 
+/// The drift seeds of the corrected logs: the default one and three more.
+const SEEDS: [u64; 4] = [support::DRIFT_SEED, 1, 2, 3];
+
 /// Checks the pooled relation errors against `max_m` / `max_deg` and
 /// against the odometry's (at most `share` of it).
 fn check(name: &str, o: &Outcome, max_m: f64, max_deg: f64, share: f64) {
-    println!("{}", support::table(name, o));
-    let (ours, odom) = (pooled(&o.ours), pooled(&o.odometry));
+    let ours = pooled(&o.ours);
     assert!(
         ours.trans_m <= max_m && ours.rot_deg <= max_deg,
         "{name}: {:.3} m / {:.2} deg, bounds {max_m} m / {max_deg} deg",
         ours.trans_m,
         ours.rot_deg
     );
+    against_odometry(name, o, share);
+}
+
+/// Replays corrected log `file` at every drift seed of [`SEEDS`]: each
+/// seed against its odometry (at most `share` of it), the mean over the
+/// seeds against `max_m` / `max_deg`.
+fn check_seeds(name: &str, file: &str, max_m: f64, max_deg: f64, share: f64) {
+    let (mut m, mut deg) = (0.0, 0.0);
+    for seed in SEEDS {
+        let o = support::corrected(file, seed);
+        let name = format!("{name} (drift seed {seed})");
+        against_odometry(&name, &o, share);
+        let ours = pooled(&o.ours);
+        m += ours.trans_m / SEEDS.len() as f64;
+        deg += ours.rot_deg / SEEDS.len() as f64;
+    }
+    println!("{name}: mean over drift seeds {SEEDS:?}: {m:.3} m / {deg:.2} deg");
+    assert!(
+        m <= max_m && deg <= max_deg,
+        "{name}: {m:.3} m / {deg:.2} deg over drift seeds {SEEDS:?}, bounds {max_m} m / {max_deg} deg"
+    );
+}
+
+/// Beats the odometry (at most `share` of its translational error, less
+/// rotational error); the square walls' prior found; the scans agree with
+/// each other about as well as at the reference's poses.
+fn against_odometry(name: &str, o: &Outcome, share: f64) {
+    println!("{}", support::table(name, o));
+    let (ours, odom) = (pooled(&o.ours), pooled(&o.odometry));
     assert!(
         ours.trans_m <= share * odom.trans_m,
         "{name}: {:.3} m is more than {share} of odometry's {:.3} m",
@@ -59,9 +93,11 @@ fn check(name: &str, o: &Outcome, max_m: f64, max_deg: f64, share: f64) {
 /// Our poses may put the returns in at most this many times the cells the
 /// reference's poses do ([`support::cells_hit`], a measure needing no
 /// reference). Measured, session 30: 0.97 (ACES), 0.99 (CSAIL
-/// corrected), 0.90 (Intel), 0.84 (Freiburg 079): the scans agree with
-/// each other better at our poses than at GMapping's on every log.
-const CELLS_MARGIN: f64 = 1.02;
+/// corrected), 0.90 (Intel), 0.84 (Freiburg 079). Session 37, at the four
+/// drift seeds: ACES 1.033–1.038 (0.98–0.99 before the weak matches, the
+/// one log they leave less self-consistent), CSAIL corrected 0.95–1.04,
+/// Intel 0.87–0.89, Freiburg 079 0.85–0.86.
+const CELLS_MARGIN: f64 = 1.045;
 
 #[test]
 fn mit_csail_raw_log_against_gmapping() {
@@ -76,34 +112,34 @@ fn mit_csail_raw_log_against_gmapping() {
     println!("recorded {recorded:.0} s, replayed in {:.1} s", o.seconds);
 }
 
+// The corrected logs' bounds hold the mean over the four drift seeds.
+// Measured, session 37 (before its weak matches): Intel 0.095 m / 0.69 deg
+// (0.098 / 0.69); ACES 0.196 / 0.45 (0.171 / 0.47); CSAIL corrected
+// 0.237 / 1.09 (0.224 / 1.12); Freiburg 079 0.054 / 0.77 (0.054 / 0.77).
+
 #[test]
 fn intel_with_drifting_odometry() {
-    let o = support::corrected("intel-corrected.log.gz");
-    // Measured: 0.099 m / 0.69 deg against odometry's 3.122 m / 17.79 deg.
-    check("intel", &o, 0.105, 0.75, 0.25);
+    check_seeds("intel", "intel-corrected.log.gz", 0.10, 0.75, 0.25);
 }
 
 #[test]
 fn aces_with_drifting_odometry() {
-    let o = support::corrected("aces-corrected.log.gz");
-    // Measured: 0.155 m / 0.48 deg against odometry's 7.266 m / 18.92 deg
-    // (0.161 m / 0.49 deg before session 30's square walls' prior).
-    check("aces", &o, 0.16, 0.52, 0.25);
+    check_seeds("aces", "aces-corrected.log.gz", 0.205, 0.50, 0.25);
 }
 
 #[test]
 fn csail_corrected_with_drifting_odometry() {
-    let o = support::corrected("csail-corrected.log.gz");
-    // Measured: 0.234 m / 1.08 deg against odometry's 10.786 m / 35.14 deg
-    // (0.274 m / 1.16 deg before session 18 narrowed the wide window's
-    // reach to 0.6 m).
-    check("csail", &o, 0.245, 1.15, 0.25);
+    check_seeds("csail", "csail-corrected.log.gz", 0.245, 1.15, 0.25);
 }
 
 #[test]
 fn freiburg_079_with_drifting_odometry() {
-    let o = support::corrected("freiburg-079-corrected.log.gz");
-    // Measured: 0.053 m / 0.75 deg against odometry's 0.456 m / 3.59 deg:
-    // the targets, met.
-    check("freiburg-079", &o, 0.10, 1.0, 0.25);
+    // The targets, met: 0.053-0.054 m at each of the four seeds.
+    check_seeds(
+        "freiburg-079",
+        "freiburg-079-corrected.log.gz",
+        0.06,
+        0.80,
+        0.25,
+    );
 }

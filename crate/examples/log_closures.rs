@@ -23,7 +23,7 @@
 use slamlab::geom::Pose2;
 use slamlab::slam::logslam::LogSlam;
 use slamlab::slam::posegraph::PoseGraph;
-use slamlab::slam::relations::{drift_odometry, relation_errors, DriftModel};
+use slamlab::slam::relations::{drift_odometry, relation_errors};
 
 #[path = "../../tests/real_support/mod.rs"]
 mod support;
@@ -322,7 +322,7 @@ fn main() {
                 .iter()
                 .map(|s| s.logged_pose.expect("FLASER pose"))
                 .collect();
-            let odom = drift_odometry(&reference, &DriftModel::default(), support::drift_seed());
+            let odom = drift_odometry(&reference, &support::drift_model(), support::drift_seed());
             let (_, slam, _) = support::replay(&log, Some(&odom), &cfg);
             report(name, &slam, &reference);
             opportunities(&log, &odom, &reference, &cfg);

@@ -42,7 +42,7 @@ use slamlab::rng::Rng;
 use slamlab::slam::degeneracy::scan_normals;
 use slamlab::slam::icp::IcpTarget;
 use slamlab::slam::logslam::{scan_points, LogSlamConfig};
-use slamlab::slam::relations::{drift_odometry, relation_errors, DriftModel, RelationErrors};
+use slamlab::slam::relations::{drift_odometry, relation_errors, RelationErrors};
 use std::collections::HashMap;
 
 #[path = "../../tests/real_support/mod.rs"]
@@ -176,7 +176,7 @@ fn print_pair(i: usize, target: &Target, points: &[DVec2], r: &Pose2, o: &Pose2)
 
 fn report(name: &str, log_all: &CarmenLog, reference: &[Pose2], cfg: &LogSlamConfig) {
     let list = std::env::var_os("LOG_LOCAL_LIST").is_some();
-    let odom = drift_odometry(reference, &DriftModel::default(), support::drift_seed());
+    let odom = drift_odometry(reference, &support::drift_model(), support::drift_seed());
     let (est, slam, _) = support::replay(log_all, Some(&odom), cfg);
     let log: &[LogScan] = &log_all.scans;
     // Front-end relative pose of consecutive scans that are both keys.

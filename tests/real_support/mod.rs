@@ -106,23 +106,44 @@ pub fn drift_seed() -> u64 {
         .unwrap_or(DRIFT_SEED)
 }
 
+/// The drift model of every figure, its noise (not its bias) times
+/// `$SLAMLAB_DRIFT_SCALE` if set (to measure a method against odometry
+/// worse or better than the default's).
+pub fn drift_model() -> DriftModel {
+    let scale: f64 = std::env::var("SLAMLAB_DRIFT_SCALE")
+        .map(|s| s.parse().expect("SLAMLAB_DRIFT_SCALE: a number"))
+        .unwrap_or(1.0);
+    let d = DriftModel::default();
+    DriftModel {
+        trans_per_m: d.trans_per_m * scale,
+        rot_per_rad: d.rot_per_rad * scale,
+        heading_per_m: d.heading_per_m * scale,
+        ..d
+    }
+}
+
 /// Random far pairs per evaluation.
 pub const RANDOM_PAIRS: usize = 1000;
 
-/// A corrected log: its poses are the reference; odometry drifted from them.
-pub fn corrected(name: &str) -> Outcome {
-    corrected_with(name, &LogSlamConfig::default())
+/// A corrected log: its poses are the reference; odometry drifted from them
+/// with drift seed `seed`.
+pub fn corrected(name: &str, seed: u64) -> Outcome {
+    corrected_seeded(name, &LogSlamConfig::default(), seed)
 }
 
-/// [`corrected`] with other SLAM settings.
+/// [`corrected`] with other SLAM settings, at [`drift_seed`].
 pub fn corrected_with(name: &str, cfg: &LogSlamConfig) -> Outcome {
+    corrected_seeded(name, cfg, drift_seed())
+}
+
+fn corrected_seeded(name: &str, cfg: &LogSlamConfig, seed: u64) -> Outcome {
     let log = load(name);
     let reference: Vec<Pose2> = log
         .scans
         .iter()
         .map(|s| s.logged_pose.expect("FLASER pose"))
         .collect();
-    let odom = drift_odometry(&reference, &DriftModel::default(), drift_seed());
+    let odom = drift_odometry(&reference, &drift_model(), seed);
     let (est, slam, seconds) = replay(&log, Some(&odom), cfg);
     Outcome {
         ours: relation_errors(&est, &reference, RANDOM_PAIRS, 1),
@@ -287,6 +308,9 @@ pub fn config_from_env() -> LogSlamConfig {
             "key_distance_m" => cfg.key_distance_m = v,
             "key_angle_deg" => cfg.key_angle_rad = v.to_radians(),
             "point_spacing_m" => cfg.point_spacing_m = v,
+            "min_match_score" => cfg.min_match_score = v,
+            "weak_match_score" => cfg.weak_match_score = v,
+            "match_range_m" => cfg.match_range_m = v,
             "manhattan" => cfg.manhattan = (v != 0.0).then(ManhattanConfig::for_logs),
             "manhattan_sigma_deg" => manhattan(&mut cfg).sigma_rad = v.to_radians(),
             "manhattan_rounds" => manhattan(&mut cfg).rounds = v as usize,
