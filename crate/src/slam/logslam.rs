@@ -26,11 +26,17 @@
 //!    a poor fit close to where the odometry put the scan — a hall whose
 //!    far walls lie beyond the 20 m match range, a turn that shows new
 //!    ground — is still a better pose than the odometry alone, whose error
-//!    the scans after it would otherwise inherit. On nine logs the lab was
-//!    never tuned on that took the mean relation error over four drift
-//!    seeds from 0.34 to 0.26 m (a convention centre 0.42 → 0.23 m, a
-//!    campus 0.86 → 0.39 m); on ACES it costs 0.171 → 0.196 m and a map
-//!    about 5 % less self-consistent (BENCHMARKS.md, session 37).
+//!    the scans after it would otherwise inherit. Such a scan fits poorly
+//!    for a reason (people around the robot, ground no key has seen), so it
+//!    gives the local map nothing to match the next scans against: once
+//!    the next key follows it, it leaves the local map (it stays a node of
+//!    the graph, with its points for loop closures). Taken into the local
+//!    map, six weak matches on ACES, each within 0.11 m of the prediction,
+//!    made later keys slide along its corridors and cost it a closed loop.
+//!    Over fourteen logs and four drift seeds the mean relation error fell
+//!    0.272 → 0.232 m (a convention centre 0.42 → 0.32 m, a campus
+//!    0.86 → 0.46 m, CSAIL corrected 0.224 → 0.205 m, ACES as before;
+//!    BENCHMARKS.md, session 37).
 //!    Wheel odometry can also arrive late: the raw MIT CSAIL log's odometry
 //!    stands still for a few scans of a fast turn, then jumps by the whole
 //!    turn (85° in one step), which the matcher had already followed. So
@@ -361,6 +367,10 @@ pub struct LogSlam {
     /// Whether the odometry did not change between the last two scans.
     odometry_stale: bool,
     unmatched_since_key: bool,
+    /// Whether the scan being added matched only weakly
+    /// (`weak_match_score`), and the same for every key.
+    scan_weak: bool,
+    weak_keys: Vec<bool>,
     /// The covariance of the match that made the next key (world frame).
     key_cov: Option<[[f64; 3]; 3]>,
     pending: Vec<Closure>,
@@ -438,6 +448,8 @@ impl LogSlam {
             last_step: Pose2::IDENTITY,
             odometry_stale: false,
             unmatched_since_key: false,
+            scan_weak: false,
+            weak_keys: Vec::new(),
             key_cov: None,
             pending: Vec::new(),
             grow_until: 0,
@@ -460,9 +472,11 @@ impl LogSlam {
         let pose = match &found {
             Some(m) => {
                 self.stats.matched += 1;
+                self.scan_weak = m.score < self.config.min_match_score;
                 m.pose
             }
             None => {
+                self.scan_weak = false;
                 self.stats.unmatched += 1;
                 self.unmatched_since_key = true;
                 predicted
@@ -569,6 +583,8 @@ impl LogSlam {
         }
         self.unmatched_since_key = false;
         self.key_points.push(points);
+        self.weak_keys.push(self.scan_weak);
+        self.scan_weak = false;
         self.key_scan.push(scan.index);
         self.scans.push(ScanEntry {
             index: scan.index,
@@ -609,12 +625,18 @@ impl LogSlam {
         }
     }
 
-    /// Rasterises the last `local_keys` key scans into the local map.
+    /// Rasterises the last `local_keys` key scans into the local map, but
+    /// the weakly matched ones.
     fn rebuild_local(&mut self) {
         let n = self.graph.nodes.len();
         let from = n.saturating_sub(self.config.local_keys);
         let mut world = Vec::new();
         for k in from..n {
+            // A weakly matched key, once another key follows it (see the
+            // module doc).
+            if self.weak_keys[k] && k + 1 < n {
+                continue;
+            }
             let f = self.graph.nodes[k].frame();
             world.extend(self.key_points[k].iter().map(|&p| f.to_parent(p)));
         }
