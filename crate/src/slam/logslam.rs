@@ -367,9 +367,7 @@ pub struct LogSlam {
     /// Whether the odometry did not change between the last two scans.
     odometry_stale: bool,
     unmatched_since_key: bool,
-    /// Whether the scan being added matched only weakly
-    /// (`weak_match_score`), and the same for every key.
-    scan_weak: bool,
+    /// Whether each key's scan matched only weakly (`weak_match_score`).
     weak_keys: Vec<bool>,
     /// The covariance of the match that made the next key (world frame).
     key_cov: Option<[[f64; 3]; 3]>,
@@ -448,7 +446,6 @@ impl LogSlam {
             last_step: Pose2::IDENTITY,
             odometry_stale: false,
             unmatched_since_key: false,
-            scan_weak: false,
             weak_keys: Vec::new(),
             key_cov: None,
             pending: Vec::new(),
@@ -463,7 +460,7 @@ impl LogSlam {
         let points = scan_points(scan, &self.config);
         self.stats.scans += 1;
         let Some((last_pose, last_odom)) = self.last else {
-            self.add_key(scan, scan.odometry, points, None);
+            self.add_key(scan, scan.odometry, points, None, false);
             self.last = Some((scan.odometry, scan.odometry));
             return;
         };
@@ -472,11 +469,9 @@ impl LogSlam {
         let pose = match &found {
             Some(m) => {
                 self.stats.matched += 1;
-                self.scan_weak = m.score < self.config.min_match_score;
                 m.pose
             }
             None => {
-                self.scan_weak = false;
                 self.stats.unmatched += 1;
                 self.unmatched_since_key = true;
                 predicted
@@ -507,7 +502,10 @@ impl LogSlam {
                 }
                 _ => None,
             };
-            self.add_key(scan, pose, points, Some(key));
+            let weak = found
+                .as_ref()
+                .is_some_and(|m| m.score < self.config.min_match_score);
+            self.add_key(scan, pose, points, Some(key), weak);
         } else {
             self.scans.push(ScanEntry {
                 index: scan.index,
@@ -558,7 +556,16 @@ impl LogSlam {
         }
     }
 
-    fn add_key(&mut self, scan: &LogScan, pose: Pose2, points: Vec<DVec2>, prev: Option<usize>) {
+    /// Adds key `scan` at `pose`, linked to key `prev`; `weak`: its match
+    /// scored under `min_match_score`.
+    fn add_key(
+        &mut self,
+        scan: &LogScan,
+        pose: Pose2,
+        points: Vec<DVec2>,
+        prev: Option<usize>,
+        weak: bool,
+    ) {
         let id = self.graph.nodes.len();
         self.graph.nodes.push(pose);
         if let Some(p) = prev {
@@ -583,8 +590,7 @@ impl LogSlam {
         }
         self.unmatched_since_key = false;
         self.key_points.push(points);
-        self.weak_keys.push(self.scan_weak);
-        self.scan_weak = false;
+        self.weak_keys.push(weak);
         self.key_scan.push(scan.index);
         self.scans.push(ScanEntry {
             index: scan.index,
