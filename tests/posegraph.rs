@@ -186,9 +186,22 @@ fn drifting_odometry_follows_its_model() {
         rot_per_rad: 0.0,
         heading_per_m: 0.0,
         bias_rad_per_m: 0.001,
+        distance_error: 0.0,
     };
     let o = drift_odometry(&reference, &bias_only, 1);
     assert!(close(o[200].theta, 0.1, 1e-9), "{:?}", o[200]);
+    // A scale error alone: 100 m driven read as 98 m, straight on.
+    let short = DriftModel {
+        bias_rad_per_m: 0.0,
+        distance_error: -0.02,
+        ..bias_only
+    };
+    let o = drift_odometry(&reference, &short, 1);
+    assert!(
+        close(o[200].x, 98.0, 1e-9) && close(o[200].y, 0.0, 1e-12),
+        "{:?}",
+        o[200]
+    );
     // Noise is seeded: the same seed, the same odometry; another, another.
     let m = DriftModel::default();
     assert_eq!(
