@@ -1,7 +1,14 @@
 //! Where the log SLAM goes wrong, per log: every accepted loop closure's
 //! measured relative pose compared with the reference's, and the key-to-key
 //! edges of the front end (successive scan matching) that disagree with the
-//! reference by more than 0.1 m or 1°.
+//! reference by more than 0.1 m or 1°, each with the odometry's error on
+//! the same pair and how well the new key's own scan pins it along its
+//! weakest direction ([`slamlab::slam::degeneracy`]: the points' worth of
+//! wall normals across that direction, and how much of the edge's error
+//! lies along it). The front end's mean error is also given apart for the
+//! keys pinned by fewer than [`CORRIDOR_POINTS`] points along it (a
+//! corridor whose ends are out of sight), where the matcher's response is
+//! flat and it slides.
 //!
 //! `cargo run --release -p slamlab --example log_closures [LOG ...]`
 //!
@@ -21,12 +28,31 @@
 //! beyond the search window.
 
 use slamlab::geom::Pose2;
+use slamlab::slam::degeneracy::{constraint_of, scan_normals_within};
 use slamlab::slam::logslam::LogSlam;
 use slamlab::slam::posegraph::PoseGraph;
 use slamlab::slam::relations::{drift_odometry, relation_errors};
 
 #[path = "../../tests/real_support/mod.rs"]
 mod support;
+
+/// A key scan pinned by fewer points than this along its weakest direction
+/// counts as a corridor's.
+const CORRIDOR_POINTS: f64 = 4.0;
+
+/// One front-end key edge: its error (m, deg), its scans, its
+/// information, the odometry's error on the pair (m), the new key's points
+/// along its weakest direction and the part of the error along it (m).
+struct FrontEdge {
+    t: f64,
+    r: f64,
+    a: usize,
+    b: usize,
+    info: f64,
+    odometry_m: f64,
+    weak_points: f64,
+    along_m: f64,
+}
 
 /// The reference pose of every scan (approximated where missing, see above).
 fn raw_reference(est: &[Pose2]) -> Vec<Pose2> {
@@ -83,7 +109,7 @@ fn report(name: &str, slam: &LogSlam, reference: &[Pose2]) {
         } else if e.information[0][0] > 0.0 {
             // (Heading-only edges are the square walls' priors, not the
             // front end's.)
-            seq.push((t, r, a, b, e.information[0][0]));
+            seq.push(front_edge(slam, reference, e, (a, b), (t, r)));
         }
     }
     println!("  closures: {total}, wrong (> 0.2 m or > 2 deg): {wrong}");
@@ -93,19 +119,74 @@ fn report(name: &str, slam: &LogSlam, reference: &[Pose2]) {
     let n = seq.len().max(1) as f64;
     let (mt, mr) = seq
         .iter()
-        .fold((0.0, 0.0), |(x, y), s| (x + s.0 / n, y + s.1 / n));
+        .fold((0.0, 0.0), |(x, y), s| (x + s.t / n, y + s.r / n));
     println!(
         "  front end: {} key edges, mean error {mt:.4} m {mr:.3} deg",
         seq.len()
     );
-    for (t, r, a, b, info) in &seq {
-        if *t > 0.1 || *r > 1.0 {
-            // An odometry key edge has σ 0.3 m (information 11), a matched
-            // one `key_sigma_m` (0.1 m: 100, or a little under in floating
-            // point, which a test against 100 took for odometry).
-            let kind = if *info < 50.0 { " (odometry)" } else { "" };
-            println!("    key edge scans {a:5} -> {b:5} error {t:6.3} m {r:6.2} deg{kind}");
-        }
+    for corridor in [true, false] {
+        let part: Vec<&FrontEdge> = seq
+            .iter()
+            .filter(|s| (s.weak_points < CORRIDOR_POINTS) == corridor)
+            .collect();
+        let k = part.len().max(1) as f64;
+        println!(
+            "    keys pinned by {} {CORRIDOR_POINTS} points along their weakest direction: {} edges, mean error {:.4} m ({:.4} m of it along that direction), the odometry's {:.4} m",
+            if corridor { "under" } else { "at least" },
+            part.len(),
+            part.iter().map(|s| s.t).sum::<f64>() / k,
+            part.iter().map(|s| s.along_m).sum::<f64>() / k,
+            part.iter().map(|s| s.odometry_m).sum::<f64>() / k,
+        );
+    }
+    for s in seq.iter().filter(|s| s.t > 0.1 || s.r > 1.0) {
+        // An odometry key edge has σ 0.3 m (information 11), a matched
+        // one `key_sigma_m` (0.1 m: 100, or a little under in floating
+        // point, which a test against 100 took for odometry).
+        let kind = if s.info < 50.0 { " (odometry)" } else { "" };
+        println!(
+            "    key edge scans {:5} -> {:5} error {:6.3} m {:6.2} deg{kind}; odometry {:.3} m; weakest direction {:.1} points, {:.3} m of the error along it",
+            s.a, s.b, s.t, s.r, s.odometry_m, s.weak_points, s.along_m
+        );
+    }
+}
+
+/// The measures of one front-end key edge `e` between scans `(a, b)`,
+/// whose error against the reference is `(t, r)`.
+fn front_edge(
+    slam: &LogSlam,
+    reference: &[Pose2],
+    e: &slamlab::slam::posegraph::Edge,
+    (a, b): (usize, usize),
+    (t, r): (f64, f64),
+) -> FrontEdge {
+    let odometry = |i: usize| {
+        slam.scans
+            .iter()
+            .find(|s| s.index == i)
+            .expect("a key's scan")
+            .odometry
+    };
+    let (odometry_m, _) = error(&odometry(a).between(&odometry(b)), reference, a, b);
+    // The new key's points are thinned to one per 10 cm: 0.3 m holds a
+    // few neighbours on each side.
+    let points = slam.key_points(e.to);
+    let normals = scan_normals_within(points, 0.3);
+    let c = constraint_of(&normals, &vec![true; normals.len()]);
+    // The error in the new key's frame, where the weak direction lies.
+    let wrong = reference[a]
+        .between(&reference[b])
+        .between(&e.measurement)
+        .position();
+    FrontEdge {
+        t,
+        r,
+        a,
+        b,
+        info: e.information[0][0],
+        odometry_m,
+        weak_points: c.weak,
+        along_m: wrong.dot(c.weak_direction).abs(),
     }
 }
 
