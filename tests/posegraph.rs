@@ -190,7 +190,7 @@ fn drifting_odometry_follows_its_model() {
     };
     let o = drift_odometry(&reference, &bias_only, 1);
     assert!(close(o[200].theta, 0.1, 1e-9), "{:?}", o[200]);
-    // A scale error alone: 100 m driven read as 98 m, straight on.
+    // A distance error alone: 100 m driven read as 98 m, straight on.
     let short = DriftModel {
         bias_rad_per_m: 0.0,
         distance_error: -0.02,

@@ -52,8 +52,8 @@ pub struct DriftModel {
     pub heading_per_m: f64,
     /// Heading bias per metre driven (b, rad/m).
     pub bias_rad_per_m: f64,
-    /// Scale error of the distance driven (s: the odometry reads `1 + s`
-    /// times the true step; a wheel radius off by that fraction).
+    /// Distance error (s: the odometry reads `1 + s` times each true
+    /// step; a wheel radius off by that fraction).
     pub distance_error: f64,
 }
 
