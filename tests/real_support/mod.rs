@@ -6,9 +6,12 @@
 use glam::DVec2;
 use slamlab::carmen::{parse_bytes, CarmenLog, LogScan};
 use slamlab::geom::Pose2;
-use slamlab::slam::logslam::{LogSlam, LogSlamConfig};
+use slamlab::slam::logslam::{scan_points, LogSlam, LogSlamConfig};
 use slamlab::slam::manhattan::ManhattanConfig;
 use slamlab::slam::relations::{drift_odometry, relation_errors, DriftModel, RelationErrors};
+use slamlab::slam::verified::{
+    errors_by_gap, verified_relations, GapErrors, Verification, VerifyConfig,
+};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -332,4 +335,58 @@ pub fn config_from_env() -> LogSlamConfig {
     }
     println!("settings: {list}");
     cfg
+}
+
+/// A log scored against the relations its scans fix
+/// ([`slamlab::slam::verified`]).
+pub struct VerifiedOutcome {
+    pub scans: usize,
+    pub verification: Verification,
+    /// The errors by gap class of the reference, ours and the odometry.
+    pub reference: Vec<GapErrors>,
+    pub ours: Vec<GapErrors>,
+    pub odometry: Vec<GapErrors>,
+}
+
+/// Replays log `name` (a corrected log with drifting odometry at
+/// [`drift_seed`], or the raw MIT CSAIL log on the scans GMapping's poses
+/// cover) and scores the reference, ours and the odometry against the
+/// relations the scans fix between the reference's poses and ours.
+pub fn verified(name: &str, cfg: &LogSlamConfig, verify: &VerifyConfig) -> VerifiedOutcome {
+    let log = load(name);
+    let (idx, reference, odometry, ours) = if name == "mit-csail.clf.gz" {
+        let (est, _, _) = replay(&log, None, cfg);
+        let (idx, reference): (Vec<usize>, Vec<Pose2>) =
+            csail_gmapping_reference().into_iter().unzip();
+        let odometry = idx.iter().map(|&i| log.scans[i].odometry).collect();
+        let ours = idx.iter().map(|&i| est[i]).collect();
+        (idx, reference, odometry, ours)
+    } else {
+        let reference: Vec<Pose2> = log
+            .scans
+            .iter()
+            .map(|s| s.logged_pose.expect("FLASER pose"))
+            .collect();
+        let odometry = drift_odometry(&reference, &drift_model(), drift_seed());
+        let (ours, _, _) = replay(&log, Some(&odometry), cfg);
+        ((0..log.scans.len()).collect(), reference, odometry, ours)
+    };
+    // Every return within the matching range takes part.
+    let dense = LogSlamConfig {
+        point_spacing_m: 0.0,
+        ..cfg.clone()
+    };
+    let points: Vec<Vec<DVec2>> = idx
+        .iter()
+        .map(|&i| scan_points(&log.scans[i], &dense))
+        .collect();
+    let verification = verified_relations(&points, &reference, &ours, verify);
+    let by_gap = |p: &[Pose2]| errors_by_gap(&verification.relations, p);
+    VerifiedOutcome {
+        scans: idx.len(),
+        reference: by_gap(&reference),
+        ours: by_gap(&ours),
+        odometry: by_gap(&odometry),
+        verification,
+    }
 }

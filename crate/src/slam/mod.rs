@@ -29,6 +29,7 @@
 //! | the simulated robots' loop-closing back end | [`robot_graph`] | Konolige et al. 2010; Hess et al. 2016 |
 //! | its key edges' compounded covariance | [`key_chain`] | Smith, Self, Cheeseman 1990; Konolige et al. 2010 |
 //! | relation errors against a reference | [`relations`] | Kümmerle et al., Auton. Robots 2009 |
+//! | relations the scans themselves fix (scoring) | [`verified`] | Kümmerle et al., Auton. Robots 2009 |
 //! | a robot's mapping handed to another thread and back | [`handoff`] | — |
 //!
 //! The simulation feeds every robot's [`RobotMapping`] once per step with
@@ -60,6 +61,7 @@ mod scenes;
 pub mod scoring;
 pub mod surface;
 pub mod surface_blocks;
+pub mod verified;
 
 pub use grid::{CellState, GridConfig, OccupancyGrid};
 pub use mapper::{MapperKind, MatchStatus, RobotMapping, SlamConfig};
