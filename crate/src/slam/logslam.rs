@@ -81,9 +81,14 @@
 //!    four drift seeds, BENCHMARKS.md, session 29). The search window
 //!    reaches ±1.5 m, and on one try in `grown_every` (4) further, by
 //!    0.03 m for every metre of the shortest path from the old key through
-//!    the chain and the closures accepted so far, up to 8 m
+//!    the chain and the closures accepted so far, up to 16 m
 //!    ([`super::loop_closure::closure_window`]): in a convention hall or
-//!    around a campus the drift a revisit must undo reaches metres. A
+//!    around a campus the drift a revisit must undo reaches metres. (Up
+//!    to 8 m, a 250 m campus left 52 of its 144 revisits out of reach,
+//!    needing 14–21 m; at 16 m, 11. The relations its scans fix between
+//!    revisits ([`super::verified`]) went from 0.235 to 0.040 m off, an
+//!    MIT corridor's from 0.200 to 0.038 m, every other log as before;
+//!    24 and 32 m gave the same figures. BENCHMARKS.md, session 40.) A
 //!    match found only in the grown reach must score `far_min_score` and
 //!    have no rival near as good; after one, every try searches the grown
 //!    window for `confirm_keys` keys so that a second can confirm it.
@@ -264,9 +269,11 @@ impl Default for LogSlamConfig {
             weak_match_score: 0.2,
             close_loops: true,
             // The closure window grows with the path (on one try in
-            // `grown_every`): a hall's loop needs a correction of metres.
+            // `grown_every`): a hall's loop needs a correction of metres,
+            // a campus's up to 20 m (see the module doc).
             loops: LoopConfig {
                 window_per_m: 0.03,
+                max_window_m: 16.0,
                 ..LoopConfig::default()
             },
             loop_every: 2,

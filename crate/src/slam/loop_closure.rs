@@ -281,7 +281,7 @@ fn widening_m(cfg: &LoopConfig, path_m: f64) -> f64 {
 /// window that reaches several metres along one finds the wrong door as
 /// readily as the right one). `LoopConfig::default` keeps it off (0 per
 /// metre), as the simulated robots' back end does. A replayed log's driver
-/// ([`super::logslam`]) turns it on (0.03 per metre, 8 m at most) and
+/// ([`super::logslam`]) turns it on (0.03 per metre, 16 m at most) and
 /// grows it on one try in four only (`grown_every`; `links: None` to
 /// [`find_closure_among`] on the other tries). Grown on every try it made
 /// one of the tuned logs worse by a centimetre and the replays 4–10×
