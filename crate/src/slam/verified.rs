@@ -143,6 +143,8 @@ fn candidates(a: &[Pose2], b: &[Pose2], cfg: &VerifyConfig) -> Vec<(usize, usize
             out.extend(c);
         }
     }
+    // By the older scan first, so that each one's ICP target is built once.
+    out.sort_unstable();
     out
 }
 
