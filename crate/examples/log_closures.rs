@@ -398,11 +398,7 @@ fn main() {
             let (est, slam, _) = support::replay(&log, None, &cfg);
             report(name, &slam, &raw_reference(&est));
         } else {
-            let reference: Vec<Pose2> = log
-                .scans
-                .iter()
-                .map(|s| s.logged_pose.expect("FLASER pose"))
-                .collect();
+            let reference = support::logged_poses(&log);
             let odom = drift_odometry(&reference, &support::drift_model(), support::drift_seed());
             let (_, slam, _) = support::replay(&log, Some(&odom), &cfg);
             report(name, &slam, &reference);

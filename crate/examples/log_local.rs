@@ -456,11 +456,7 @@ fn main() {
             continue;
         }
         let log = support::load(&name);
-        let reference: Vec<Pose2> = log
-            .scans
-            .iter()
-            .map(|s| s.logged_pose.expect("FLASER pose"))
-            .collect();
+        let reference = support::logged_poses(&log);
         report(&name, &log, &reference, &cfg);
     }
 }

@@ -136,6 +136,15 @@ pub fn drift_model() -> DriftModel {
 /// Random far pairs per evaluation.
 pub const RANDOM_PAIRS: usize = 1000;
 
+/// A corrected log's own poses (GMapping's), the reference it is scored
+/// against.
+pub fn logged_poses(log: &CarmenLog) -> Vec<Pose2> {
+    log.scans
+        .iter()
+        .map(|s| s.logged_pose.expect("FLASER pose"))
+        .collect()
+}
+
 /// A corrected log: its poses are the reference; odometry drifted from them
 /// with drift seed `seed`.
 pub fn corrected(name: &str, seed: u64) -> Outcome {
@@ -149,11 +158,7 @@ pub fn corrected_with(name: &str, cfg: &LogSlamConfig) -> Outcome {
 
 fn corrected_seeded(name: &str, cfg: &LogSlamConfig, seed: u64) -> Outcome {
     let log = load(name);
-    let reference: Vec<Pose2> = log
-        .scans
-        .iter()
-        .map(|s| s.logged_pose.expect("FLASER pose"))
-        .collect();
+    let reference = logged_poses(&log);
     let odom = drift_odometry(&reference, &drift_model(), seed);
     let (est, slam, seconds) = replay(&log, Some(&odom), cfg);
     Outcome {
@@ -362,11 +367,7 @@ pub fn verified(name: &str, cfg: &LogSlamConfig, verify: &VerifyConfig) -> Verif
         let ours = idx.iter().map(|&i| est[i]).collect();
         (idx, reference, odometry, ours)
     } else {
-        let reference: Vec<Pose2> = log
-            .scans
-            .iter()
-            .map(|s| s.logged_pose.expect("FLASER pose"))
-            .collect();
+        let reference = logged_poses(&log);
         let odometry = drift_odometry(&reference, &drift_model(), drift_seed());
         let (ours, _, _) = replay(&log, Some(&odometry), cfg);
         ((0..log.scans.len()).collect(), reference, odometry, ours)
