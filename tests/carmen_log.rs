@@ -4,7 +4,7 @@
 //! and malformed lines refused with their line number; the log SLAM's map
 //! resolution and its weak matches.
 
-use slamlab::carmen::{parse_bytes, parse_str};
+use slamlab::formats::carmen::{parse_bytes, parse_str};
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::io::Write;
 use wasm_bindgen_test::wasm_bindgen_test;
@@ -184,7 +184,7 @@ fn bad_and_truncated_lines_name_their_line() {
 /// dropped, and the corridor walls at both places are in it.
 #[wasm_bindgen_test(unsupported = test)]
 fn a_tour_too_big_for_5_cm_is_mapped_whole_at_10_cm() {
-    use slamlab::slam::log_replay::LogReplay;
+    use slamlab::lab::log_replay::LogReplay;
     use slamlab::slam::CellState;
     // 181 beams over 180°: walls 1.5 m either side, nothing ahead.
     let ranges: Vec<f64> = (0..181)
@@ -207,7 +207,7 @@ fn a_tour_too_big_for_5_cm_is_mapped_whole_at_10_cm() {
     let map = replay.map().unwrap();
     assert_eq!(map.resolution_m(), 0.1);
     assert_eq!(map.dropped_updates(), 0);
-    assert!(map.width() * map.height() <= slamlab::slam::logslam::MAP_MAX_CELLS);
+    assert!(map.width() * map.height() <= slamlab::slam::logs::logslam::MAP_MAX_CELLS);
     // Beside each place (the first scan's pose, then the fourth's), 1.5 m
     // to its left, the wall.
     for p in [[0.5, 1.5], [300.5, 301.5]] {
@@ -223,7 +223,7 @@ fn a_tour_too_big_for_5_cm_is_mapped_whole_at_10_cm() {
 #[wasm_bindgen_test(unsupported = test)]
 fn the_log_map_resolution_grows_with_the_tour() {
     use glam::DVec2;
-    use slamlab::slam::logslam::{map_resolution, MAP_MAX_CELLS};
+    use slamlab::slam::logs::logslam::{map_resolution, MAP_MAX_CELLS};
     let tour = |side: f64| [DVec2::ZERO, DVec2::splat(side)].into_iter();
     assert_eq!(map_resolution(0.05, tour(100.0), 20.0, MAP_MAX_CELLS), 0.05);
     assert_eq!(map_resolution(0.05, tour(300.0), 20.0, MAP_MAX_CELLS), 0.1);
@@ -242,7 +242,7 @@ fn room_scan(
     pose: slamlab::geom::Pose2,
     odometry: slamlab::geom::Pose2,
     cluttered: impl Fn(usize) -> bool,
-) -> slamlab::carmen::LogScan {
+) -> slamlab::slam::logs::LogScan {
     let ranges = (0..181)
         .map(|i| {
             if cluttered(i) {
@@ -266,7 +266,7 @@ fn room_scan(
             r
         })
         .collect();
-    slamlab::carmen::LogScan {
+    slamlab::slam::logs::LogScan {
         index,
         line: index + 1,
         time: index as f64,
@@ -287,7 +287,7 @@ fn room_scan(
 #[wasm_bindgen_test(unsupported = test)]
 fn a_weak_match_near_the_prediction_beats_the_odometry() {
     use slamlab::geom::Pose2;
-    use slamlab::slam::logslam::{LogSlam, LogSlamConfig};
+    use slamlab::slam::logs::logslam::{LogSlam, LogSlamConfig};
     let truth = |k: usize| Pose2::new(0.4 * k as f64, 0.0, 0.0);
     // The odometry is right but at the last scan, 0.12 m and 2° off.
     let odometry = |k: usize| {

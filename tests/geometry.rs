@@ -272,7 +272,7 @@ fn the_sensors_grid_finds_the_same_ranges_as_the_worlds() {
 
 #[wasm_bindgen_test(unsupported = test)]
 fn the_aligned_ate_forgives_a_turned_map_the_start_aligned_does_not() {
-    use slamlab::slam::scoring::{ate_aligned_m, ate_m};
+    use slamlab::slam::eval::scoring::{ate_aligned_m, ate_m};
     // The truth: 11 poses along y = 0 from x = 0 to 10, start at (2, 3).
     // The estimate (odometry frame, origin at the start) turned by 1°
     // about the start, as a heading error before the first wall would.

@@ -18,15 +18,15 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// The layers, bottom first. A module may name modules of lower layers
-/// only. (`carmen` and `rosmap`, readers of real robots' files, come with
-/// the real-data work: `carmen` needs only `geom`, `rosmap` the grids of
-/// `slam`.)
+/// only. `formats` reads robots' files into the lab's own types (a log's
+/// scans are `slam`'s, a saved map is what `merge` merges), so it stands
+/// above `slam` and below `merge`.
 const LAYERS: &[&[&str]] = &[
     &["geom", "rng", "palette"],
-    &["kinematics", "world", "maze", "carmen"],
+    &["kinematics", "world", "maze"],
     &["scenario", "sensors"],
     &["odometry", "follower", "camera", "surf", "slam"],
-    &["sim", "rosmap"],
+    &["sim", "formats"],
     &["render", "merge"],
     &["lab"],
     &["bindings"],

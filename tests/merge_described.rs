@@ -1,5 +1,5 @@
 //! Frames described by a second lab of the same scenario, as the command
-//! line's worker threads do (`slamlab::merge::described`): the features come
+//! line's worker threads do (`slamlab::merge::described_ahead`): the features come
 //! out bit for bit the same, cross the boundary exactly, and a merge that
 //! takes them (or pictures rendered there and described here) reports what a
 //! merge computing everything itself reports.
@@ -7,7 +7,7 @@
 use slamlab::lab::Lab;
 use slamlab::maze::{random_maze, MazeSpec};
 use slamlab::merge::config::MergeConfig;
-use slamlab::merge::described::{decode, encode, PACKED_LEN};
+use slamlab::merge::described_ahead::{decode, encode, PACKED_LEN};
 use slamlab::merge::frames::strongest_features;
 use slamlab::merge::MergeMethod;
 use slamlab::surf::GrayImage;

@@ -11,10 +11,10 @@ use glam::DVec2;
 use slamlab::camera::PinholeCamera;
 use slamlab::geom::{wrap_angle, Pose2};
 use slamlab::merge::baseline::{grid_picture, map_only_merge, BaselineConfig};
-use slamlab::merge::selection::{front_wall, is_square, select_frames, SelectionConfig};
-use slamlab::merge::thesis::{
+use slamlab::merge::pinhole::{
     solve_distance, thesis_merge, thesis_merge_with, PairMatch, ThesisConfig, ThesisOutcome,
 };
+use slamlab::merge::selection::{front_wall, is_square, select_frames, SelectionConfig};
 use slamlab::merge::{FrameInfo, MergeStatus};
 use slamlab::scenario::{CameraSpec, Scenario};
 use slamlab::sensors::laser::beam_bearing;

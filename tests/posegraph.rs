@@ -2,8 +2,8 @@
 //! scoring and the drifting odometry's model.
 
 use slamlab::geom::Pose2;
+use slamlab::slam::eval::relations::{drift_odometry, relation_errors, DriftModel};
 use slamlab::slam::posegraph::{Edge, PoseGraph};
-use slamlab::slam::relations::{drift_odometry, relation_errors, DriftModel};
 use std::f64::consts::FRAC_PI_2;
 use wasm_bindgen_test::wasm_bindgen_test;
 

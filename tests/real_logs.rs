@@ -4,7 +4,7 @@
 //!
 //! The raw MIT CSAIL log is scored against GMapping's poses for 406 of its
 //! scans; each corrected log (GMapping's poses) is replayed with drifting
-//! odometry made from those poses (seeded, `slam::relations::DriftModel`)
+//! odometry made from those poses (seeded, `slam::eval::relations::DriftModel`)
 //! and scored against them, at four drift seeds. One seed's figure moves by
 //! several centimetres with which loop closures a small change lets the
 //! replay find (BENCHMARKS.md, sessions 18–37), so the bounds hold the mean
@@ -144,7 +144,7 @@ fn freiburg_079_with_drifting_odometry() {
     );
 }
 
-/// Against the relations the scans themselves fix (`slam::verified`,
+/// Against the relations the scans themselves fix (`slam::eval::verified`,
 /// Kümmerle et al.'s relations with the person replaced by checks), at the
 /// default drift seed: our poses within 0.035 m / 0.40 deg on average, no
 /// further off than the reference's own poses, and at most a quarter of
@@ -155,14 +155,14 @@ fn freiburg_079_with_drifting_odometry() {
 /// (0.031 / 0.63), with up to 4,000 candidates per gap class.
 #[test]
 fn scan_verified_relations() {
-    let verify = slamlab::slam::verified::VerifyConfig {
+    let verify = slamlab::slam::eval::verified::VerifyConfig {
         max_pairs: 1000,
         ..Default::default()
     };
     for name in support::LOGS {
         let o = support::verified(
             name,
-            &slamlab::slam::logslam::LogSlamConfig::default(),
+            &slamlab::slam::logs::logslam::LogSlamConfig::default(),
             &verify,
         );
         let (ours, reference, odometry) = (

@@ -1,15 +1,15 @@
-//! Real-data suite: the offline merge on real laser maps and the Halmstad
+//! Real-data suite: the saved-maps merge on real laser maps and the Halmstad
 //! maps (`../shared/data/maps`, or `$SLAMLAB_DATA/maps`). Fails when the
 //! data is missing. Run: `./build.sh test-real` (or
 //! `cargo test --release -p slamlab --features real-data --test real_maps -- --nocapture`
 //! to see the per-pair tables).
 
 use glam::DVec2;
+use slamlab::formats::rosmap::{self, MapYaml, RosMap};
 use slamlab::geom::{wrap_angle, Pose2};
-use slamlab::merge::offline::{merge_pair, OfflineConfig, PairResult};
-use slamlab::merge::wallmap::WallMap;
+use slamlab::merge::saved::wallmap::WallMap;
+use slamlab::merge::saved::{merge_pair, PairResult, SavedMergeConfig};
 use slamlab::merge::MergeStatus;
-use slamlab::rosmap::{self, MapYaml, RosMap};
 use std::path::{Path, PathBuf};
 
 #[path = "real_support/npy.rs"]
@@ -53,7 +53,7 @@ fn load_png(png: &Path) -> RosMap {
 
 fn pair(a: &RosMap, b: &RosMap) -> PairResult {
     let (wa, wb) = (WallMap::new(a), WallMap::new(b));
-    merge_pair((0, a, &wa), (1, b, &wb), &OfflineConfig::default())
+    merge_pair((0, a, &wa), (1, b, &wb), &SavedMergeConfig::default())
 }
 
 fn error(est: &Pose2, truth: &Pose2) -> (f64, f64) {
@@ -276,7 +276,7 @@ fn halmstad(floor: &str, maps: &[&str]) -> Vec<(String, MergeStatus, f64, f64, f
             let r = merge_pair(
                 (0, &loaded[i], &prepared[i]),
                 (1, &loaded[j], &prepared[j]),
-                &OfflineConfig::default(),
+                &SavedMergeConfig::default(),
             );
             let e = r.evidence.unwrap_or_default();
             let (ours, off, deg) = r.pose.map_or((f64::NAN, f64::NAN, f64::NAN), |p| {

@@ -1,9 +1,9 @@
-//! Reading ROS map_server maps (crate/src/rosmap): YAML fields, PGM P5/P2
+//! Reading ROS map_server maps (crate/src/formats/rosmap): YAML fields, PGM P5/P2
 //! at 8 and 16 bits, PNG grey/RGB/RGBA, map_server's classification in
 //! trinary, scale and raw modes, and every bad input naming file and field.
 
 use image::ImageEncoder;
-use slamlab::rosmap::{self, MapYaml, Mode, MAX_CELLS};
+use slamlab::formats::rosmap::{self, MapYaml, Mode, MAX_CELLS};
 
 const YAML: &str = "image: m.pgm\nresolution: 0.05\norigin: [-1.5, 2.0, 0.25]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
 

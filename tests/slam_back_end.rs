@@ -13,8 +13,8 @@
 
 use slamlab::scenario::Scenario;
 use slamlab::sim::Simulation;
+use slamlab::slam::eval::scoring::ate_m;
 use slamlab::slam::mapper::{RobotMapping, SlamConfig};
-use slamlab::slam::scoring::ate_m;
 
 /// The run's ATE (m) and loop closures accepted, with or without the back end.
 fn run(back_end: bool) -> (f64, usize) {

@@ -125,7 +125,7 @@ export class Lab {
 
   // --- The world view (canvas) ------------------------------------------------
 
-  /** Sets what `draw` shows: size, centre, scale, layers, selection (see crate/src/render.rs). */
+  /** Sets what `draw` shows: size, centre, scale, layers, selection (see crate/src/render/mod.rs). */
   setView(view) {
     this.raw.setView(JSON.stringify(view));
   }

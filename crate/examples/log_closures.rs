@@ -29,9 +29,9 @@
 
 use slamlab::geom::Pose2;
 use slamlab::slam::degeneracy::{constraint_of, scan_normals_within};
-use slamlab::slam::logslam::LogSlam;
+use slamlab::slam::eval::relations::{drift_odometry, relation_errors};
+use slamlab::slam::logs::logslam::LogSlam;
 use slamlab::slam::posegraph::PoseGraph;
-use slamlab::slam::relations::{drift_odometry, relation_errors};
 
 #[path = "../../tests/real_support/mod.rs"]
 mod support;
@@ -317,10 +317,10 @@ const REVISIT_M: f64 = 1.0;
 /// Replays the log scan by scan and scores every closure try against the
 /// reference (see the module doc).
 fn opportunities(
-    log: &slamlab::carmen::CarmenLog,
+    log: &slamlab::formats::carmen::CarmenLog,
     odom: &[Pose2],
     reference: &[Pose2],
-    cfg: &slamlab::slam::logslam::LogSlamConfig,
+    cfg: &slamlab::slam::logs::logslam::LogSlamConfig,
 ) {
     let loops = &cfg.loops;
     let mut slam = LogSlam::new(cfg.clone());

@@ -36,13 +36,14 @@
 //! reference differ by over 0.1 m or 1° is listed.
 
 use glam::DVec2;
-use slamlab::carmen::{CarmenLog, LogScan};
+use slamlab::formats::carmen::CarmenLog;
 use slamlab::geom::{wrap_angle, Pose2};
 use slamlab::rng::Rng;
 use slamlab::slam::degeneracy::scan_normals;
+use slamlab::slam::eval::relations::{drift_odometry, relation_errors, RelationErrors};
 use slamlab::slam::icp::IcpTarget;
-use slamlab::slam::logslam::{scan_points, LogSlamConfig};
-use slamlab::slam::relations::{drift_odometry, relation_errors, RelationErrors};
+use slamlab::slam::logs::logslam::{scan_points, LogSlamConfig};
+use slamlab::slam::logs::LogScan;
 use std::collections::HashMap;
 
 #[path = "../../tests/real_support/mod.rs"]

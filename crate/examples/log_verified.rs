@@ -15,7 +15,7 @@
 //! them on ACES and CSAIL corrected).
 //!
 //! This example makes relations in Kümmerle's manner with the person
-//! replaced by checks ([`slamlab::slam::verified`]): candidate pairs near
+//! replaced by checks ([`slamlab::slam::eval::verified`]): candidate pairs near
 //! by the reference's poses or by ours, each aligned by point-to-line ICP
 //! from both estimates' relative poses, accepted when both starts end at
 //! one pose that every direction pins.
@@ -35,7 +35,7 @@
 //! (its gaps count among those scans).
 //! `SLAMLAB_DRIFT_SEED` and `SLAMLAB_LOG_SLAM` as in `log_relations`.
 
-use slamlab::slam::verified::VerifyConfig;
+use slamlab::slam::eval::verified::VerifyConfig;
 
 #[path = "../../tests/real_support/mod.rs"]
 mod support;

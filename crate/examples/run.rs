@@ -43,7 +43,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         if let Some(sim) = lab.simulation() {
             let config =
                 slamlab::merge::config::MergeConfig::new(MergeMethod::Auto, sim.scenario.seed);
-            let described = slamlab::merge::described::frames_to_describe(sim, &config);
+            let described = slamlab::merge::described_ahead::frames_to_describe(sim, &config);
             let stored: usize = sim.robots.iter().map(|r| r.frames.frames.len()).sum();
             println!(
                 "frames: {} stored, {} taking part in the automatic merge",

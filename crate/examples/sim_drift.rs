@@ -29,8 +29,8 @@ mod back_end_support;
 use slamlab::geom::{wrap_angle, Pose2};
 use slamlab::scenario::Scenario;
 use slamlab::sim::Simulation;
+use slamlab::slam::eval::scoring::{ate_aligned_m, ate_m, position_errors_m};
 use slamlab::slam::mapper::{MatchCounts, RobotMapping, SlamConfig};
-use slamlab::slam::scoring::{ate_aligned_m, ate_m, position_errors_m};
 
 struct Traced {
     index: usize,

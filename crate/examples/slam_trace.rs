@@ -29,9 +29,9 @@ mod slam_support;
 use slamlab::geom::{wrap_angle, Pose2};
 use slamlab::scenario::Scenario;
 use slamlab::sim::Simulation;
+use slamlab::slam::eval::scoring::{ate_m, map_accuracy};
 use slamlab::slam::grid::OccupancyGrid;
 use slamlab::slam::mapper::{match_scan, MapperKind, RobotMapping, SlamConfig};
-use slamlab::slam::scoring::{ate_m, map_accuracy};
 use std::time::Instant;
 
 /// Random-maze seeds of the benchmark set.

@@ -26,8 +26,7 @@
 //! | [`slam`] | per-robot occupancy grids, scan matching, map scoring and export |
 //! | [`sim`] | the fixed-step simulation and its per-robot logs |
 //! | [`render`] | tiny-skia drawing of the world, robots and sensors |
-//! | [`carmen`] | reading CARMEN laser logs (real data: FLASER, ROBOTLASER1, ODOM) |
-//! | [`rosmap`] | ROS map_server maps on disk: reading, classifying, writing |
+//! | [`formats`] | robots' files read into the lab's types: CARMEN logs, ROS maps |
 //! | [`merge`] | map merging: the thesis's method, the automatic one, a map-only baseline |
 //! | [`lab`] | the session the page and the CLI drive, its views and the report |
 //! | [`bindings`] | the wasm-bindgen boundary |
@@ -43,8 +42,8 @@
 
 pub mod bindings;
 pub mod camera;
-pub mod carmen;
 pub mod follower;
+pub mod formats;
 pub mod geom;
 pub mod kinematics;
 pub mod lab;
@@ -54,7 +53,6 @@ pub mod odometry;
 pub mod palette;
 pub mod render;
 pub mod rng;
-pub mod rosmap;
 pub mod scenario;
 pub mod sensors;
 pub mod sim;

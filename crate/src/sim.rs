@@ -738,7 +738,7 @@ impl Simulation {
     /// this noise seed shows ([`Simulation::frame_image`] of its parts): a
     /// second simulation of the same scenario renders the same picture, which
     /// is what lets another thread describe the frames of this one
-    /// ([`crate::merge::described`]).
+    /// ([`crate::merge::described_ahead`]).
     pub fn render_stored(
         &self,
         truth: &Pose2,

@@ -1,13 +1,13 @@
 //! A person's rough placing of one saved map on another, for the tests of
-//! Refine (crate/src/merge/refine.rs): `tests/offline_merge.rs` and
+//! Refine (crate/src/merge/saved/refine.rs): `tests/saved_merge.rs` and
 //! `tests/real_maps.rs` include this file with `#[path]`.
 
 use glam::DVec2;
+use slamlab::formats::rosmap::RosMap;
 use slamlab::geom::Pose2;
-use slamlab::merge::offline::{OfflineConfig, PairResult};
-use slamlab::merge::refine::refine_pair;
-use slamlab::merge::wallmap::WallMap;
-use slamlab::rosmap::RosMap;
+use slamlab::merge::saved::refine::refine_pair;
+use slamlab::merge::saved::wallmap::WallMap;
+use slamlab::merge::saved::{PairResult, SavedMergeConfig};
 
 /// `pose` (B's map frame in A's) turned by `dtheta` about B's point
 /// `pivot` (in B's map frame) and then moved by `shift`: how a person drags
@@ -29,5 +29,11 @@ pub fn middle(m: &RosMap) -> DVec2 {
 /// B refined on A from `guess` with the default settings.
 pub fn refined(a: &RosMap, b: &RosMap, guess: Pose2) -> PairResult {
     let (wa, wb) = (WallMap::new(a), WallMap::new(b));
-    refine_pair((0, a, &wa), (1, b, &wb), guess, &OfflineConfig::default()).unwrap()
+    refine_pair(
+        (0, a, &wa),
+        (1, b, &wb),
+        guess,
+        &SavedMergeConfig::default(),
+    )
+    .unwrap()
 }

@@ -4,14 +4,15 @@
 #![allow(dead_code)]
 
 use glam::DVec2;
-use slamlab::carmen::{parse_bytes, CarmenLog, LogScan};
+use slamlab::formats::carmen::{parse_bytes, CarmenLog};
 use slamlab::geom::Pose2;
-use slamlab::slam::logslam::{scan_points, LogSlam, LogSlamConfig};
-use slamlab::slam::manhattan::ManhattanConfig;
-use slamlab::slam::relations::{drift_odometry, relation_errors, DriftModel, RelationErrors};
-use slamlab::slam::verified::{
+use slamlab::slam::eval::relations::{drift_odometry, relation_errors, DriftModel, RelationErrors};
+use slamlab::slam::eval::verified::{
     errors_by_gap, verified_relations, GapErrors, Verification, VerifyConfig,
 };
+use slamlab::slam::logs::logslam::{scan_points, LogSlam, LogSlamConfig};
+use slamlab::slam::logs::LogScan;
+use slamlab::slam::manhattan::ManhattanConfig;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -343,7 +344,7 @@ pub fn config_from_env() -> LogSlamConfig {
 }
 
 /// A log scored against the relations its scans fix
-/// ([`slamlab::slam::verified`]).
+/// ([`slamlab::slam::eval::verified`]).
 pub struct VerifiedOutcome {
     pub scans: usize,
     pub verification: Verification,

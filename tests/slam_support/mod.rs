@@ -4,8 +4,8 @@
 
 use slamlab::scenario::Scenario;
 use slamlab::sim::Simulation;
+use slamlab::slam::eval::scoring::{ate_m, map_accuracy, MapAccuracy};
 use slamlab::slam::mapper::MapperKind;
-use slamlab::slam::scoring::{ate_m, map_accuracy, MapAccuracy};
 
 pub const PRESETS: [(&str, &str); 4] = [
     ("thesis", include_str!("../../scenarios/thesis.json")),

@@ -1,5 +1,5 @@
 // Worker threads that describe the run's camera frames while it is still
-// running (crate/src/merge/described.rs says why that gives the same report).
+// running (crate/src/merge/described_ahead.rs says why that gives the same report).
 //
 // Every few simulated seconds the run loop calls dispatch(): the lab lists
 // the frames a merge would describe that nobody has yet, they join a queue,

@@ -1,7 +1,7 @@
 // A worker thread of `node web/cli.mjs run`: its own instance of the wasm
 // build and its own Lab of the same scenario (never run), which renders the
 // main lab's stored frames from their specs and describes them with SURF
-// (crate/src/merge/described.rs), or only renders them for the main thread
+// (crate/src/merge/described_ahead.rs), or only renders them for the main thread
 // to describe. Messages in: {robot, index, spec, render}; out: {robot, index,
 // packed} (features) or, with `render`, {robot, index, gray} (pixels), the
 // buffer transferred; or {robot, index, error}.

@@ -1,6 +1,6 @@
 // The `merge-maps` command: merge saved ROS map_server maps (YAML + PGM/PNG)
 // offline. Node reads the files and hands text and bytes to wasm
-// (crate/src/bindings/maps.rs); the merge itself is crate/src/merge/offline.rs.
+// (crate/src/bindings/maps.rs); the merge itself is crate/src/merge/saved/mod.rs.
 import { readFile, writeFile } from 'node:fs/promises';
 import path from 'node:path';
 import { performance } from 'node:perf_hooks';

@@ -1,5 +1,5 @@
 // The robots' colours on the page: the renderer's own list
-// (`robotColours()` of the wasm build, crate/src/render.rs), set once the
+// (`robotColours()` of the wasm build, crate/src/palette.rs), set once the
 // wasm is up, so that a robot's card, camera, map, markers and name label
 // have the colour it is drawn in on the map.
 

@@ -1,13 +1,13 @@
 //! # JavaScript boundary of the log replay
 //!
-//! `LogReplay` wraps [`crate::slam::log_replay::LogReplay`]: open a CARMEN
+//! `LogReplay` wraps [`crate::lab::log_replay::LogReplay`]: open a CARMEN
 //! log from its bytes (plain or gzip), optionally restrict it to a stretch of
 //! laser records, replay it a few scans at a time, finish, then read the
 //! report (JSON) and the map (ROS map_server PGM + YAML, PNG).
 
+use crate::lab::log_replay;
 use crate::slam::export::{self, MapInfo};
 use crate::slam::grid::OccupancyGrid;
-use crate::slam::log_replay;
 use wasm_bindgen::prelude::*;
 
 use super::convert::js_err as err;

@@ -1,18 +1,18 @@
-//! # JavaScript boundary of the offline map merge
+//! # JavaScript boundary of the saved-maps merge
 //!
 //! `MapMerge` holds the saved maps a user brought (ROS `map_server` YAML
 //! text and image bytes, read by the caller: node from disk, the page from
-//! a file picker), merges them ([`crate::merge::offline`]) and hands back
+//! a file picker), merges them ([`crate::merge::saved`]) and hands back
 //! the report as JSON and the merged map as PGM, PNG and YAML. A thin
 //! converting layer: every error is a `JsError` whose message names the
 //! file and the field.
 
 use super::convert::js_err as err;
+use crate::formats::rosmap::{self, write::MergedMap, MapYaml, RosMap};
 use crate::geom::Pose2;
-use crate::merge::offline::{merge_all, OfflineConfig, OfflineMerge, PairResult};
-use crate::merge::refine::{refine_pair, refuse_if_beaten};
-use crate::merge::wallmap::WallMap;
-use crate::rosmap::{self, write::MergedMap, MapYaml, RosMap};
+use crate::merge::saved::refine::{refine_pair, refuse_if_beaten};
+use crate::merge::saved::wallmap::WallMap;
+use crate::merge::saved::{merge_all, PairResult, SavedMerge, SavedMergeConfig};
 use wasm_bindgen::prelude::*;
 
 /// Saved maps and, after `merge`, the result.
@@ -20,7 +20,7 @@ use wasm_bindgen::prelude::*;
 #[derive(Default)]
 pub struct MapMerge {
     maps: Vec<RosMap>,
-    result: Option<OfflineMerge>,
+    result: Option<SavedMerge>,
     /// The automatic merge's pairs, kept for Refine's check.
     automatic: Vec<PairResult>,
     merged: Option<MergedMap>,
@@ -118,7 +118,7 @@ impl MapMerge {
         if self.maps.len() < 2 {
             return Err(JsError::new("merge-maps needs at least two maps"));
         }
-        let result = merge_all(&self.maps, &OfflineConfig::default(), progress);
+        let result = merge_all(&self.maps, &SavedMergeConfig::default(), progress);
         let report = result.report(&self.maps).to_string();
         self.automatic = result.pairs.clone();
         self.result = Some(result);
@@ -191,7 +191,7 @@ impl MapMerge {
             guess = guess.inverse();
             (b, a)
         };
-        let cfg = OfflineConfig::default();
+        let cfg = SavedMergeConfig::default();
         let (ma, mb) = (&self.maps[a], &self.maps[b]);
         let (wa, wb) = (WallMap::new(ma), WallMap::new(mb));
         let mut pair = refine_pair((a, ma, &wa), (b, mb, &wb), guess, &cfg)

@@ -66,10 +66,10 @@ impl Lab {
         method: &str,
     ) -> Result<Vec<f32>, JsError> {
         let method = MergeMethod::parse(method).map_err(err)?;
-        let spec: crate::lab::described::FrameSpec =
+        let spec: crate::lab::frame_spec::FrameSpec =
             serde_json::from_str(spec_json).map_err(|e| err(format!("frame spec: {e}")))?;
         let f = self.inner.describe_frame_spec(&spec, method).map_err(err)?;
-        Ok(crate::merge::described::encode(&f))
+        Ok(crate::merge::described_ahead::encode(&f))
     }
 
     /// In a lab of the same scenario (a worker's): the grey pixels of the
@@ -77,7 +77,7 @@ impl Lab {
     /// lab to describe with `describeRendered`.
     #[wasm_bindgen(js_name = renderFrameSpec)]
     pub fn render_frame_spec(&mut self, spec_json: &str) -> Result<Vec<u8>, JsError> {
-        let spec: crate::lab::described::FrameSpec =
+        let spec: crate::lab::frame_spec::FrameSpec =
             serde_json::from_str(spec_json).map_err(|e| err(format!("frame spec: {e}")))?;
         Ok(self.inner.render_frame_spec(&spec).map_err(err)?.gray)
     }
@@ -113,7 +113,7 @@ impl Lab {
         packed: &[f32],
     ) -> Result<bool, JsError> {
         let method = MergeMethod::parse(method).map_err(err)?;
-        let f = crate::merge::described::decode(packed).map_err(err)?;
+        let f = crate::merge::described_ahead::decode(packed).map_err(err)?;
         self.inner
             .store_described(robot as usize, index as usize, method, f)
             .map_err(err)

@@ -7,10 +7,10 @@
 
 use super::Lab;
 use crate::sim::{RobotSim, Simulation};
+use crate::slam::eval::scoring::{ate_aligned_m, ate_m, map_accuracy, position_errors_m};
 use crate::slam::export::{to_pgm, to_png, to_yaml, GridPicture};
 use crate::slam::grid::OccupancyGrid;
 use crate::slam::mapper::{MapperKind, RobotMapping};
-use crate::slam::scoring::{ate_aligned_m, ate_m, map_accuracy, position_errors_m};
 use glam::DVec2;
 use serde::Serialize;
 
@@ -21,7 +21,7 @@ pub struct SlamFigures {
     pub ate_m: f64,
     /// The same after the best rigid fit onto the truth (m): without the
     /// heading error made before anything was in view
-    /// ([`crate::slam::scoring`]).
+    /// ([`crate::slam::eval::scoring`]).
     pub ate_aligned_m: f64,
     /// ATE of the raw odometry (m).
     pub odometry_ate_m: f64,

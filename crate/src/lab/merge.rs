@@ -11,11 +11,11 @@
 //! frames are the robots' odometry frames, whose origins are their start
 //! poses).
 
-use super::described::{describe_spec, render_spec, FrameSpec};
+use super::frame_spec::{describe_spec, render_spec, FrameSpec};
 use super::Lab;
 use crate::camera::CameraImage;
 use crate::geom::{wrap_angle, Pose2};
-use crate::merge::described::{describe_image, frames_to_describe};
+use crate::merge::described_ahead::{describe_image, frames_to_describe};
 use crate::merge::job::{
     MergeConfig, MergeJob, MergeOutcome, MergeTimes, PairOutcome, RobotGroup, RobotTransform, Stage,
 };
@@ -209,7 +209,7 @@ impl Lab {
 
     /// The frames (robot, frame index) a merge with `method` would describe
     /// now and that no other thread has described yet
-    /// ([`crate::merge::described`]); empty before a run.
+    /// ([`crate::merge::described_ahead`]); empty before a run.
     pub fn frames_to_describe(&self, method: MergeMethod) -> Vec<(usize, usize)> {
         let Some(sim) = self.simulation() else {
             return Vec::new();

@@ -38,8 +38,9 @@ use serde::Serialize;
 use std::fmt::Write;
 use tiny_skia::Pixmap;
 
-pub mod described;
+pub mod frame_spec;
 pub mod groups;
+pub mod log_replay;
 pub mod maps;
 pub mod memory;
 pub mod merge;
@@ -62,8 +63,8 @@ pub struct Lab {
     /// [`merge`]); dropped when the run changes.
     merge: Option<crate::merge::job::MergeJob>,
     /// Features of this run's frames described ahead of a merge by other
-    /// threads ([`crate::merge::described`]); dropped when the run changes.
-    described: crate::merge::described::DescribedFrames,
+    /// threads ([`crate::merge::described_ahead`]); dropped when the run changes.
+    described: crate::merge::described_ahead::DescribedFrames,
     /// The host's millisecond clock, for stage timings.
     clock: Option<fn() -> f64>,
     /// Bytes of frames all robots may keep, when not the default
@@ -388,7 +389,7 @@ impl Lab {
         if let Some(t) = self.merge.as_ref().map(|j| j.times_ms) {
             if timings.matching == 0.0 && timings.merge == 0.0 {
                 // The caller's `features` is its wait for frames other
-                // threads described (`crate::merge::described`), if any.
+                // threads described (`crate::merge::described_ahead`), if any.
                 timings.features += t.features;
                 timings.matching = t.matching;
                 timings.merge = t.merge;

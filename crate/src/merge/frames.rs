@@ -8,7 +8,7 @@
 //! for a method that reads the maps only); and the SURF features of one
 //! frame, the strongest keypoints only ([`strongest_features`]). The merge
 //! job ([`super::job`]) and the frames described ahead on other threads
-//! ([`super::described`]) both choose and describe frames here, so they
+//! ([`super::described_ahead`]) both choose and describe frames here, so they
 //! make the same choice.
 
 use super::config::MergeConfig;

@@ -26,7 +26,7 @@
 //!    with MSAC ([`super::verify`]); the inlier count fills one cell of the
 //!    table. One unit of work per pair.
 //! 5. **Decision.** Per pair of robots: the thesis's distance computation
-//!    (§6.2.4, [`super::thesis`]), the automatic verdict (consistency, grid
+//!    (§6.2.4, [`super::pinhole`]), the automatic verdict (consistency, grid
 //!    alignment and map agreement, [`super::verdict`]; when vision finds no
 //!    transform the maps confirm, a search of the maps alone,
 //!    [`super::mapsearch`], judged as strictly), or the baseline's
@@ -41,7 +41,7 @@
 
 mod decision;
 
-use super::described::{describe_image, DescribedFrames};
+use super::described_ahead::{describe_image, DescribedFrames};
 use super::frames::MergeInput;
 use super::fuse::FuseSteps;
 use super::graph::{groups, spanning_tree, Joined, PairEdge};
@@ -168,7 +168,7 @@ pub struct MergeJob {
     merged: Option<OccupancyGrid>,
     /// Time per stage, measured by the caller's clock (the session's).
     pub times_ms: MergeTimes,
-    /// Frames described ahead, elsewhere ([`super::described`]): taken
+    /// Frames described ahead, elsewhere ([`super::described_ahead`]): taken
     /// instead of describing them again.
     described: DescribedFrames,
     /// The proposal stage between calls ([`ProposalSteps`]).

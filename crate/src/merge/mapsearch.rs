@@ -98,8 +98,8 @@ pub use steps::MapSearchSteps;
 use steps::RotationSearch;
 
 use super::align::refine_alignment;
-use super::correlation::{add_row, Correlation};
 use super::peaksearch::ScoreImage;
+use super::raster_correlation::{add_row, Correlation};
 use super::verdict::{contradiction_reason, map_agreement, Agreement, VerdictConfig};
 use super::MergeStatus;
 use crate::geom::{wrap_angle, Pose2};

@@ -6,7 +6,7 @@
 //! finds both from what the robots saw (thesis chapters 5 and 6.2), in two
 //! ways:
 //!
-//! * **the thesis's method** ([`selection`], [`thesis`]): frames taken while
+//! * **the thesis's method** ([`selection`], [`pinhole`]): frames taken while
 //!   a robot faces a wall squarely are compared pairwise with SURF + MSAC;
 //!   the pair with the most inliers gives the distance between the robots by
 //!   the pinhole relations of §6.2.4, and one map is rotated and translated
@@ -37,13 +37,13 @@
 //! trait) what to select, propose, check and decide. [`frames`] chooses and
 //! describes the frames that take part (and says what a merge reads,
 //! [`frames::MergeInput`]); [`work`] holds what the job works on; [`config`]
-//! every setting; [`described`] lets other threads describe the frames
+//! every setting; [`described_ahead`] lets other threads describe the frames
 //! ahead of the job.
 //!
-//! Saved maps without robots (ROS `map_server` files, [`crate::rosmap`])
-//! are merged offline by [`offline`], with its own search
-//! ([`offline_search`]) and verdict ([`evidence`]) made for real maps;
-//! [`refine`] aligns a pair again from a person's rough overlay.
+//! Saved maps without robots (ROS `map_server` files, [`crate::formats::rosmap`])
+//! are merged by [`saved`], with its own search
+//! ([`saved::search`]) and verdict ([`saved::evidence`]) made for real maps;
+//! [`saved::refine`] aligns a pair again from a person's rough overlay.
 //!
 //! Ground truth is never read here: the session layer (`crate::lab`) scores
 //! the result.
@@ -52,9 +52,7 @@ pub mod align;
 pub mod baseline;
 pub mod config;
 pub mod consistency;
-pub mod correlation;
-pub mod described;
-pub mod evidence;
+pub mod described_ahead;
 pub mod frames;
 pub mod fuse;
 pub mod graph;
@@ -62,18 +60,16 @@ pub mod job;
 pub mod lift;
 pub mod mapsearch;
 pub mod method;
-pub mod offline;
-pub mod offline_search;
 pub mod pairbudget;
 pub mod peaksearch;
-pub mod refine;
+pub mod pinhole;
+pub mod raster_correlation;
 pub mod rigid;
+pub mod saved;
 pub mod selection;
-pub mod thesis;
 pub mod verdict;
 pub mod verify;
 pub mod vocabulary;
-pub mod wallmap;
 pub mod work;
 
 use crate::geom::Pose2;

@@ -10,7 +10,7 @@
 //! (a cell's score is +1 near a wall, −`free_penalty` in sure free space,
 //! 0 when unknown or outside the raster), and keeps the best few local
 //! maxima that lie `apart` from each other
-//! ([`super::correlation::Correlation::peaks`]). Done exhaustively, that is
+//! ([`super::raster_correlation::Correlation::peaks`]). Done exhaustively, that is
 //! every wall of one map times every cell of the other: quadratic in the
 //! maps' area. On 60 m maps at 0.1 m it is about 4·10⁹ additions a
 //! rotation, and nearly all of them are spent on translations that score
@@ -68,7 +68,7 @@
 //! figures. The answer does not depend on it: the test module checks it
 //! against the exhaustive correlation.
 //!
-//! [`Correlation::peaks`]: super::correlation::Correlation::peaks
+//! [`Correlation::peaks`]: super::raster_correlation::Correlation::peaks
 
 use std::collections::{BinaryHeap, HashMap};
 
@@ -403,7 +403,7 @@ impl Search {
         v
     }
 
-    /// [`super::correlation::Correlation::peaks`]'s local maximum rule.
+    /// [`super::raster_correlation::Correlation::peaks`]'s local maximum rule.
     fn is_local_max(&mut self, a_max: &MaxPyramid, i: [i64; 2], v: i32) -> bool {
         for dy in 0..3 {
             for dx in 0..3 {
@@ -430,7 +430,7 @@ fn block_within(k: usize, b: [i64; 2], peak: [i64; 2], apart: f64) -> bool {
 }
 
 /// Whether `i` is refused for lying near a peak kept: written as the
-/// negation of [`super::correlation::Correlation::peaks`]'s own test, so
+/// negation of [`super::raster_correlation::Correlation::peaks`]'s own test, so
 /// that even a NaN `apart` is treated alike.
 fn near(i: [i64; 2], peaks: &[([i64; 2], i32)], apart: f64) -> bool {
     !peaks.iter().all(|(u, _)| {
@@ -607,7 +607,7 @@ impl PeakSearch {
 /// The best `count` positive local maxima of the correlation of B's
 /// raster over A's, at least `apart` translation cells from each other,
 /// as (translation index, score): exactly what
-/// [`super::correlation::Correlation::peaks`] returns on the exhaustive
+/// [`super::raster_correlation::Correlation::peaks`] returns on the exhaustive
 /// correlation (indices there are these plus its `t0`). `a_max` is A's
 /// pyramid ([`pyramid_of`]), kept by the caller across B's rotations.
 /// `None` when one of B's scores does not fit a byte. [`PeakSearch`] run
@@ -626,7 +626,7 @@ pub fn best_translations(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::merge::correlation::Correlation;
+    use crate::merge::raster_correlation::Correlation;
 
     /// The exhaustive correlation, written out plainly from the formula of
     /// the module doc (zero outside the rasters).

@@ -1,6 +1,6 @@
 //! # Image selection: frames taken facing a wall squarely (thesis §5.6, §6.2.2)
 //!
-//! The thesis's distance computation (§6.2.4, [`super::thesis`]) reads only
+//! The thesis's distance computation (§6.2.4, [`super::pinhole`]) reads only
 //! two things off a matched image pair: how much the view *shrank* and how
 //! far it *shifted*. That is all a camera that moves along its optical axis
 //! and sideways can do to the picture of a flat wall in front of it (§5.5.1,
@@ -55,7 +55,7 @@
 //! skew of the wall ahead directly, by a line fit to the laser's central
 //! beams ([`front_wall`], within about 0.2° median on the presets); it is
 //! off by default, to keep the thesis's rule as the thesis wrote it.
-//! [`super::thesis`] uses the same fit to check its distances and to
+//! [`super::pinhole`] uses the same fit to check its distances and to
 //! correct for the few degrees by which "square" robots are in fact turned.
 //!
 //! Conventions: metres and radians; the sonars are numbered 1 to 8 from

@@ -6,7 +6,7 @@
 //! checked cells (the matched-pair table), and the decision on each pair.
 
 use super::pairbudget::PairBudget;
-use super::thesis::DistanceSolution;
+use super::pinhole::DistanceSolution;
 use super::verdict::PairDecision;
 use super::{Candidate, FrameInfo, MergeStatus};
 use crate::surf::{Features, Homography};

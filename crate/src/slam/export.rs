@@ -58,7 +58,7 @@ fn grid_pixels(grid: &OccupancyGrid) -> (usize, usize, Vec<u8>) {
 
 /// A binary PGM (P5) of `w × h` grey `pixels` (top row first), with a
 /// comment giving the resolution. Shared by the lab's grids and the
-/// merged real maps ([`crate::rosmap::write`]).
+/// merged real maps ([`crate::formats::rosmap::write`]).
 pub fn pgm_bytes(w: usize, h: usize, pixels: &[u8], resolution_m: f64) -> Vec<u8> {
     let mut out =
         format!("P5\n# slamlab occupancy grid, {resolution_m} m/cell\n{w} {h}\n255\n").into_bytes();

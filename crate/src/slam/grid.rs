@@ -160,7 +160,7 @@ const SURFACE_SCALE: f64 = 65536.0;
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct OccupancyGrid {
     pub config: GridConfig,
-    #[serde(with = "super::handoff::keep_capacity")]
+    #[serde(with = "super::keep_capacity")]
     cells: Vec<i8>,
     /// Per-cell surface means where hits are, by blocks (empty unless
     /// [`GridConfig::surface_points`]).

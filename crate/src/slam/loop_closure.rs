@@ -399,7 +399,7 @@ pub const RIVAL_EXCLUDE_M: f64 = 0.5;
 
 /// Neighbourhood of a thinned key scan's point for its normal, and the
 /// association radius and Huber threshold of [`closure_fit`] (m):
-/// those of the closing refinement ([`super::log_refine`]).
+/// those of the closing refinement ([`super::logs::refine`]).
 const PIN_NORMAL_RADIUS_M: f64 = 0.35;
 const PIN_RADIUS_M: f64 = 0.2;
 const PIN_HUBER_M: f64 = 0.02;

@@ -16,20 +16,17 @@
 //! | corridor degeneracy guard | [`degeneracy`] | Zhang, Kaess, Singh, ICRA 2016 |
 //! | pose filter with odometry self-calibration | [`filter`] | Thrun et al. §7.4; Martinelli 2007 |
 //! | the two mappers, online | [`mapper`] | thesis §4.3 (online SLAM) |
-//! | scoring against ground truth | [`scoring`] | Sturm et al., IROS 2012 (ATE) |
 //! | drawing and ROS map export | [`export`] | ROS `map_server` format |
 //! | tables of scans for real lasers | [`multires`] | Olson, ICRA 2009 |
 //! | a match's covariance from its response | [`match_covariance`] | Olson, ICRA 2009 §IV-C; Konolige et al. 2010 |
 //! | point-to-line ICP on points, off the raster's grain | [`icp`] | Besl & McKay 1992; Chen & Medioni 1992 |
 //! | pose graph, sparse least squares | [`posegraph`] | Lu & Milios 1997; Grisetti et al. 2010 |
 //! | loop closure by correlative matching | [`loop_closure`] | Konolige et al. 2010; Hess et al. 2016 |
-//! | SLAM for real laser logs | [`logslam`] | Karto / slam_toolbox, Cartographer |
-//! | its closing refinement, every revisit linked | [`log_refine`] | Konolige et al. 2010; Agarwal et al. 2013 |
+//! | SLAM for recorded laser logs, and its closing refinement | [`logs`] | Karto / slam_toolbox, Cartographer |
 //! | its square walls' heading prior | [`manhattan`] | Nguyen et al., IROS 2006 (Orthogonal SLAM) |
 //! | the simulated robots' loop-closing back end | [`robot_graph`] | Konolige et al. 2010; Hess et al. 2016 |
 //! | its key edges' compounded covariance | [`key_chain`] | Smith, Self, Cheeseman 1990; Konolige et al. 2010 |
-//! | relation errors against a reference | [`relations`] | Kümmerle et al., Auton. Robots 2009 |
-//! | relations the scans themselves fix (scoring) | [`verified`] | Kümmerle et al., Auton. Robots 2009 |
+//! | scoring: ATE, map figures, relation errors | [`eval`] | Sturm et al. 2012; Kümmerle et al. 2009 |
 //! | a robot's mapping handed to another thread and back | [`handoff`] | — |
 //!
 //! The simulation feeds every robot's [`RobotMapping`] once per step with
@@ -37,31 +34,28 @@
 
 pub mod correlative;
 pub mod degeneracy;
+pub mod eval;
 pub mod export;
 pub mod filter;
 pub mod gauss_newton;
 pub mod grid;
 pub mod handoff;
 pub mod icp;
+pub mod keep_capacity;
 pub mod key_chain;
 pub mod likelihood;
-pub mod log_refine;
-pub mod log_replay;
-pub mod logslam;
+pub mod logs;
 pub mod loop_closure;
 pub mod manhattan;
 pub mod mapper;
 pub mod match_covariance;
 pub mod multires;
 pub mod posegraph;
-pub mod relations;
 pub mod robot_graph;
 #[cfg(test)]
 mod scenes;
-pub mod scoring;
 pub mod surface;
 pub mod surface_blocks;
-pub mod verified;
 
 pub use grid::{CellState, GridConfig, OccupancyGrid};
 pub use mapper::{MapperKind, MatchStatus, RobotMapping, SlamConfig};

@@ -72,9 +72,9 @@ impl Edge {
 /// Nodes (poses) and edges.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PoseGraph {
-    #[serde(with = "super::handoff::keep_capacity")]
+    #[serde(with = "super::keep_capacity")]
     pub nodes: Vec<Pose2>,
-    #[serde(with = "super::handoff::keep_capacity")]
+    #[serde(with = "super::keep_capacity")]
     pub edges: Vec<Edge>,
 }
 

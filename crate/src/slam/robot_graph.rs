@@ -324,7 +324,7 @@ impl Default for RobotGraphConfig {
 /// set for a reflective return) and the step it was taken at.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 struct KeyScan {
-    #[serde(with = "super::handoff::keep_capacity")]
+    #[serde(with = "super::keep_capacity")]
     ranges_mm: Vec<u16>,
     range_max_m: f64,
 }
@@ -482,16 +482,16 @@ pub struct FrontEnd<'a> {
 pub struct RobotGraph {
     pub config: RobotGraphConfig,
     pub graph: PoseGraph,
-    #[serde(with = "super::handoff::keep_capacity")]
+    #[serde(with = "super::keep_capacity")]
     keys: Vec<KeyScan>,
     /// The step (index into the estimates) each key was taken at.
-    #[serde(with = "super::handoff::keep_capacity")]
+    #[serde(with = "super::keep_capacity")]
     key_step: Vec<usize>,
     /// The path driven up to each key (m, along the key edges).
-    #[serde(with = "super::handoff::keep_capacity")]
+    #[serde(with = "super::keep_capacity")]
     key_path_m: Vec<f64>,
     /// The key each step's estimate follows (the last key at or before it).
-    #[serde(with = "super::handoff::keep_capacity")]
+    #[serde(with = "super::keep_capacity")]
     step_key: Vec<u32>,
     /// The pose since the last key and its covariance (`None` before the
     /// first key).
@@ -499,18 +499,18 @@ pub struct RobotGraph {
     pending: Vec<Closure>,
     /// The key of the last accepted pair (for the cool-down).
     last_accepted: Option<usize>,
-    #[serde(with = "super::handoff::keep_capacity")]
+    #[serde(with = "super::keep_capacity")]
     pub closures: Vec<ClosureRecord>,
     /// Keys still to be drawn into the SLAM map after a correction moved
     /// them, the nearest to the robot last (they are popped).
-    #[serde(with = "super::handoff::keep_capacity")]
+    #[serde(with = "super::keep_capacity")]
     redraw: Vec<usize>,
     /// Every closure found, with `config.record_trials`.
-    #[serde(with = "super::handoff::keep_capacity")]
+    #[serde(with = "super::keep_capacity")]
     pub trials: Vec<ClosureTrial>,
     pub stats: RobotGraphStats,
     /// Square keys waiting for a heading prior: (key, scan direction).
-    #[serde(with = "super::handoff::keep_capacity")]
+    #[serde(with = "super::keep_capacity")]
     square: Vec<(usize, f64)>,
     /// The building's direction modulo 90°, once measured.
     building: Option<f64>,

@@ -50,9 +50,9 @@ pub struct SurfaceBlocks {
     /// Blocks a row of the index.
     cols: usize,
     /// Pool position of each block, row by row (`NONE`: no cells).
-    #[serde(with = "super::handoff::keep_capacity")]
+    #[serde(with = "super::keep_capacity")]
     index: Vec<u32>,
-    #[serde(with = "super::handoff::keep_capacity")]
+    #[serde(with = "super::keep_capacity")]
     pool: Vec<[SurfaceCell; CELLS]>,
 }
 

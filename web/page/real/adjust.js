@@ -6,7 +6,7 @@
 // first in the overlay (Shift-drag, or the "drag turns" box, turns it about
 // its middle; the arrow keys move it and Q / E turn it), and press Refine:
 // the merge worker aligns the map from that guess and judges it with the
-// same tests as the automatic merge (crate/src/merge/refine.rs), and the
+// same tests as the automatic merge (crate/src/merge/saved/refine.rs), and the
 // view shows the new verdict, transforms and downloads. The map is drawn by
 // the worker while it moves (one drawing in flight at a time), in a view
 // that stays still so the map stays under the pointer.

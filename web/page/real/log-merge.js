@@ -4,7 +4,7 @@
 // are replayed as robots of their own (log-worker.js). Logs carry no
 // camera, so what can join them is the maps' own evidence: each robot's
 // finished map goes to the offline merge of `merge-maps` (`MapMerge`,
-// crate/src/merge/offline.rs: wall-surface points, rotations from Hough
+// crate/src/merge/saved/mod.rs: wall-surface points, rotations from Hough
 // spectra, coarse correlation and refinement, then a verdict on the
 // agreement) exactly as a saved ROS map would, PGM and YAML.
 //

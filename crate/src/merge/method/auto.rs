@@ -41,7 +41,7 @@ pub struct Auto;
 /// duration. Compared with every frame kept so far (not only the last),
 /// the frames grow with the places seen, which the world bounds. Frames are
 /// visited in capture order, so the choice only ever adds frames as the
-/// run goes on (what [`crate::merge::described`] relies on). The kept
+/// run goes on (what [`crate::merge::described_ahead`] relies on). The kept
 /// frames are found through a hash grid of `min_m` cells: each frame looks
 /// at its own cell and the eight around it.
 pub fn thin_by_place(infos: &[FrameInfo], min_m: f64, min_rad: f64) -> Vec<usize> {

@@ -4,12 +4,12 @@
 //! ([`crate::merge::selection`]); every kept frame of one robot is compared
 //! with every kept frame of the other (§6.2.3), the table showing MSAC
 //! homography inliers (its Table 1); the best pair gives the distance
-//! between the robots and the transform (§6.2.4, [`crate::merge::thesis`]).
+//! between the robots and the transform (§6.2.4, [`crate::merge::pinhole`]).
 
 use super::{pose3, MethodStages, PairInput};
 use crate::merge::config::MergeConfig;
+use crate::merge::pinhole::{thesis_merge, PairMatch};
 use crate::merge::selection::select_frames;
-use crate::merge::thesis::{thesis_merge, PairMatch};
 use crate::merge::verify::PairCheck;
 use crate::merge::work::{PairOutcome, PairWork, RobotFrames};
 use crate::merge::FrameInfo;

@@ -20,8 +20,8 @@
 //! * **Wall coverage**: the share of true wall length (sampled every
 //!   0.05 m) with an occupied cell within 0.15 m — how much the robot saw.
 
-use super::grid::{CellState, OccupancyGrid};
 use crate::geom::Pose2;
+use crate::slam::grid::{CellState, OccupancyGrid};
 use crate::world::World;
 use glam::DVec2;
 

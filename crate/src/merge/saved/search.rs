@@ -1,13 +1,13 @@
 //! # Finding one saved map in another: rotation, translation, refinement
 //!
-//! The search of the offline merge ([`super::offline`]) proposes overlays
+//! The search of the saved-maps merge ([`super`]) proposes overlays
 //! of map B on map A (B's image frame in A's); [`super::evidence`] judges
 //! them. It is a multi-resolution correlative search in the spirit of
 //! E. Olson, *Real-time correlative scan matching* (ICRA 2009), with the
 //! rotation taken from the maps' wall directions as S. Carpin does in
 //! *Fast and accurate map merging for multi-robot systems* (Autonomous
 //! Robots 25, 2008), the same idea as the lab's own map search
-//! ([`super::mapsearch`]) but made for real maps:
+//! ([`crate::merge::mapsearch`]) but made for real maps:
 //!
 //! 1. **Rotations from the Hough spectrum.** For each normal direction
 //!    `φ` (0.25° steps over 180°) the wall-surface points are binned by
@@ -39,9 +39,9 @@
 //!
 //! Everything is deterministic; no random sampling.
 
-use super::correlation::{add_row, Correlation};
 use super::wallmap::WallMap;
 use crate::geom::{wrap_angle, Pose2};
+use crate::merge::raster_correlation::{add_row, Correlation};
 use glam::DVec2;
 use std::f64::consts::PI;
 

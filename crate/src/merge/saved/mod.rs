@@ -1,19 +1,19 @@
-//! # Merging saved maps offline: two to sixteen ROS maps, no robots
+//! # Merging saved maps: two to sixteen ROS maps, no robots
 //!
 //! Everything else in [`crate::merge`] merges the maps of robots the lab
 //! simulated, with their camera frames and laser scans at hand. Here only
 //! the maps are: ROS `map_server` files from GMapping, slam_toolbox,
-//! Cartographer or Hector, made on different runs ([`crate::rosmap`]
+//! Cartographer or Hector, made on different runs ([`crate::formats::rosmap`]
 //! reads them). The stages, one file each:
 //!
 //! | stage | file | what |
 //! |---|---|---|
-//! | prepare | [`super::wallmap`] | wall-surface points and a distance field per map |
-//! | search | [`super::offline_search`] | rotations from Hough spectra, coarse correlation, refinement |
-//! | judge | [`super::evidence`] | agreement within a tolerance band, acceptance index, margin |
-//! | join | [`super::graph`] | with three or more maps, the most confident spanning tree |
-//! | refine | [`super::refine`] | a pair again, from a person's rough overlay (the page's Refine) |
-//! | write | [`crate::rosmap::write`] | the merged map as PGM + PNG + YAML |
+//! | prepare | [`wallmap`] | wall-surface points and a distance field per map |
+//! | search | [`search`] | rotations from Hough spectra, coarse correlation, refinement |
+//! | judge | [`evidence`] | agreement within a tolerance band, acceptance index, margin |
+//! | join | [`crate::merge::graph`] | with three or more maps, the most confident spanning tree |
+//! | refine | [`refine`] | a pair again, from a person's rough overlay (the page's Refine) |
+//! | write | [`crate::formats::rosmap::write`] | the merged map as PGM + PNG + YAML |
 //!
 //! Each pair of maps is searched and judged on its own; a pair is an edge
 //! when its verdict is "merged", weighted by its confidence, and the maps
@@ -25,24 +25,29 @@
 //! pair's image-frame overlay `P` becomes `origin_A ⊕ P ⊕ origin_B⁻¹`.
 //!
 //! Nothing here changes the lab's own pipeline: the simulated robots'
-//! merge keeps its own search ([`super::mapsearch`]) and verdict.
+//! merge keeps its own search ([`crate::merge::mapsearch`]) and verdict.
 
-use super::evidence::{distinct, evidence, judge, Evidence, EvidenceConfig};
-use super::graph::{spanning_tree, PairEdge};
-use super::offline_search::{propose, RefineConfig, SearchConfig};
-use super::wallmap::WallMap;
-use super::MergeStatus;
+pub mod evidence;
+pub mod refine;
+pub mod search;
+pub mod wallmap;
+
+use self::evidence::{distinct, evidence, judge, Evidence, EvidenceConfig};
+use self::search::{propose, RefineConfig, SearchConfig};
+use self::wallmap::WallMap;
+use crate::formats::rosmap::RosMap;
 use crate::geom::Pose2;
-use crate::rosmap::RosMap;
+use crate::merge::graph::{spanning_tree, PairEdge};
+use crate::merge::MergeStatus;
 use glam::DVec2;
 use serde_json::json;
 
-/// Settings of the offline merge.
+/// Settings of the saved-maps merge.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct OfflineConfig {
+pub struct SavedMergeConfig {
     pub search: SearchConfig,
     pub evidence: EvidenceConfig,
-    /// The search around a person's guess ([`super::refine`]).
+    /// The search around a person's guess ([`refine`]).
     pub refine: RefineConfig,
 }
 
@@ -90,7 +95,7 @@ impl PairResult {
 pub fn agreement_reason(
     e: &Evidence,
     rival_support_m: f64,
-    cfg: &OfflineConfig,
+    cfg: &SavedMergeConfig,
     others: &str,
 ) -> String {
     let ratio = if rival_support_m > 0.0 {
@@ -118,7 +123,7 @@ pub fn agreement_reason(
 
 /// The merge of all maps.
 #[derive(Clone, Debug, PartialEq)]
-pub struct OfflineMerge {
+pub struct SavedMerge {
     pub status: MergeStatus,
     pub reason: String,
     pub confidence: f64,
@@ -132,7 +137,7 @@ pub struct OfflineMerge {
 pub fn merge_pair(
     (ia, a, wa): (usize, &RosMap, &WallMap),
     (ib, b, wb): (usize, &RosMap, &WallMap),
-    cfg: &OfflineConfig,
+    cfg: &SavedMergeConfig,
 ) -> PairResult {
     let mut out = PairResult::unjudged(ia, ib);
     if wa.walls.len() < 10 || wb.walls.len() < 10 {
@@ -160,7 +165,7 @@ pub fn judge_overlays(
     out: &mut PairResult,
     (a, b, wb): (&RosMap, &RosMap, &WallMap),
     judged: &[(Pose2, Evidence)],
-    cfg: &OfflineConfig,
+    cfg: &SavedMergeConfig,
     others: &str,
 ) -> bool {
     let Some(w) = (0..judged.len()).reduce(|best, i| {
@@ -196,9 +201,9 @@ pub fn judge_overlays(
 /// pair.
 pub fn merge_all(
     maps: &[RosMap],
-    cfg: &OfflineConfig,
+    cfg: &SavedMergeConfig,
     progress: &mut dyn FnMut(&str),
-) -> OfflineMerge {
+) -> SavedMerge {
     let prepared: Vec<WallMap> = maps.iter().map(WallMap::new).collect();
     let mut pairs = Vec::new();
     for i in 0..maps.len() {
@@ -227,7 +232,7 @@ pub fn merge_all(
 
 /// Joins `maps` along the most confident spanning tree of the merged
 /// `pairs` (see the module doc) and words the verdict.
-pub fn join(maps: &[RosMap], pairs: Vec<PairResult>) -> OfflineMerge {
+pub fn join(maps: &[RosMap], pairs: Vec<PairResult>) -> SavedMerge {
     let edges: Vec<PairEdge> = pairs
         .iter()
         .filter(|p| p.status == MergeStatus::Merged)
@@ -281,7 +286,7 @@ pub fn join(maps: &[RosMap], pairs: Vec<PairResult>) -> OfflineMerge {
             ),
         )
     };
-    OfflineMerge {
+    SavedMerge {
         status,
         reason,
         confidence: if status == MergeStatus::Merged {
@@ -295,7 +300,7 @@ pub fn join(maps: &[RosMap], pairs: Vec<PairResult>) -> OfflineMerge {
     }
 }
 
-impl OfflineMerge {
+impl SavedMerge {
     /// Puts `pair` in place of the result on the same two maps (either
     /// order) and joins the maps again; returns its index in `pairs`,
     /// `None` when no such pair was judged.
@@ -321,7 +326,7 @@ fn status_name(s: MergeStatus) -> &'static str {
     }
 }
 
-impl OfflineMerge {
+impl SavedMerge {
     /// The report's `maps` and `merge` (docs/interfaces.md, "Real maps:
     /// merge-maps"); the caller adds `timings_ms`.
     pub fn report(&self, maps: &[RosMap]) -> serde_json::Value {

@@ -1,6 +1,6 @@
-//! # Evidence that two real maps show one place, and the offline verdict
+//! # Evidence that two real maps show one place, and the saved-maps verdict
 //!
-//! The lab's verdict ([`super::verdict`]) refuses an overlay as soon as a
+//! The lab's verdict ([`crate::merge::verdict`]) refuses an overlay as soon as a
 //! short piece of wall stands in the other map's free space. On maps the
 //! lab makes itself that is right. On real maps it vetoes the truth: maps
 //! of one building from different runs put 0.3–6 % of their common wall,
@@ -47,7 +47,7 @@ use crate::slam::grid::CellState;
 use glam::DVec2;
 use serde::Serialize;
 
-/// Settings of the offline verdict.
+/// Settings of the saved-maps verdict.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EvidenceConfig {
     pub agree_m: f64,

@@ -1,16 +1,16 @@
 //! # A log replay session: what the CLI's `run-log` and the page drive
 //!
-//! Holds a parsed CARMEN log ([`crate::carmen`]), the stretch of its laser
+//! Holds a parsed CARMEN log ([`crate::formats::carmen`]), the stretch of its laser
 //! records to replay (`from..=to`, positions among the log's laser records),
 //! and the [`LogSlam`] fed with them in file order, a few at a time (so a
 //! page can animate it and a CLI can time it). At the end it draws the map
 //! at the final poses and writes the report of `docs/interfaces.md`
 //! ("Real laser logs: run-log").
 
-use super::export::MapInfo;
-use super::grid::OccupancyGrid;
-use super::logslam::{ClosureInfo, LogSlam, LogSlamConfig, LogSlamStats};
-use crate::carmen::{parse_bytes, CarmenLog, LogError};
+use crate::formats::carmen::{parse_bytes, CarmenLog, LogError};
+use crate::slam::export::MapInfo;
+use crate::slam::grid::OccupancyGrid;
+use crate::slam::logs::logslam::{ClosureInfo, LogSlam, LogSlamConfig, LogSlamStats};
 use serde::Serialize;
 
 /// A replay of one log.
@@ -106,7 +106,7 @@ impl LogReplay {
 
     /// The laser records replayed so far (a page draws the map as it grows
     /// from them with [`LogSlam::build_map`]).
-    pub fn replayed(&self) -> &[crate::carmen::LogScan] {
+    pub fn replayed(&self) -> &[crate::slam::logs::LogScan] {
         &self.log.scans[self.from..self.from + self.next]
     }
 

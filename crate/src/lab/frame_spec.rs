@@ -1,6 +1,6 @@
 //! # A stored frame, for another lab to render and describe
 //!
-//! The session's half of [`crate::merge::described`]: a stored frame's
+//! The session's half of [`crate::merge::described_ahead`]: a stored frame's
 //! parts ([`FrameSpec`]) as JSON, for a lab of the same scenario on another
 //! thread, which renders the same pixels ([`render_spec`]) and may describe
 //! them as the merge would ([`describe_spec`]). A frame's parts include the
@@ -11,7 +11,7 @@
 use crate::camera::{CameraImage, RobotBox};
 use crate::geom::Pose2;
 use crate::merge::config::MergeConfig;
-use crate::merge::described::describe_image;
+use crate::merge::described_ahead::describe_image;
 use crate::sim::Simulation;
 use crate::surf::Features;
 use glam::DVec2;

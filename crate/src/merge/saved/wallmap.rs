@@ -1,6 +1,6 @@
 //! # A saved map made ready to merge: its walls and their distance field
 //!
-//! The offline merge ([`super::offline`]) compares real maps that were
+//! The saved-maps merge ([`super`]) compares real maps that were
 //! made on different days, by different robots, perhaps with different
 //! sensors. Their walls are 1 to 5 cells thick, a little bent against each
 //! other, and cluttered with furniture that one run saw and the other did
@@ -27,7 +27,7 @@
 //! *likelihood field* of Thrun, Burgard and Fox, *Probabilistic Robotics*
 //! §6.4, used for scan matching; here for map matching).
 
-use crate::rosmap::RosMap;
+use crate::formats::rosmap::RosMap;
 use crate::slam::grid::CellState;
 use glam::DVec2;
 
@@ -62,7 +62,7 @@ impl WallMap {
         let state: Vec<u8> = map
             .data
             .iter()
-            .map(|&v| match crate::rosmap::state_of_value(v) {
+            .map(|&v| match crate::formats::rosmap::state_of_value(v) {
                 CellState::Occupied => WALL,
                 CellState::Free => FREE,
                 CellState::Unknown => UNKNOWN,

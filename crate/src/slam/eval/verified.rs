@@ -18,7 +18,7 @@
 //!    `near_rad` of each other by `a` *or* by `b` (either may have put two
 //!    overlapping scans apart).
 //! 2. **The scans' own relation**: scan `j`'s points aligned to scan `i`'s
-//!    by point-to-line ICP ([`super::icp`]), once from `a`'s relative pose
+//!    by point-to-line ICP ([`crate::slam::icp`]), once from `a`'s relative pose
 //!    and once from `b`'s.
 //! 3. **Accepted** when both starts end at the same pose (within `same_m`
 //!    and `same_rad`: the answer is the scans', not the start's), at least
@@ -36,9 +36,9 @@
 //! relations, a scan matcher aligns scans by construction, so the measure
 //! favours one; a scoring tool, which no SLAM reads.
 
-use super::degeneracy::scan_normals;
-use super::icp::{IcpFit, IcpTarget};
 use crate::geom::Pose2;
+use crate::slam::degeneracy::scan_normals;
+use crate::slam::icp::{IcpFit, IcpTarget};
 use glam::DVec2;
 
 /// Settings of [`verified_relations`].

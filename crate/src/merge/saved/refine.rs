@@ -1,6 +1,6 @@
 //! # Refine: aligning two saved maps from a person's rough guess
 //!
-//! The automatic offline merge ([`super::offline`]) searches the whole of
+//! The automatic saved-maps merge ([`super`]) searches the whole of
 //! map A for map B and answers `no_merge` when it cannot tell which overlay
 //! is the right one: a building that looks the same turned by 180°, a row
 //! of identical rooms. A person looking at the two maps often can: the
@@ -26,7 +26,7 @@
 //!    go on.
 //! 2. **The automatic merge's refinement**: each goes through the same
 //!    pattern search on the wide, then narrow field
-//!    ([`super::offline_search::refine`]), so a refined overlay is as
+//!    ([`super::search::refine`]), so a refined overlay is as
 //!    precise as an automatic one.
 //! 3. **The same verdict** ([`super::evidence`]): enough common wall,
 //!    agreement dominating the contradiction (the acceptance index), and a
@@ -48,18 +48,18 @@
 //! knows a person chose the neighbourhood.
 
 use super::evidence::{distinct, evidence, Evidence};
-use super::offline::{judge_overlays, OfflineConfig, PairResult};
-pub use super::offline_search::RefineConfig;
-use super::offline_search::{field_score, refine, thinned};
+pub use super::search::RefineConfig;
+use super::search::{field_score, refine, thinned};
 use super::wallmap::WallMap;
-use super::MergeStatus;
+use super::{judge_overlays, PairResult, SavedMergeConfig};
+use crate::formats::rosmap::RosMap;
 use crate::geom::{wrap_angle, Pose2};
-use crate::rosmap::RosMap;
+use crate::merge::MergeStatus;
 use glam::DVec2;
 
 /// The best distinct coarse overlays (B's image frame in A's) in the window
 /// around `start` (step 1 of the module doc), best first.
-fn window_peaks(a: &WallMap, b: &WallMap, start: Pose2, cfg: &OfflineConfig) -> Vec<Pose2> {
+fn window_peaks(a: &WallMap, b: &WallMap, start: Pose2, cfg: &SavedMergeConfig) -> Vec<Pose2> {
     let r = &cfg.refine;
     let (half_m, step_m) = r.window_m(a.resolution, b.resolution);
     let n = (half_m / step_m).round() as i64;
@@ -106,7 +106,7 @@ fn window_peaks(a: &WallMap, b: &WallMap, start: Pose2, cfg: &OfflineConfig) -> 
 }
 
 /// How every reason of a refined pair begins.
-fn guess_prefix(a: &RosMap, b: &RosMap, cfg: &OfflineConfig) -> String {
+fn guess_prefix(a: &RosMap, b: &RosMap, cfg: &SavedMergeConfig) -> String {
     let (half_m, _) = cfg.refine.window_m(a.resolution, b.resolution);
     format!(
         "refined from your guess (within {:.1} m and {:.0}° of it)",
@@ -122,7 +122,7 @@ pub fn refine_pair(
     (ia, a, wa): (usize, &RosMap, &WallMap),
     (ib, b, wb): (usize, &RosMap, &WallMap),
     guess: Pose2,
-    cfg: &OfflineConfig,
+    cfg: &SavedMergeConfig,
 ) -> Result<PairResult, String> {
     if !guess.is_finite() {
         return Err(format!(
@@ -166,7 +166,7 @@ pub fn refuse_if_beaten(
     refined: &mut PairResult,
     automatic: &PairResult,
     (a, b): (&RosMap, &RosMap),
-    cfg: &OfflineConfig,
+    cfg: &SavedMergeConfig,
 ) -> bool {
     let (Some(mine), Some(theirs)) = (refined.evidence, automatic.evidence) else {
         return false;

@@ -19,7 +19,7 @@
 //!    goes on; a frame chosen early and dropped later costs work, not
 //!    correctness.
 //! 2. One frame's parts, as JSON (the session's `FrameSpec`, in
-//!    `crate::lab::described`, since they hold the camera's true pose), for
+//!    `crate::lab::frame_spec`, since they hold the camera's true pose), for
 //!    the other lab, which describes it and sends back the features packed
 //!    in a flat `f32` array ([`encode`]). The work splits in two halves as
 //!    well: the other lab may only render the frame and send its grey bytes

@@ -14,7 +14,7 @@
 //! a few decimetres of where it belongs:
 //!
 //! 1. for every key, each earlier visit to its place (runs of keys within
-//!    `radius_m`, [`super::loop_closure::find_closure_among`]'s visits, not
+//!    `radius_m`, [`crate::slam::loop_closure::find_closure_among`]'s visits, not
 //!    only the nearest) is a candidate;
 //! 2. the key's scan is matched against that visit's keys in a *narrow*
 //!    window around its current estimate (`window`): the graph is already
@@ -29,11 +29,13 @@
 //! left, so a place whose passes were too far apart for the narrow window
 //! may come within it.
 
-use super::degeneracy::scan_normals_within;
-use super::icp::IcpTarget;
-use super::loop_closure::{match_visit, on_window_edge, visit_centres, visit_keys, LoopConfig};
-use super::multires::Window;
-use super::posegraph::PoseGraph;
+use crate::slam::degeneracy::scan_normals_within;
+use crate::slam::icp::IcpTarget;
+use crate::slam::loop_closure::{
+    match_visit, on_window_edge, visit_centres, visit_keys, LoopConfig,
+};
+use crate::slam::multires::Window;
+use crate::slam::posegraph::PoseGraph;
 use glam::DVec2;
 use std::collections::BTreeSet;
 
@@ -53,7 +55,7 @@ pub struct RefineConfig {
     /// Φ of Dynamic Covariance Scaling in the optimisation.
     pub dcs_phi: f64,
     /// Refine each link by point-to-line ICP on the visit's points
-    /// ([`super::icp`]), off the matcher's raster grain.
+    /// ([`crate::slam::icp`]), off the matcher's raster grain.
     pub icp: bool,
     /// A link whose ICP answer is pinned less than this in its weakest
     /// direction (points' worth) is dropped.

@@ -1,14 +1,14 @@
-//! The offline merge of saved maps (crate/src/merge/offline.rs) on maps cut
+//! The merge of saved maps (crate/src/merge/saved/) on maps cut
 //! from generated buildings with known transforms: a pair merges to the
 //! truth, three maps join along the spanning tree, two different buildings
 //! are refused, and the merged map is written as ROS map_server files.
 
 use glam::DVec2;
+use slamlab::formats::rosmap::{self, RosMap};
 use slamlab::geom::{wrap_angle, Pose2, Segment};
-use slamlab::merge::offline::{merge_all, OfflineConfig};
+use slamlab::merge::saved::{merge_all, SavedMergeConfig};
 use slamlab::merge::MergeStatus;
 use slamlab::rng::Rng;
-use slamlab::rosmap::{self, RosMap};
 
 /// A floor plan: an outer `w × h` rectangle, rooms along two sides of a
 /// corridor, doors, a slanted wall and pillars, placed by `seed`.
@@ -118,7 +118,7 @@ fn turned_frame(x0: f64, x1: f64, h: f64, theta: f64, size: f64) -> Pose2 {
 #[test]
 fn a_pair_cut_from_one_building_merges_to_the_known_transform() {
     let (a, b, truth) = east_west_pair();
-    let r = merge_all(&[a, b], &OfflineConfig::default(), &mut |_| {});
+    let r = merge_all(&[a, b], &SavedMergeConfig::default(), &mut |_| {});
     assert_eq!(r.status, MergeStatus::Merged, "{}", r.reason);
     let est = r.poses[1].unwrap();
     let (dm, dd) = error(&est, &truth);
@@ -149,7 +149,7 @@ fn three_maps_join_along_the_spanning_tree() {
     );
     let fc = turned_frame(10.0, 37.0, h, 2.5, 38.0);
     let c = plan.cut("c.yaml", fc, DVec2::new(38.0, 38.0), |p| p.x >= 10.0, oa);
-    let r = merge_all(&[a, b, c], &OfflineConfig::default(), &mut |line| {
+    let r = merge_all(&[a, b, c], &SavedMergeConfig::default(), &mut |line| {
         println!("{line}")
     });
     assert_eq!(r.status, MergeStatus::Merged, "{}", r.reason);
@@ -178,7 +178,7 @@ fn two_buildings() -> (RosMap, RosMap, Pose2) {
 #[test]
 fn two_different_buildings_are_not_merged() {
     let (a, b, _) = two_buildings();
-    let r = merge_all(&[a, b], &OfflineConfig::default(), &mut |_| {});
+    let r = merge_all(&[a, b], &SavedMergeConfig::default(), &mut |_| {});
     println!("different buildings: {}", r.reason);
     assert_eq!(r.status, MergeStatus::NoMerge, "{}", r.reason);
     assert_eq!(r.unjoined, vec![1]);
@@ -223,15 +223,15 @@ fn the_merged_map_is_written_as_map_server_files() {
     assert_eq!(from_png.data, back.data);
 }
 
-// Refine (crate/src/merge/refine.rs): a pair aligned again from a person's
+// Refine (crate/src/merge/saved/refine.rs): a pair aligned again from a person's
 // rough overlay, judged by the same verdict.
 
 #[path = "merge_support/guess.rs"]
 mod guess;
 use guess::{middle, nudged, refined};
-use slamlab::merge::offline::join;
-use slamlab::merge::refine::refine_pair;
-use slamlab::merge::wallmap::WallMap;
+use slamlab::merge::saved::join;
+use slamlab::merge::saved::refine::refine_pair;
+use slamlab::merge::saved::wallmap::WallMap;
 
 /// The first test's pair (A the west part of a building, B the east part
 /// turned by 0.7 rad, both with YAML origins) and B's true pose in A.
@@ -323,8 +323,13 @@ fn refine_refuses_a_guess_that_is_not_finite() {
         Pose2::new(0.0, f64::INFINITY, 0.0),
         Pose2::new(0.0, 0.0, f64::NEG_INFINITY),
     ] {
-        let e =
-            refine_pair((0, &a, &wa), (1, &b, &wb), guess, &OfflineConfig::default()).unwrap_err();
+        let e = refine_pair(
+            (0, &a, &wa),
+            (1, &b, &wb),
+            guess,
+            &SavedMergeConfig::default(),
+        )
+        .unwrap_err();
         assert!(e.contains("finite"), "{e}");
     }
 }
@@ -351,7 +356,7 @@ fn refine_merges_a_symmetric_building_the_automatic_merge_declines() {
     let b = plan.cut("b.yaml", fb, DVec2::new(44.0, 44.0), all, Pose2::IDENTITY);
     let truth = fa.between(&fb);
     let maps = [a, b];
-    let mut r = merge_all(&maps, &OfflineConfig::default(), &mut |_| {});
+    let mut r = merge_all(&maps, &SavedMergeConfig::default(), &mut |_| {});
     println!("symmetric building, automatic: {}", r.reason);
     assert_eq!(r.status, MergeStatus::NoMerge, "{}", r.reason);
     assert!(r.reason.contains("ambiguous"), "{}", r.reason);
@@ -381,11 +386,11 @@ fn refine_merges_a_symmetric_building_the_automatic_merge_declines() {
 
 #[test]
 fn refine_is_refused_where_the_automatic_merge_found_a_clear_winner_elsewhere() {
-    use slamlab::merge::offline::merge_pair;
-    use slamlab::merge::refine::refuse_if_beaten;
+    use slamlab::merge::saved::merge_pair;
+    use slamlab::merge::saved::refine::refuse_if_beaten;
     let (a, b, truth) = east_west_pair();
     let (wa, wb) = (WallMap::new(&a), WallMap::new(&b));
-    let cfg = OfflineConfig::default();
+    let cfg = SavedMergeConfig::default();
     let automatic = merge_pair((0, &a, &wa), (1, &b, &wb), &cfg);
     let guess = nudged(&truth, middle(&b), 0.1, DVec2::new(0.5, 0.5));
     let mine = refined(&a, &b, guess);

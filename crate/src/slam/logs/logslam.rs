@@ -1,6 +1,6 @@
 //! # SLAM for real laser logs: scan-to-map matching, a pose graph, loop closures
 //!
-//! The driver that replays a CARMEN log ([`crate::carmen`]) in file order,
+//! The driver that replays a CARMEN log ([`crate::formats::carmen`]) in file order,
 //! in the manner of Karto / slam_toolbox (Konolige et al., IROS 2010) and
 //! Cartographer (Hess et al., ICRA 2016):
 //!
@@ -9,7 +9,7 @@
 //! 2. **Match** the scan against the local map — the points of the last
 //!    `local_keys` key scans at their current estimates — with Olson's
 //!    multi-resolution correlative search and a Gauss–Newton refinement
-//!    ([`super::multires`]). A narrow window first; if its best pose lies
+//!    ([`crate::slam::multires`]). A narrow window first; if its best pose lies
 //!    on the window's edge or scores poorly, a wide window (real wheel
 //!    odometry slips: the raw MIT CSAIL log's heading jumps by 10–30°).
 //!    The wide window turns far (35°) but reaches only 0.6 m: in a corridor
@@ -46,15 +46,15 @@
 //!    by more than the narrow window, the scan is also matched around that
 //!    prediction, and the better-scoring match is kept.
 //! 3. **Key scans** (every `key_distance_m` or `key_angle_rad` of motion)
-//!    become nodes of the pose graph ([`super::posegraph`]), linked to the
+//!    become nodes of the pose graph ([`crate::slam::posegraph`]), linked to the
 //!    previous key by the matched relative pose (or, where no match held,
 //!    by odometry with a looser covariance). The matched edge's covariance
 //!    is one σ for all (`key_sigma_m`, `key_sigma_rad`), or with
 //!    `key_covariance` the match's own, from the spread of the matcher's
-//!    response ([`super::match_covariance`]; measured in BENCHMARKS.md,
+//!    response ([`crate::slam::match_covariance`]; measured in BENCHMARKS.md,
 //!    off by default). Other scans are stored relative
 //!    to their key, so they follow it when the graph moves.
-//! 4. **Loop closures** ([`super::loop_closure`]): every `loop_every` keys
+//! 4. **Loop closures** ([`crate::slam::loop_closure`]): every `loop_every` keys
 //!    the new key is matched against older keys near its estimate (with
 //!    `loop_visits` > 1, against the nearest key of each of that many
 //!    earlier passes through the place, the best match kept). A closure
@@ -68,7 +68,7 @@
 //!    from 0.43 to 0.22 m, BENCHMARKS.md). With `loop_min_weak` > 0 a
 //!    closure is also refused when the new key's points, laid at the match
 //!    onto the visit's scans, pin it in their weakest direction by fewer
-//!    than that many points' worth ([`super::loop_closure::closure_fit`]):
+//!    than that many points' worth ([`crate::slam::loop_closure::closure_fit`]):
 //!    a corridor whose ends are out of sight pins nothing along it. Off by
 //!    default: it removes the corridor slides that make some settings'
 //!    figures jump, but costs the corridor-rich logs right closures too
@@ -82,11 +82,11 @@
 //!    reaches ±1.5 m, and on one try in `grown_every` (4) further, by
 //!    0.03 m for every metre of the shortest path from the old key through
 //!    the chain and the closures accepted so far, up to 16 m
-//!    ([`super::loop_closure::closure_window`]): in a convention hall or
+//!    ([`crate::slam::loop_closure::closure_window`]): in a convention hall or
 //!    around a campus the drift a revisit must undo reaches metres. (Up
 //!    to 8 m, a 250 m campus left 52 of its 144 revisits out of reach,
 //!    needing 14–21 m; at 16 m, 11. The relations its scans fix between
-//!    revisits ([`super::verified`]) went from 0.235 to 0.040 m off, an
+//!    revisits ([`crate::slam::eval::verified`]) went from 0.235 to 0.040 m off, an
 //!    MIT corridor's from 0.200 to 0.038 m, every other log as before;
 //!    24 and 32 m gave the same figures. BENCHMARKS.md, session 40.) A
 //!    match found only in the grown reach must score `far_min_score` and
@@ -111,7 +111,7 @@
 //!    with key edges of σ 0.1 m the graph absorbs each closure, wrong ones
 //!    included, to χ² < 1.)
 //!
-//! 7. **Closing refinement** ([`super::log_refine`], off unless
+//! 7. **Closing refinement** ([`super::refine`], off unless
 //!    `refine.rounds` > 0): once the log is replayed, every key is linked
 //!    to every earlier visit to its place (Karto's near chains), each link
 //!    refined by point-to-line ICP, and the graph optimised again. It makes
@@ -123,19 +123,19 @@
 //! The poses are in the log's odometry frame: the first scan's pose is its
 //! odometry pose, and the graph's first node stays fixed there.
 
-use super::grid::{GridConfig, OccupancyGrid, GROW_STEP_CELLS};
-use super::likelihood::LikelihoodField;
-use super::log_refine::{refine, RefineConfig};
-use super::loop_closure::{
+use super::refine::{refine, RefineConfig};
+use super::scan::LogScan;
+use crate::geom::{wrap_angle, Pose2};
+use crate::slam::grid::{GridConfig, OccupancyGrid, GROW_STEP_CELLS};
+use crate::slam::likelihood::LikelihoodField;
+use crate::slam::loop_closure::{
     closure_fit, closures_agree, find_closure_among, loosened_along_weak, on_window_edge, Closure,
     LoopConfig,
 };
-use super::manhattan::{scan_direction, settle_priors, ManhattanConfig};
-use super::match_covariance::{edge_information, response_covariance, ResponseWindow};
-use super::multires::{field_from_points, match_scan, ScanMatch, Window};
-use super::posegraph::{Edge, PoseGraph};
-use crate::carmen::LogScan;
-use crate::geom::{wrap_angle, Pose2};
+use crate::slam::manhattan::{scan_direction, settle_priors, ManhattanConfig};
+use crate::slam::match_covariance::{edge_information, response_covariance, ResponseWindow};
+use crate::slam::multires::{field_from_points, match_scan, ScanMatch, Window};
+use crate::slam::posegraph::{Edge, PoseGraph};
 use glam::DVec2;
 
 /// Settings of the log SLAM.
@@ -182,13 +182,13 @@ pub struct LogSlamConfig {
     /// disagrees with the odometry's (see the module doc).
     pub velocity_prior: bool,
     /// Dynamic Covariance Scaling of the loop closures (Agarwal et al.
-    /// 2013; [`super::posegraph`]): Φ, or 0 for plain least squares.
+    /// 2013; [`crate::slam::posegraph`]): Φ, or 0 for plain least squares.
     pub dcs_phi: f64,
     /// Whether DCS also weighs the optimisations that accept closures (else
     /// only the final one, started from the accepted graph).
     pub dcs_incremental: bool,
     /// Weigh each matched key edge by its own match's covariance (the
-    /// spread of the matcher's response, [`super::match_covariance`])
+    /// spread of the matcher's response, [`crate::slam::match_covariance`])
     /// instead of `key_sigma_m` / `key_sigma_rad`.
     pub key_covariance: bool,
     /// The same for loop closures (instead of `loops.sigma_m` /
@@ -209,7 +209,7 @@ pub struct LogSlamConfig {
     /// Least score of such a scan-to-scan match.
     pub chain_min_score: f64,
     /// Closure candidates: the nearest key of up to this many earlier
-    /// visits to the place ([`super::loop_closure::find_closure_among`]).
+    /// visits to the place ([`crate::slam::loop_closure::find_closure_among`]).
     pub loop_visits: usize,
     /// Refuse a closure whose match lies on the edge of the closure search
     /// window (the best pose inside the window is then not a peak of the
@@ -218,7 +218,7 @@ pub struct LogSlamConfig {
     /// Refuse a closure whose match leaves the new key pinned by fewer than
     /// this many points' worth of constraint in its weakest direction, as
     /// a point-to-line fit onto the visit's scans at the matched pose sees
-    /// it ([`super::loop_closure::closure_fit`]; 0: off). A corridor pins a scan only across
+    /// it ([`crate::slam::loop_closure::closure_fit`]; 0: off). A corridor pins a scan only across
     /// itself, and a closure there can slide along it by metres.
     pub loop_min_weak: f64,
     /// With a closure window that grows with the path
@@ -236,12 +236,12 @@ pub struct LogSlamConfig {
     /// A closure's edge is loose along its weakest direction: its variance
     /// there is `loops.sigma_m²` times the ratio of the strong to the weak
     /// eigenvalue of the match's point-to-line information, at most this
-    /// ([`super::loop_closure::loosened_along_weak`]; 0 or 1: one σ for
+    /// ([`crate::slam::loop_closure::loosened_along_weak`]; 0 or 1: one σ for
     /// all). A corridor's closure is right across it and unsure along it.
     pub loop_loosen_ratio: f64,
-    /// The closing refinement after the replay ([`super::log_refine`]).
+    /// The closing refinement after the replay ([`super::refine`]).
     pub refine: RefineConfig,
-    /// Square walls' heading prior after the replay ([`super::manhattan`];
+    /// Square walls' heading prior after the replay ([`crate::slam::manhattan`];
     /// `None`: off). On: a building whose walls are not square gets no
     /// prior.
     pub manhattan: Option<ManhattanConfig>,
@@ -353,9 +353,9 @@ pub struct LogSlamStats {
     pub closures_far_weak: usize,
     /// Closures refused as not pinned in every direction (`loop_min_weak`).
     pub closures_degenerate: usize,
-    /// Links the closing refinement added ([`super::log_refine`]).
+    /// Links the closing refinement added ([`super::refine`]).
     pub refine_links: usize,
-    /// Keys given a square walls' heading prior ([`super::manhattan`]).
+    /// Keys given a square walls' heading prior ([`crate::slam::manhattan`]).
     pub square_keys: usize,
 }
 

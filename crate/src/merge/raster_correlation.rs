@@ -1,6 +1,6 @@
 //! A translation correlation of two rasters and its peaks, shared by the
 //! map search of the lab's own maps ([`super::mapsearch`]) and of saved
-//! real maps ([`super::offline_search`]).
+//! real maps ([`super::saved::search`]).
 //!
 //! Both searches score every whole-cell translation of one raster (B) over
 //! the other (A) at once: each wall cell of one raster adds a row of the
