@@ -9,6 +9,8 @@
 //! |---|---|---|
 //! | CARMEN laser logs (`.log`, `.clf`, gzip or not) | [`carmen`] | [`crate::slam::logs::LogScan`]s |
 //! | ROS `map_server` maps (YAML + PGM / PNG) | [`rosmap`] | [`rosmap::RosMap`] |
+//! | ROS bags: ROS 1 `.bag`, MCAP, rosbag2 `.db3` | [`bag`] | topics and decoded messages |
 
+pub mod bag;
 pub mod carmen;
 pub mod rosmap;
