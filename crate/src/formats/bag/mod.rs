@@ -26,12 +26,15 @@ pub mod messages;
 use std::fmt;
 
 /// How a message's bytes are serialised.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Encoding {
     /// ROS 1 serialisation: little-endian, packed, `u32` lengths.
     Ros1,
     /// ROS 2's CDR (OMG XTypes, encapsulation header first), aligned.
     Cdr,
+    /// Anything else (an MCAP channel of JSON or protobuf, say): listed,
+    /// counted, never decoded.
+    Other(String),
 }
 
 /// One topic of a bag: a ROS 1 connection, an MCAP channel, a rosbag2
