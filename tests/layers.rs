@@ -9,7 +9,10 @@
 //!   the bindings names `crate::bindings`;
 //! * the files of one folder import each other in a circle (`super::NAME`
 //!   of a sibling file);
-//! * a module the table does not know appears (add it to its layer).
+//! * a module the table does not know appears (add it to its layer);
+//! * a bindings file names any module but `lab` (the boundary converts
+//!   only: the plain value types it needs, `lab` re-exports), or builds
+//!   JSON by hand (`json!`) instead of serialising what `lab` returns.
 //!
 //! Native only: the wasm build of the tests has no file system.
 #![cfg(not(target_arch = "wasm32"))]
@@ -160,6 +163,32 @@ fn imports_run_down_the_layers_only() {
                     f.display()
                 )),
             }
+        }
+    }
+    assert!(wrong.is_empty(), "\n{}", wrong.join("\n"));
+}
+
+#[test]
+fn bindings_name_only_the_session_and_build_no_json() {
+    let mut files = Vec::new();
+    rust_files(&src_dir().join("bindings"), &mut files);
+    assert!(files.len() >= 5, "the bindings folder has its files");
+    let mut wrong = Vec::new();
+    for f in &files {
+        let code = code_of(f);
+        for used in names_after(&code, "crate::") {
+            if used != "lab" {
+                wrong.push(format!(
+                    "{} names crate::{used}: bindings call `lab` only",
+                    f.display()
+                ));
+            }
+        }
+        if code.contains("json!") {
+            wrong.push(format!(
+                "{} builds JSON by hand: views are built in `lab`",
+                f.display()
+            ));
         }
     }
     assert!(wrong.is_empty(), "\n{}", wrong.join("\n"));

@@ -332,7 +332,7 @@ fn colour_jpeg_and_grey_png_decode_to_the_same_size() {
 
 #[wasm_bindgen_test(unsupported = test)]
 fn features_json_has_the_interface_fields() {
-    let json = slamlab::bindings::surf::features_json(ASTRONAUT).expect("decodes");
+    let json = slamlab::lab::images::features_json(ASTRONAUT).expect("decodes");
     let v: serde_json::Value = serde_json::from_str(&json).expect("json");
     assert_eq!(v["width"], 640);
     assert_eq!(v["height"], 480);
@@ -349,14 +349,14 @@ fn features_json_has_the_interface_fields() {
         assert!((norm - 1.0).abs() < 1e-4);
     }
     assert!(matches!(
-        slamlab::bindings::surf::features_json(b"nope"),
+        slamlab::lab::images::features_json(b"nope"),
         Err(SurfError::NotAnImage(_))
     ));
 }
 
 #[wasm_bindgen_test(unsupported = test)]
 fn match_json_recovers_the_shipped_warped_pair() {
-    let json = slamlab::bindings::surf::match_json(COFFEE, COFFEE_ROT12_S085).expect("decodes");
+    let json = slamlab::lab::images::match_json(COFFEE, COFFEE_ROT12_S085).expect("decodes");
     let v: serde_json::Value = serde_json::from_str(&json).expect("json");
     assert!(v["matches"].as_u64().expect("n") >= 50);
     assert!(v["inliers"].as_u64().expect("n") >= 40);
@@ -374,7 +374,7 @@ fn match_json_recovers_the_shipped_warped_pair() {
     // No overlap: a photo against a constant image has no homography.
     let flat = png_of(&GrayImage::new(64, 64, vec![9; 64 * 64]).expect("valid"));
     let v: serde_json::Value =
-        serde_json::from_str(&slamlab::bindings::surf::match_json(COFFEE, &flat).expect("ok"))
+        serde_json::from_str(&slamlab::lab::images::match_json(COFFEE, &flat).expect("ok"))
             .expect("json");
     assert_eq!(v["matches"], 0);
     assert!(v["homography"].is_null() && v["quad"].is_null());

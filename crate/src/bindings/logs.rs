@@ -1,22 +1,18 @@
 //! # JavaScript boundary of the log replay
 //!
-//! `LogReplay` wraps [`crate::lab::log_replay::LogReplay`]: open a CARMEN
-//! log from its bytes (plain or gzip), optionally restrict it to a stretch of
-//! laser records, replay it a few scans at a time, finish, then read the
-//! report (JSON) and the map (ROS map_server PGM + YAML, PNG).
+//! `LogReplay` wraps the log replay session ([`crate::lab::log_replay`]):
+//! open a CARMEN log from its bytes (plain or gzip), optionally restrict it
+//! to a stretch of laser records, replay it a few scans at a time, finish,
+//! then read the report (JSON) and the map (ROS map_server PGM + YAML,
+//! PNG). Converts only.
 
+use super::convert::{js_err as err, to_json};
 use crate::lab::log_replay;
-use crate::slam::export::{self, MapInfo};
-use crate::slam::grid::OccupancyGrid;
 use wasm_bindgen::prelude::*;
-
-use super::convert::js_err as err;
 
 #[wasm_bindgen]
 pub struct LogReplay {
     inner: log_replay::LogReplay,
-    /// The map drawn by `drawLive` (the scans so far at today's poses).
-    live: Option<OccupancyGrid>,
 }
 
 #[wasm_bindgen]
@@ -26,7 +22,6 @@ impl LogReplay {
     pub fn new(bytes: &[u8]) -> Result<LogReplay, JsError> {
         Ok(LogReplay {
             inner: log_replay::LogReplay::new(bytes).map_err(err)?,
-            live: None,
         })
     }
 
@@ -57,57 +52,35 @@ impl LogReplay {
     #[wasm_bindgen(js_name = reportJson)]
     pub fn report_json(&self, timings_json: &str) -> Result<String, JsError> {
         let timings: serde_json::Value = serde_json::from_str(timings_json).map_err(err)?;
-        let report = self.inner.report(timings).map_err(err)?;
-        serde_json::to_string(&report).map_err(err)
+        to_json(&self.inner.report(timings).map_err(err)?)
     }
 
     /// The map as a binary PGM (ROS map_server).
     #[wasm_bindgen(js_name = mapPgm)]
     pub fn map_pgm(&self) -> Result<Vec<u8>, JsError> {
-        Ok(export::to_pgm(self.inner.map().map_err(err)?))
+        self.inner.map_pgm().map_err(err)
     }
 
     /// The map as a PNG.
     #[wasm_bindgen(js_name = mapPng)]
     pub fn map_png(&self) -> Result<Vec<u8>, JsError> {
-        export::to_png(self.inner.map().map_err(err)?).map_err(err)
+        self.inner.map_png().map_err(err)
     }
 
     /// The map_server YAML naming `image` (the PGM's file name).
     #[wasm_bindgen(js_name = mapYaml)]
     pub fn map_yaml(&self, image: &str) -> Result<String, JsError> {
-        Ok(export::to_yaml(self.inner.map().map_err(err)?, image))
+        self.inner.map_yaml(image).map_err(err)
     }
 
     /// The replay so far, for a page that animates it (JSON): `done` and
     /// `total` scans, each replayed scan's odometry and current SLAM pose
-    /// as flat `[x, y, theta, ...]` lists (the same frame: the first scan
-    /// at its odometry pose), and each loop closure found so far as the
-    /// segment between its two key scans' current poses
+    /// as flat `[x, y, theta, ...]` lists, and each loop closure found so
+    /// far as the segment between its two key scans' current poses
     /// (`[x1, y1, x2, y2]`), with its scan indices and score.
     #[wasm_bindgen(js_name = viewJson)]
     pub fn view_json(&self) -> Result<String, JsError> {
-        let slam = &self.inner.slam;
-        let flat = |poses: &mut dyn Iterator<Item = crate::geom::Pose2>| -> Vec<f64> {
-            poses.flat_map(|p| [p.x, p.y, p.theta]).collect()
-        };
-        let odometry = flat(&mut slam.scans.iter().map(|s| s.odometry));
-        let poses = flat(&mut slam.poses().into_iter());
-        let node = |k: usize| slam.graph.nodes.get(k).copied().unwrap_or_default();
-        let closures: Vec<serde_json::Value> = slam
-            .closures
-            .iter()
-            .map(|c| {
-                let (a, b) = (node(c.from_key), node(c.to_key));
-                serde_json::json!({"segment": [a.x, a.y, b.x, b.y], "from_scan": c.from_scan, "to_scan": c.to_scan, "score": c.score})
-            })
-            .collect();
-        let total = self.inner.replayed().len() + self.inner.remaining();
-        Ok(serde_json::json!({
-            "done": self.inner.replayed().len(), "total": total,
-            "odometry": odometry, "poses": poses, "closures": closures,
-        })
-        .to_string())
+        to_json(&self.inner.view())
     }
 
     /// Draws the map of the scans replayed so far at their current poses
@@ -115,31 +88,18 @@ impl LogReplay {
     /// the first scan.
     #[wasm_bindgen(js_name = drawLive)]
     pub fn draw_live(&mut self) -> bool {
-        let scans = self.inner.replayed();
-        if scans.is_empty() {
-            return false;
-        }
-        self.live = Some(self.inner.slam.build_map(scans));
-        true
+        self.inner.draw_live()
     }
 
     /// Size, resolution and origin of the live map (`MapInfo` JSON).
     #[wasm_bindgen(js_name = liveInfoJson)]
     pub fn live_info_json(&self) -> Result<String, JsError> {
-        let grid = self
-            .live
-            .as_ref()
-            .ok_or_else(|| JsError::new("drawLive first"))?;
-        serde_json::to_string(&MapInfo::of(grid)).map_err(err)
+        to_json(&self.inner.live_info().map_err(err)?)
     }
 
     /// The live map's grey pixels (PGM shades), top row first.
     #[wasm_bindgen(js_name = livePixels)]
     pub fn live_pixels(&self) -> Result<Vec<u8>, JsError> {
-        let grid = self
-            .live
-            .as_ref()
-            .ok_or_else(|| JsError::new("drawLive first"))?;
-        Ok(export::grey_rows_top_first(grid))
+        self.inner.live_pixels().map_err(err)
     }
 }

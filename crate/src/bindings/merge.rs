@@ -9,7 +9,7 @@
 
 use super::convert::{js_err as err, put_rgba, to_json as json};
 use super::Lab;
-use crate::merge::MergeMethod;
+use crate::lab::MergeMethod;
 use wasm_bindgen::prelude::*;
 
 #[wasm_bindgen]
@@ -68,8 +68,9 @@ impl Lab {
         let method = MergeMethod::parse(method).map_err(err)?;
         let spec: crate::lab::frame_spec::FrameSpec =
             serde_json::from_str(spec_json).map_err(|e| err(format!("frame spec: {e}")))?;
-        let f = self.inner.describe_frame_spec(&spec, method).map_err(err)?;
-        Ok(crate::merge::described_ahead::encode(&f))
+        self.inner
+            .describe_frame_spec_packed(&spec, method)
+            .map_err(err)
     }
 
     /// In a lab of the same scenario (a worker's): the grey pixels of the
@@ -113,9 +114,8 @@ impl Lab {
         packed: &[f32],
     ) -> Result<bool, JsError> {
         let method = MergeMethod::parse(method).map_err(err)?;
-        let f = crate::merge::described_ahead::decode(packed).map_err(err)?;
         self.inner
-            .store_described(robot as usize, index as usize, method, f)
+            .store_described_packed(robot as usize, index as usize, method, packed)
             .map_err(err)
     }
 

@@ -10,7 +10,7 @@ mod logs;
 mod maps;
 mod merge;
 mod slam;
-pub mod surf;
+mod surf;
 
 /// The one error conversion, JSON serialisation and pixel copy every
 /// binding block uses.
@@ -18,10 +18,8 @@ mod convert;
 
 use crate::lab;
 use crate::lab::report::Timings;
-use crate::render::RenderOptions;
-use crate::scenario::Scenario;
+use crate::lab::RenderOptions;
 use convert::{js_err, put_rgba, ChunkSink};
-use image::ImageEncoder;
 use wasm_bindgen::prelude::*;
 
 #[wasm_bindgen]
@@ -62,8 +60,7 @@ pub fn start() {
 /// default filled in, as pretty JSON.
 #[wasm_bindgen(js_name = validateScenario)]
 pub fn validate_scenario(json: &str) -> Result<String, JsError> {
-    let s = Scenario::from_json(json).map_err(js_err)?;
-    Ok(s.to_json_pretty())
+    lab::validate_scenario(json).map_err(js_err)
 }
 
 /// The crate version, for the page's footer and reports.
@@ -76,7 +73,7 @@ pub fn version() -> String {
 /// `[[r, g, b], ...]` (the page's legend and readouts use the same).
 #[wasm_bindgen(js_name = robotColours)]
 pub fn robot_colours() -> String {
-    serde_json::to_string(&crate::palette::ROBOT_COLOURS).unwrap_or_else(|_| "[]".into())
+    lab::robot_colours_json()
 }
 
 /// Whether this build was compiled with wasm SIMD128.
@@ -89,19 +86,6 @@ pub fn simd_enabled() -> bool {
 #[wasm_bindgen]
 pub struct Lab {
     inner: lab::Lab,
-}
-
-impl Lab {
-    /// Captured frame `index` of robot `robot`, or the message saying why not.
-    fn frame_at(
-        &self,
-        robot: u32,
-        index: u32,
-    ) -> Result<&crate::camera::capture::CapturedFrame, JsError> {
-        self.inner
-            .frame(robot as usize, index as usize)
-            .map_err(js_err)
-    }
 }
 
 #[wasm_bindgen]
@@ -338,8 +322,10 @@ impl Lab {
         index: u32,
         ctx: &web_sys::CanvasRenderingContext2d,
     ) -> Result<(), JsError> {
-        let f = self.frame_at(robot, index)?;
-        let img = self.inner.frame_image(f).map_err(js_err)?;
+        let img = self
+            .inner
+            .frame_grey(robot as usize, index as usize)
+            .map_err(js_err)?;
         let rgba: Vec<u8> = img.gray.iter().flat_map(|&g| [g, g, g, 255]).collect();
         put_rgba(ctx, &rgba, img.width, img.height)
     }
@@ -357,28 +343,10 @@ impl Lab {
         width: u32,
         ctx: &web_sys::CanvasRenderingContext2d,
     ) -> Result<(), JsError> {
-        let sim = self
+        let img = self
             .inner
-            .simulation()
-            .ok_or_else(|| JsError::new("nothing has run yet"))?;
-        let f = self.frame_at(robot, index)?;
-        if width == 0 || width > sim.camera.width {
-            return Err(JsError::new(&format!(
-                "thumbnail width {width} must be 1 to the camera's {} pixels",
-                sim.camera.width
-            )));
-        }
-        let cam = sim.camera.scaled(width);
-        let img = crate::camera::render(
-            &cam,
-            &f.truth,
-            &sim.world,
-            &sim.scenario.walls,
-            &f.others,
-            &mut sim.textures.lock(),
-            false,
-            None,
-        );
+            .frame_thumbnail(robot as usize, index as usize, width)
+            .map_err(js_err)?;
         let rgba: Vec<u8> = img.gray.iter().flat_map(|&g| [g, g, g, 255]).collect();
         put_rgba(ctx, &rgba, img.width, img.height)
     }
@@ -386,25 +354,19 @@ impl Lab {
     /// Captured frame `index` of robot `robot` as grey bytes.
     #[wasm_bindgen(js_name = frameGray)]
     pub fn frame_gray(&self, robot: u32, index: u32) -> Result<Vec<u8>, JsError> {
-        let f = self.frame_at(robot, index)?;
-        Ok(self.inner.frame_image(f).map_err(js_err)?.gray)
+        Ok(self
+            .inner
+            .frame_grey(robot as usize, index as usize)
+            .map_err(js_err)?
+            .gray)
     }
 
     /// Captured frame `index` of robot `robot` as a PNG file (8-bit grey).
     #[wasm_bindgen(js_name = framePng)]
     pub fn frame_png(&self, robot: u32, index: u32) -> Result<Vec<u8>, JsError> {
-        let f = self.frame_at(robot, index)?;
-        let img = self.inner.frame_image(f).map_err(js_err)?;
-        let mut out = Vec::new();
-        image::codecs::png::PngEncoder::new(&mut out)
-            .write_image(
-                &img.gray,
-                img.width,
-                img.height,
-                image::ExtendedColorType::L8,
-            )
-            .map_err(js_err)?;
-        Ok(out)
+        self.inner
+            .frame_png(robot as usize, index as usize)
+            .map_err(js_err)
     }
 
     /// Puts a PNG or JPEG picture on every wall whose texture is `image:NAME`.

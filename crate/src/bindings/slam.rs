@@ -7,7 +7,8 @@
 
 use super::convert::{js_err as err, put_rgba, to_json};
 use super::Lab;
-use crate::slam::MapperKind;
+use crate::lab::mapping_away::MappingAway;
+use crate::lab::MapperKind;
 use wasm_bindgen::prelude::*;
 
 fn kind(mapper: &str) -> Result<MapperKind, JsError> {
@@ -140,11 +141,11 @@ impl Lab {
 
 /// A robot's mapping on another thread (`web/cli/slam-pool.mjs`): made
 /// from `Lab.sendMappingAway`'s bytes, fed `Lab.takeMappingSteps`'s
-/// batches in order, and sent home as bytes for `Lab.bringMappingHome`.
-/// It maps exactly as the lab would have (see `crate::slam::handoff`).
+/// batches in order, and sent home as bytes for `Lab.bringMappingHome`
+/// ([`crate::lab::mapping_away`]).
 #[wasm_bindgen]
 pub struct SlamAway {
-    mapping: crate::slam::RobotMapping,
+    inner: MappingAway,
 }
 
 #[wasm_bindgen]
@@ -152,36 +153,30 @@ impl SlamAway {
     #[wasm_bindgen(constructor)]
     pub fn new(bytes: &[u8]) -> Result<SlamAway, JsError> {
         Ok(SlamAway {
-            mapping: crate::slam::handoff::mapping_from_bytes(bytes).map_err(err)?,
+            inner: MappingAway::new(bytes).map_err(err)?,
         })
     }
 
     /// Maps a batch of steps; returns how many it held. A batch cut short
     /// throws and maps none of its steps.
     pub fn observe(&mut self, steps: &[u8]) -> Result<u32, JsError> {
-        let n = crate::slam::handoff::observe_packed(&mut self.mapping, steps).map_err(err)?;
-        Ok(n as u32)
+        Ok(self.inner.observe(steps).map_err(err)? as u32)
     }
 
     /// Steps mapped so far (the run's, from its start).
     pub fn steps(&self) -> u32 {
-        self.mapping.estimates().len().saturating_sub(1) as u32
+        self.inner.steps() as u32
     }
 
     /// The estimates from row `row` on (row 0 is the start), flat
     /// `[x, y, theta, …]`, for `Lab.noteAwayEstimates`.
     #[wasm_bindgen(js_name = estimatesFrom)]
     pub fn estimates_from(&self, row: u32) -> Vec<f64> {
-        let e = self.mapping.estimates();
-        e.get(row as usize..)
-            .unwrap_or_default()
-            .iter()
-            .flat_map(|p| [p.x, p.y, p.theta])
-            .collect()
+        self.inner.estimates_from(row as usize)
     }
 
     /// The mapping as bytes, for `Lab.bringMappingHome`.
     pub fn finish(&self) -> Result<Vec<u8>, JsError> {
-        crate::slam::handoff::mapping_to_bytes(&self.mapping).map_err(err)
+        self.inner.finish().map_err(err)
     }
 }

@@ -1,118 +1,43 @@
-//! The SURF boundary between JavaScript and [`crate::surf`].
+//! # JavaScript boundary of the image sessions ([`crate::lab::images`])
 //!
-//! Images cross as encoded PNG/JPEG bytes (decoded in Rust with size
-//! limits, see [`crate::surf::gray`]) or as canvas RGBA; results come back
-//! as JSON strings in the formats of `shared/docs/interfaces.md`
-//! (`features`, `match`). Every function returns `Result<_, JsError>`: bad
-//! input is a message, never a panic. The `*_json` functions are the same
-//! logic as plain Rust, so native tests can check the JSON and the errors.
+//! `features` and `match` JSON of PNG/JPEG bytes or canvas RGBA, and the
+//! benchmark sessions `SurfBench` / `SurfMatchBench`. Converts only.
 
-use serde_json::{json, Value};
 use wasm_bindgen::prelude::*;
 
 use super::convert::js_err;
-
-use crate::surf::{
-    extract, fit_homography, match_features, Features, GrayImage, MatchConfig, MatchedRegion,
-    MsacConfig, SurfConfig, SurfError,
-};
-
-fn features_value(image: &GrayImage, features: &Features) -> Value {
-    let keypoints: Vec<Value> = features
-        .keypoints
-        .iter()
-        .zip(&features.descriptors)
-        .map(|(kp, d)| {
-            json!({
-                "x": kp.x, "y": kp.y, "scale": kp.scale, "orientation": kp.orientation,
-                "laplacian": kp.laplacian, "response": kp.response, "descriptor": d.0.to_vec(),
-            })
-        })
-        .collect();
-    json!({ "width": image.width(), "height": image.height(), "keypoints": keypoints })
-}
-
-/// `features` JSON of an encoded image with the default settings.
-pub fn features_json(bytes: &[u8]) -> Result<String, SurfError> {
-    let image = GrayImage::decode(bytes)?;
-    let features = extract(&image, &SurfConfig::default());
-    Ok(features_value(&image, &features).to_string())
-}
-
-/// `match` JSON of two encoded images: ratio-test matches, MSAC
-/// homography (image 1 pixels to image 2 pixels) and the matched region.
-pub fn match_json(bytes1: &[u8], bytes2: &[u8]) -> Result<String, SurfError> {
-    let image1 = GrayImage::decode(bytes1)?;
-    let image2 = GrayImage::decode(bytes2)?;
-    let config = SurfConfig::default();
-    let (f1, f2) = (extract(&image1, &config), extract(&image2, &config));
-    Ok(match_value(&image1, &f1, &image2, &f2).to_string())
-}
-
-fn match_value(image1: &GrayImage, f1: &Features, image2: &GrayImage, f2: &Features) -> Value {
-    let matches = match_features(f1, f2, &MatchConfig::default());
-    let p1: Vec<[f64; 2]> = matches.iter().map(|m| pt(f1, m.query)).collect();
-    let p2: Vec<[f64; 2]> = matches.iter().map(|m| pt(f2, m.train)).collect();
-    let fit = fit_homography(&p1, &p2, &MsacConfig::default());
-    let region = fit.as_ref().and_then(|f| {
-        MatchedRegion::new(
-            &f.model,
-            (image1.width(), image1.height()),
-            (image2.width(), image2.height()),
-        )
-    });
-    json!({
-        "matches": matches.len(),
-        "inliers": fit.as_ref().map_or(0, |f| f.inliers.len()),
-        "homography": fit.as_ref().map(|f| f.model.0.to_vec()),
-        "quad": region.map(|r| r.quad.to_vec()),
-        "shrinkage": region.map(|r| r.shrinkage),
-        "shift": region.map(|r| r.shift.to_vec()),
-        "left_right_ratio": region.map(|r| r.left_right_ratio),
-        "keypoints": [f1.len(), f2.len()],
-    })
-}
-
-fn pt(f: &Features, i: usize) -> [f64; 2] {
-    let k = &f.keypoints[i];
-    [k.x as f64, k.y as f64]
-}
+use crate::lab::images::{self, ImageBench, MatchBench};
 
 /// SURF keypoints and descriptors of a PNG/JPEG, as the `features` JSON.
 #[wasm_bindgen]
 pub fn surf_features(bytes: &[u8]) -> Result<String, JsError> {
-    features_json(bytes).map_err(js_err)
+    images::features_json(bytes).map_err(js_err)
 }
 
 /// SURF keypoints of straight RGBA pixels (a canvas `ImageData`), as the
 /// `features` JSON.
 #[wasm_bindgen]
 pub fn surf_features_rgba(rgba: &[u8], width: u32, height: u32) -> Result<String, JsError> {
-    let image = GrayImage::from_rgba(width as usize, height as usize, rgba).map_err(js_err)?;
-    let features = extract(&image, &SurfConfig::default());
-    Ok(features_value(&image, &features).to_string())
+    images::features_rgba_json(rgba, width, height).map_err(js_err)
 }
 
 /// Matches of two PNG/JPEG images with MSAC, as the `match` JSON.
 #[wasm_bindgen]
 pub fn surf_match(bytes1: &[u8], bytes2: &[u8]) -> Result<String, JsError> {
-    match_json(bytes1, bytes2).map_err(js_err)
+    images::match_json(bytes1, bytes2).map_err(js_err)
 }
 
 /// True when this wasm build uses the SIMD128 kernels.
 #[wasm_bindgen]
 pub fn surf_simd() -> bool {
-    crate::surf::simd::SIMD128
+    images::simd()
 }
 
 /// A decoded image held in wasm memory, so that a benchmark times SURF
 /// alone: `run()` is one detect + describe with the default settings.
 #[wasm_bindgen]
 pub struct SurfBench {
-    image: GrayImage,
-    /// Intermediate results for the per-stage timings.
-    integral: Option<crate::surf::IntegralImage>,
-    keypoints: Vec<crate::surf::Keypoint>,
+    inner: ImageBench,
 }
 
 #[wasm_bindgen]
@@ -120,50 +45,42 @@ impl SurfBench {
     /// Decodes a PNG/JPEG.
     #[wasm_bindgen(constructor)]
     pub fn new(bytes: &[u8]) -> Result<SurfBench, JsError> {
-        let image = GrayImage::decode(bytes).map_err(js_err)?;
         Ok(SurfBench {
-            image,
-            integral: None,
-            keypoints: Vec::new(),
+            inner: ImageBench::new(bytes).map_err(js_err)?,
         })
     }
+
     /// Detect + describe once; returns the number of keypoints.
     pub fn run(&self) -> u32 {
-        extract(&self.image, &SurfConfig::default()).len() as u32
+        self.inner.run()
     }
+
     /// Stage 1 alone: builds (and keeps) the integral image.
     pub fn stage_integral(&mut self) -> u32 {
-        self.integral = Some(crate::surf::IntegralImage::new(&self.image));
-        1
+        self.inner.stage_integral()
     }
-    /// Stage 2 alone: Fast-Hessian on the kept integral image; keeps the keypoints.
+
+    /// Stage 2 alone: Fast-Hessian on the kept integral image.
     pub fn stage_detect(&mut self) -> u32 {
-        let ii = self
-            .integral
-            .get_or_insert_with(|| crate::surf::IntegralImage::new(&self.image));
-        self.keypoints = crate::surf::FastHessian::new(&SurfConfig::default()).detect(ii);
-        self.keypoints.len() as u32
+        self.inner.stage_detect()
     }
+
     /// Stage 3 alone: orientations of the kept keypoints.
     pub fn stage_orientation(&mut self) -> u32 {
-        let ii = self
-            .integral
-            .get_or_insert_with(|| crate::surf::IntegralImage::new(&self.image));
-        crate::surf::orientation::assign_orientations(ii, &mut self.keypoints);
-        self.keypoints.len() as u32
+        self.inner.stage_orientation()
     }
+
     /// Stage 4 alone: descriptors of the kept keypoints.
     pub fn stage_describe(&mut self) -> u32 {
-        let ii = self
-            .integral
-            .get_or_insert_with(|| crate::surf::IntegralImage::new(&self.image));
-        crate::surf::descriptor::describe_all(ii, &self.keypoints).len() as u32
+        self.inner.stage_describe()
     }
+
     pub fn width(&self) -> u32 {
-        self.image.width() as u32
+        self.inner.width()
     }
+
     pub fn height(&self) -> u32 {
-        self.image.height() as u32
+        self.inner.height()
     }
 }
 
@@ -171,8 +88,7 @@ impl SurfBench {
 /// MSAC alone: `run()` matches, fits and returns the inlier count.
 #[wasm_bindgen]
 pub struct SurfMatchBench {
-    f1: Features,
-    f2: Features,
+    inner: MatchBench,
 }
 
 #[wasm_bindgen]
@@ -180,16 +96,13 @@ impl SurfMatchBench {
     /// Decodes and describes both PNG/JPEG images.
     #[wasm_bindgen(constructor)]
     pub fn new(bytes1: &[u8], bytes2: &[u8]) -> Result<SurfMatchBench, JsError> {
-        let config = SurfConfig::default();
-        let f1 = extract(&GrayImage::decode(bytes1).map_err(js_err)?, &config);
-        let f2 = extract(&GrayImage::decode(bytes2).map_err(js_err)?, &config);
-        Ok(SurfMatchBench { f1, f2 })
+        Ok(SurfMatchBench {
+            inner: MatchBench::new(bytes1, bytes2).map_err(js_err)?,
+        })
     }
+
     /// Match + MSAC once; returns the number of inliers (0 without a model).
     pub fn run(&self) -> u32 {
-        let matches = match_features(&self.f1, &self.f2, &MatchConfig::default());
-        let p1: Vec<[f64; 2]> = matches.iter().map(|m| pt(&self.f1, m.query)).collect();
-        let p2: Vec<[f64; 2]> = matches.iter().map(|m| pt(&self.f2, m.train)).collect();
-        fit_homography(&p1, &p2, &MsacConfig::default()).map_or(0, |f| f.inliers.len() as u32)
+        self.inner.run()
     }
 }

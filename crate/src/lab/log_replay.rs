@@ -1,14 +1,17 @@
-//! # A log replay session: what the CLI's `run-log` and the page drive
+//! # The log replay session: what the CLI's `run-log` and "Your log…" drive
 //!
 //! Holds a parsed CARMEN log ([`crate::formats::carmen`]), the stretch of its laser
 //! records to replay (`from..=to`, positions among the log's laser records),
 //! and the [`LogSlam`] fed with them in file order, a few at a time (so a
-//! page can animate it and a CLI can time it). At the end it draws the map
+//! page can animate it and a CLI can time it). While it runs, the page
+//! reads its view ([`LogReplay::view`]: the paths and loop closures so far)
+//! and the live map ([`LogReplay::draw_live`]); at the end it draws the map
 //! at the final poses and writes the report of `docs/interfaces.md`
 //! ("Real laser logs: run-log").
 
 use crate::formats::carmen::{parse_bytes, CarmenLog, LogError};
-use crate::slam::export::MapInfo;
+use crate::geom::Pose2;
+use crate::slam::export::{self, MapInfo};
 use crate::slam::grid::OccupancyGrid;
 use crate::slam::logs::logslam::{ClosureInfo, LogSlam, LogSlamConfig, LogSlamStats};
 use serde::Serialize;
@@ -21,6 +24,35 @@ pub struct LogReplay {
     to: usize,
     next: usize,
     map: Option<OccupancyGrid>,
+    /// The map of the scans replayed so far at their current poses, drawn
+    /// by [`LogReplay::draw_live`].
+    live: Option<OccupancyGrid>,
+}
+
+/// The replay so far, for a page that animates it.
+#[derive(Serialize)]
+pub struct ReplayView {
+    /// Scans replayed, of `total`.
+    pub done: usize,
+    pub total: usize,
+    /// Each replayed scan's odometry, flat `[x, y, theta, ...]` (the first
+    /// scan at its odometry pose).
+    pub odometry: Vec<f64>,
+    /// Each replayed scan's current SLAM pose, flat, same frame.
+    pub poses: Vec<f64>,
+    /// Each loop closure found so far.
+    pub closures: Vec<ClosureView>,
+}
+
+/// A loop closure as the page draws it: the segment between its two key
+/// scans' current poses.
+#[derive(Serialize)]
+pub struct ClosureView {
+    /// `[x1, y1, x2, y2]`.
+    pub segment: [f64; 4],
+    pub from_scan: usize,
+    pub to_scan: usize,
+    pub score: f64,
 }
 
 /// One scan of the report.
@@ -65,6 +97,7 @@ impl LogReplay {
             to,
             next: 0,
             map: None,
+            live: None,
         })
     }
 
@@ -160,5 +193,77 @@ impl LogReplay {
             skipped: self.log.skipped.clone(),
             timings_ms,
         })
+    }
+
+    /// The map as a binary PGM (ROS map_server).
+    pub fn map_pgm(&self) -> Result<Vec<u8>, String> {
+        Ok(export::to_pgm(self.map()?))
+    }
+
+    /// The map as a PNG.
+    pub fn map_png(&self) -> Result<Vec<u8>, String> {
+        export::to_png(self.map()?).map_err(|e| e.to_string())
+    }
+
+    /// The map_server YAML naming `image` (the PGM's file name).
+    pub fn map_yaml(&self, image: &str) -> Result<String, String> {
+        Ok(export::to_yaml(self.map()?, image))
+    }
+
+    /// The replay so far: paths and loop closures.
+    pub fn view(&self) -> ReplayView {
+        let slam = &self.slam;
+        let flat = |poses: &mut dyn Iterator<Item = Pose2>| -> Vec<f64> {
+            poses.flat_map(|p| [p.x, p.y, p.theta]).collect()
+        };
+        let node = |k: usize| slam.graph.nodes.get(k).copied().unwrap_or_default();
+        let closures = slam
+            .closures
+            .iter()
+            .map(|c| {
+                let (a, b) = (node(c.from_key), node(c.to_key));
+                ClosureView {
+                    segment: [a.x, a.y, b.x, b.y],
+                    from_scan: c.from_scan,
+                    to_scan: c.to_scan,
+                    score: c.score,
+                }
+            })
+            .collect();
+        ReplayView {
+            done: self.replayed().len(),
+            total: self.replayed().len() + self.remaining(),
+            odometry: flat(&mut slam.scans.iter().map(|s| s.odometry)),
+            poses: flat(&mut slam.poses().into_iter()),
+            closures,
+        }
+    }
+
+    /// Draws the map of the scans replayed so far at their current poses
+    /// (kept for [`LogReplay::live_info`] and [`LogReplay::live_pixels`]);
+    /// returns false before the first scan.
+    pub fn draw_live(&mut self) -> bool {
+        let scans = self.replayed();
+        if scans.is_empty() {
+            return false;
+        }
+        self.live = Some(self.slam.build_map(scans));
+        true
+    }
+
+    fn live(&self) -> Result<&OccupancyGrid, String> {
+        self.live
+            .as_ref()
+            .ok_or_else(|| "drawLive first".to_string())
+    }
+
+    /// Size, resolution and origin of the live map.
+    pub fn live_info(&self) -> Result<MapInfo, String> {
+        Ok(MapInfo::of(self.live()?))
+    }
+
+    /// The live map's grey pixels (PGM shades), top row first.
+    pub fn live_pixels(&self) -> Result<Vec<u8>, String> {
+        Ok(export::grey_rows_top_first(self.live()?))
     }
 }

@@ -141,36 +141,6 @@ impl Lab {
         Ok(self.robot_sim(robot)?.1.mapping.settled_map(which))
     }
 
-    /// Hands robot `robot`'s mapping to another thread
-    /// ([`Simulation::send_mapping_away`]): its bytes, for a
-    /// [`crate::slam::handoff`] reader there. Starts the run if none is.
-    pub fn send_mapping_away(&mut self, robot: usize) -> Result<Vec<u8>, String> {
-        let sim = self.start().map_err(|e| e.to_string())?;
-        sim.send_mapping_away(robot)
-    }
-
-    /// The steps robot `robot`'s mapping, away, has yet to be sent (packed).
-    pub fn take_mapping_steps(&mut self, robot: usize) -> Vec<u8> {
-        self.sim
-            .as_mut()
-            .map(|s| s.take_mapping_steps(robot))
-            .unwrap_or_default()
-    }
-
-    /// Appends the estimates robot `robot`'s mapping, away, reports
-    /// ([`Simulation::note_away_estimates`]).
-    pub fn note_away_estimates(&mut self, robot: usize, flat: &[f64]) -> Result<(), String> {
-        let sim = self.sim.as_mut().ok_or("nothing has run yet")?;
-        sim.note_away_estimates(robot, flat)
-    }
-
-    /// Takes robot `robot`'s mapping back from another thread
-    /// ([`Simulation::bring_mapping_home`]).
-    pub fn bring_mapping_home(&mut self, robot: usize, bytes: &[u8]) -> Result<(), String> {
-        let sim = self.sim.as_mut().ok_or("nothing has run yet")?;
-        sim.bring_mapping_home(robot, bytes)
-    }
-
     /// Index of the robot called `name`.
     pub fn robot_index(&self, name: &str) -> Result<usize, String> {
         self.scenario()

@@ -314,6 +314,30 @@ impl Lab {
         Ok(true)
     }
 
+    /// [`Lab::describe_frame_spec`], packed in a flat `f32` array for
+    /// another thread ([`crate::merge::described_ahead::encode`]).
+    pub fn describe_frame_spec_packed(
+        &mut self,
+        spec: &FrameSpec,
+        method: MergeMethod,
+    ) -> Result<Vec<f32>, String> {
+        let f = self.describe_frame_spec(spec, method)?;
+        Ok(crate::merge::described_ahead::encode(&f))
+    }
+
+    /// [`Lab::store_described`] of features packed by
+    /// [`Lab::describe_frame_spec_packed`] on another thread.
+    pub fn store_described_packed(
+        &mut self,
+        robot: usize,
+        index: usize,
+        method: MergeMethod,
+        packed: &[f32],
+    ) -> Result<bool, String> {
+        let f = crate::merge::described_ahead::decode(packed)?;
+        self.store_described(robot, index, method, f)
+    }
+
     /// Where the merge stands.
     pub fn merge_progress(&self) -> Result<MergeProgress, String> {
         let job = self.merge.as_ref().ok_or("no merge has been started")?;

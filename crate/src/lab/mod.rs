@@ -17,18 +17,34 @@
 //! | `mod.rs` | the scenario, the run, the top view, the camera, frames and logs |
 //! | [`merge`] | merging the run's maps, the merge's views, scoring it against the truth |
 //! | [`groups`] | each group of robots the merge joined: its merged map, its errors |
-//! | [`described`] | a stored frame's parts, for another lab to render and describe |
+//! | [`frame_spec`] | a stored frame's parts, for another lab to render and describe |
+//! | [`frames`] | a stored frame as grey bytes, PNG or thumbnail |
 //! | [`memory`] | where the session's bytes are, structure by structure |
 //! | [`maps`] | a robot's maps as files and pictures, their figures against the truth |
+//! | [`mapping_away`] | a robot's mapping on another thread: both halves of the hand-off |
 //! | [`report`] | the JSON report of a run (`web/cli.mjs run --json`) |
 //! | [`views`] | the small JSON views the page reads |
 //!
+//! Beside the simulated lab, the sessions of the real-data views and
+//! commands:
+//!
+//! | file | session |
+//! |---|---|
+//! | [`saved_maps`] | saved ROS maps merged (`merge-maps`, "Your maps…") |
+//! | [`log_replay`] | a recorded log replayed through SLAM (`run-log`, "Your log…") |
+//! | [`images`] | SURF on images (`features`, `match`, `bench-surf`) |
+//!
 //! `Lab`'s fields are private to this folder: callers use its methods.
+
+pub use crate::geom::Pose2;
+pub use crate::merge::MergeMethod;
+pub use crate::render::RenderOptions;
+pub use crate::slam::MapperKind;
 
 use crate::camera::capture::CapturedFrame;
 use crate::camera::texture::{ImageTexture, TextureBank};
 use crate::camera::{render as render_camera, robot_boxes, CameraImage, PinholeCamera};
-use crate::render::{render_world_cached, RenderOptions, TrailLayer, ViewLayers};
+use crate::render::{render_world_cached, TrailLayer, ViewLayers};
 use crate::scenario::{Scenario, ScenarioError, MAX_DURATION_S};
 use crate::sensors::laser::beam_bearing;
 use crate::sim::{Simulation, LASER_LOG_NO_RETURN};
@@ -38,13 +54,29 @@ use serde::Serialize;
 use std::fmt::Write;
 use tiny_skia::Pixmap;
 
+/// Checks a scenario fully (shape and placement) and returns it with every
+/// default filled in, as pretty JSON.
+pub fn validate_scenario(json: &str) -> Result<String, ScenarioError> {
+    Ok(Scenario::from_json(json)?.to_json_pretty())
+}
+
+/// The robot colours the renderer uses, by robot index, as JSON
+/// `[[r, g, b], ...]`.
+pub fn robot_colours_json() -> String {
+    serde_json::to_string(&crate::palette::ROBOT_COLOURS).unwrap_or_else(|_| "[]".into())
+}
+
 pub mod frame_spec;
+pub mod frames;
 pub mod groups;
+pub mod images;
 pub mod log_replay;
+pub mod mapping_away;
 pub mod maps;
 pub mod memory;
 pub mod merge;
 pub mod report;
+pub mod saved_maps;
 pub mod views;
 
 /// A lab session: a scenario, and its simulation once started.
