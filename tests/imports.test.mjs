@@ -1,9 +1,12 @@
 // The JavaScript's import graph (web/**/*.js, web/**/*.mjs): no circles, no
 // import of a file that is not there, and the layers ARCHITECTURE.md draws
 // ("The page"): web/app.js composes web/page/; web/cli.mjs composes
-// web/cli/; both stand on web/lab.js, which imports nothing; the page and
-// the command line never import each other. Also the sizes the page keeps
-// to: the composition root at most 300 lines, no module over 600.
+// web/cli/; both stand on the facades over the wasm build (web/lab.js,
+// web/saved-maps.js, web/log-replay.js, web/images.js), which import
+// nothing; the page and the command line never import each other, and
+// reach the wasm classes and functions that answer in JSON text only
+// through those facades. Also the sizes the page keeps to: the composition
+// root at most 300 lines, no module over 600.
 //
 // Static `import … from` / `export … from` lines are read as text (the
 // wasm build in web/pkg/ is generated and left out; dynamic imports of it
@@ -113,9 +116,19 @@ test('the import graph of web/ has no circle', () => {
   assert.equal(c, null, c && `import circle: ${c.map(rel).join(' -> ')}`);
 });
 
-test('the layers: lab.js imports nothing; page and command line stay apart', () => {
+/** The facades over the wasm build: each parses the JSON its binding returns, and imports nothing. */
+const FACADES = ['lab.js', 'saved-maps.js', 'log-replay.js', 'images.js'].map((f) => path.join(web, f));
+
+/**
+ * Raw wasm-bindgen names that answer in JSON text and have a facade: the
+ * saved-maps merge, the log replay and SURF on image files. (The raw `Lab`
+ * stays open to worker threads, which take only bytes from it.)
+ */
+const WRAPPED = /\bwasm\.(MapMerge|LogReplay|mapImagePath|mapMaxCells|surf_features(_rgba)?|surf_match)\b/;
+
+test('the layers: the facades import nothing; page and command line stay apart', () => {
   const g = graph();
-  assert.deepEqual(g.get(path.join(web, 'lab.js')), []);
+  for (const f of FACADES) assert.deepEqual(g.get(f), [], `${rel(f)} imports ${(g.get(f) ?? []).map(rel)}`);
   const inDir = (p, d) => p.startsWith(path.join(web, d) + path.sep);
   for (const [f, deps] of g) {
     for (const d of deps) {
@@ -135,4 +148,16 @@ test('the page: a small composition root over modules of at most 600 lines', () 
   for (const f of sources().filter((p) => p.startsWith(path.join(web, 'page') + path.sep))) {
     assert.ok(lines(f) <= 600, `${rel(f)} has ${lines(f)} lines`);
   }
+});
+
+test('the wasm classes that answer in JSON are reached only through their facades', () => {
+  assert.ok(WRAPPED.test('const m = new wasm.MapMerge();') && WRAPPED.test('wasm.surf_features(bytes)'));
+  assert.ok(!WRAPPED.test('new wasm.Lab(text)') && !WRAPPED.test('maps.mapImagePath'));
+  const raw = [];
+  for (const f of sources().filter((p) => !FACADES.includes(p))) {
+    for (const [k, line] of readFileSync(f, 'utf8').split('\n').entries()) {
+      if (WRAPPED.test(line)) raw.push(`${rel(f)}:${k + 1}: ${line.trim()}`);
+    }
+  }
+  assert.deepEqual(raw, []);
 });

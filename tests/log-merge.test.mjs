@@ -11,6 +11,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { loadWasm } from '../web/cli/wasm.mjs';
+import { LogReplay } from '../web/log-replay.js';
 import { inverse, mergedPaths, mergeRobots, robotMap, stretches } from '../web/page/real/log-merge.js';
 import { compose } from '../web/page/real/overlay.js';
 import { ringLog } from './support/synthetic-log.mjs';
@@ -20,10 +21,10 @@ const wrap = (a) => Math.atan2(Math.sin(a), Math.cos(a));
 
 /** A robot replaying laser records `from..=to` of `text`, finished. */
 function robot(name, text, [from, to]) {
-  const replay = new wasm.LogReplay(new TextEncoder().encode(text));
+  const replay = LogReplay.open(wasm, new TextEncoder().encode(text));
   replay.setRange(from, to);
   replay.finish();
-  return { name, replay, report: JSON.parse(replay.reportJson('{}')) };
+  return { name, replay, report: replay.report() };
 }
 
 test('a log of 211 records cut into 2, 3 and 300 stretches: near-equal, in order, no record lost', () => {
@@ -65,7 +66,7 @@ test("a robot's map goes to the merge in its own frame: the YAML origin is s⁻�
 test('two stretches of one log that overlap in space merge within 0.15 m and 1° of the truth', () => {
   const hall = ringLog({ laps: 1.5, perLap: 140, world: 'hall' });
   const robots = stretches(hall.truth.length, 2).map((part, k) => robot(`hall-${k + 1}`, hall.text, part));
-  const { merger, report, files } = mergeRobots(wasm, robots);
+  const { savedMaps, report, files } = mergeRobots(wasm, robots);
   assert.equal(report.merge.status, 'merged', report.merge.reason);
   const truth = compose(inverse(hall.truth[0]), hall.truth[105]);
   const [x, y, th] = report.merge.transforms[1].pose;
@@ -87,17 +88,17 @@ test('two stretches of one log that overlap in space merge within 0.15 m and 1°
     }
   }
   assert.ok(worst < 0.2, `a merged path is ${worst} m off the truth`);
-  merger.free();
+  savedMaps.free();
 });
 
 test('two logs of different worlds do not merge, and say why', () => {
   const ring = ringLog({ laps: 2, perLap: 140 });
   const hall = ringLog({ laps: 1, perLap: 140, world: 'hall' });
   const robots = [robot('ring', ring.text, [0, 280]), robot('hall', hall.text, [0, 140])];
-  const { merger, report, files } = mergeRobots(wasm, robots);
+  const { savedMaps, report, files } = mergeRobots(wasm, robots);
   assert.equal(report.merge.status, 'no_merge');
   assert.match(report.merge.reason, /^too little common wall: \d+\.\d m of wall agree within 0\.15 m \(20 m needed\)$/);
   assert.deepEqual(report.merge.unjoined, ['hall.yaml']);
   assert.equal(files, null);
-  merger.free();
+  savedMaps.free();
 });

@@ -76,7 +76,7 @@ function mergedSize({ sizeA, sizeB, originA }, [x, y, t]) {
   return [Math.ceil(span(0) / RES), Math.ceil(span(1) / RES)];
 }
 
-const snapshot = (page) => page.evaluate(() => window.slamlab.realMaps.snapshot());
+const snapshot = (page) => page.evaluate(() => window.slamlab.savedMaps.snapshot());
 
 /** Records the duration of every long task of the page's main thread in `window.longTasks`. */
 function watchLongTasks(page) {
@@ -122,7 +122,7 @@ test('your maps: open two maps, merge them, read the verdict and the transform, 
   const { context, page, problems } = await newPage(env.browser);
   await openView(page);
   await page.setInputFiles('#real-files', maps.files);
-  await page.waitForFunction(() => window.slamlab.realMaps.snapshot().report, null, { timeout: 120000 });
+  await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().report, null, { timeout: 120000 });
   assert.equal(await page.locator('.real-card').count(), 2, 'a card per map');
   assert.match(await page.locator('.real-card').first().innerText(), /floor-a\.yaml \+ floor-a\.pgm\s+640 × 440 cells · 0\.05 m · origin \[-2, 1, 0\]/);
 
@@ -211,7 +211,7 @@ test('your maps: bad files are refused by name and field, and nothing already op
   // The map opened before is still there, and a good second map merges with it.
   assert.equal(await page.locator('.real-card').count(), 1);
   await page.setInputFiles('#real-files', maps.files.slice(2));
-  await page.waitForFunction(() => window.slamlab.realMaps.snapshot().report, null, { timeout: 120000 });
+  await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().report, null, { timeout: 120000 });
   assert.equal((await snapshot(page)).maps.length, 2);
 
   // The lab behind the view kept its scenario and its run.
@@ -235,7 +235,7 @@ test('your maps: opening and merging two 2000 x 2000 maps shows no long task ove
   await watchLongTasks(page);
   const t0 = Date.now();
   await page.setInputFiles('#real-files', maps.files);
-  await page.waitForFunction(() => window.slamlab.realMaps.snapshot().report, null, { timeout: 540000, polling: 200 });
+  await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().report, null, { timeout: 540000, polling: 200 });
   const wall = Date.now() - t0;
   // Long tasks are reported after they end: give the observer a moment.
   await page.waitForTimeout(500);
@@ -321,14 +321,14 @@ test('your maps: a merge declined as ambiguous is placed by hand, turned and dra
   const { context, page, problems } = await newPage(env.browser, { width: 1280, height: 900 });
   await openView(page);
   await page.setInputFiles('#real-files', files);
-  await page.waitForFunction(() => window.slamlab.realMaps.snapshot().report, null, { timeout: 120000 });
+  await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().report, null, { timeout: 120000 });
   const auto = (await snapshot(page)).report.merge;
   assert.equal(auto.status, 'no_merge', auto.reason);
   assert.match(auto.reason, /ambiguous/);
   assert.match(await page.locator('#real-pair').innerText(), /sym-b\.yaml onto sym-a\.yaml \(no merge\)/);
 
   await page.getByRole('button', { name: 'Place by hand' }).click();
-  await page.waitForFunction(() => window.slamlab.realMaps.snapshot().adjust.view);
+  await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().adjust.view);
   assert.match(await page.locator('#real-adjust-help').innerText(), /Drag the map roughly onto the other, then press Refine/);
   const start = (await snapshot(page)).adjust.placing;
   assert.deepEqual(start.pose.map((v) => Number(v.toFixed(6))).slice(2), [0], 'the map starts unturned, beside the other');
@@ -352,7 +352,7 @@ test('your maps: a merge declined as ambiguous is placed by hand, turned and dra
   await page.screenshot({ path: path.join(ARTIFACTS, 'page-real-placing.png') });
 
   await page.getByRole('button', { name: 'Refine' }).click();
-  await page.waitForFunction(() => window.slamlab.realMaps.snapshot().adjust.pair && !window.slamlab.realMaps.snapshot().busy, null, { timeout: 120000 });
+  await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().adjust.pair && !window.slamlab.savedMaps.snapshot().busy, null, { timeout: 120000 });
   const snap = await snapshot(page);
   assert.equal(snap.adjust.pair.status, 'merged', snap.adjust.pair.reason);
   assert.equal(snap.report.merge.status, 'merged', snap.report.merge.reason);
@@ -374,13 +374,13 @@ test('your maps: a merge declined as ambiguous is placed by hand, turned and dra
 
   // Onto a wrong place: the map's middle dragged 6 m west and 4 m south of where it belongs.
   await page.getByRole('button', { name: 'Place by hand' }).click();
-  await page.waitForFunction(() => window.slamlab.realMaps.snapshot().adjust.view && window.slamlab.realMaps.snapshot().adjust.placing);
+  await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().adjust.view && window.slamlab.savedMaps.snapshot().adjust.placing);
   const again = (await snapshot(page)).adjust.placing;
   const middle = compose(again.pose, [...again.pivot, 0]);
   await drag(page, [await onScreen(page, middle), await onScreen(page, [middle[0] - 6, middle[1] - 4])], 12);
   await page.getByRole('button', { name: 'Refine' }).click();
   await page.waitForFunction((n) => {
-    const s = window.slamlab.realMaps.snapshot();
+    const s = window.slamlab.savedMaps.snapshot();
     return s.adjust.pair && s.adjust.pair.status !== 'merged' && !s.busy;
   }, null, { timeout: 120000 });
   const wrong = await snapshot(page);

@@ -17,7 +17,7 @@
 //                   pair-view.js (+ pair-map.js) the merge's frame pair,
 //                   match-table.js, merge-words.js, hidpi.js (pixel ratio)
 //   frame.js        an animation frame's work and pacing (+ frame-times.js)
-//   real/           your own maps and logs, merged and replayed in workers
+//   real/           saved maps and logs, merged and replayed in workers
 // and web/lab.js, the facade over the wasm `Lab` the command line uses too.
 //
 // Data flows one way: input handlers call the store or a controller; the
@@ -48,7 +48,7 @@ import { MapsPanel } from './page/maps-panel.js';
 import { MergePanel } from './page/merge-panel.js';
 import { GuidedTour } from './page/guided.js';
 import { Covers } from './page/real/cover.js';
-import { RealMaps } from './page/real/panel.js';
+import { SavedMapsView } from './page/real/panel.js';
 import { LogView } from './page/real/log-panel.js';
 
 const $ = (id) => document.getElementById(id);
@@ -159,7 +159,7 @@ const summary = new Summary($('summary'), $('summary-open'), {
   merge: mergePanel,
 });
 const covers = new Covers();
-const realMaps = new RealMaps($('real'), $('real-open'), { download, covers });
+const savedMaps = new SavedMapsView($('real'), $('real-open'), { download, covers });
 const logView = new LogView($('logview'), $('log-open'), { download, covers });
 const toolbar = new Toolbar({ guard, store, runner, editor, view, persistence, robotsPanel, canvas });
 const keys = new Keys({
@@ -238,7 +238,7 @@ async function main() {
   view.restoreLayers();
   toolbar.wire();
   $('guided-open').addEventListener('click', () => guide.toggle());
-  realMaps.wire();
+  savedMaps.wire();
   logView.wire();
   pointer.listen();
   keys.listen();
@@ -274,7 +274,7 @@ async function main() {
     /** Work counters for the page tests (issue 22): live camera renders per
      *  robot, maps scored, canvas backing stores resized. */
     perf: () => ({ liveDraws: [...cameraPanel.liveDraws], scored: mapsPanel.scored, resized: fitStats.resized }),
-    realMaps,
+    savedMaps,
     logView,
     /** Where the frames' time went since the last `reset` (web/page/frame-times.js). */
     frameTimes: (reset = false) => pacer.report(reset),

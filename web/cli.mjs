@@ -20,7 +20,7 @@ import * as camera from './cli/camera.mjs';
 import * as surf from './cli/surf.mjs';
 import * as slam from './cli/slam.mjs';
 import * as merge from './cli/merge.mjs';
-import * as mergeMaps from './cli/merge-maps.mjs';
+import * as savedMaps from './cli/merge-maps.mjs';
 import * as runLog from './cli/run-log.mjs';
 
 export { UsageError, parseArgs };
@@ -36,7 +36,7 @@ const MODULES = [
   surf,
   slam,
   merge,
-  mergeMaps,
+  savedMaps,
   runLog,
 ];
 

@@ -1,24 +1,26 @@
-// The `merge-maps` command: merge saved ROS map_server maps (YAML + PGM/PNG)
-// offline. Node reads the files and hands text and bytes to wasm
-// (crate/src/bindings/maps.rs); the merge itself is crate/src/merge/saved/mod.rs.
+// The `merge-maps` command: merge saved ROS map_server maps (YAML + PGM/PNG).
+// Node reads the files and hands text and bytes to the saved-maps facade
+// (web/saved-maps.js, over crate/src/bindings/maps.rs); the merge itself is
+// crate/src/merge/saved/mod.rs.
 import { readFile, writeFile } from 'node:fs/promises';
 import path from 'node:path';
 import { performance } from 'node:perf_hooks';
+import { MAX_SAVED_MAPS, SavedMaps, mapImagePath } from '../saved-maps.js';
 import { parseArgs, UsageError, wasmCall } from './args.mjs';
 
 export const usage = `  node web/cli.mjs merge-maps MAP.yaml MAP.yaml [MAP.yaml ...] [--out MERGED.yaml] [--json]
       merge two to sixteen saved ROS map_server maps (YAML + PGM/PNG) offline; with --out,
       write the merged map as PGM + YAML (+ PNG); nothing is written on no_merge`;
 
-/** Reads one map's YAML and the image it names into `merger`. */
-async function addMap(merger, file, wasm) {
+/** Reads one map's YAML and the image it names into `maps` (a SavedMaps); returns its index. */
+async function readMap(maps, file, wasm) {
   let yaml;
   try {
     yaml = await readFile(file, 'utf8');
   } catch (e) {
     throw new UsageError(`${file}: cannot read the map's YAML: ${e.code ?? e.message}`);
   }
-  const image = wasmCall(() => wasm.mapImagePath(file, yaml));
+  const image = wasmCall(() => mapImagePath(wasm, file, yaml));
   const imagePath = path.resolve(path.dirname(file), image);
   let bytes;
   try {
@@ -26,7 +28,7 @@ async function addMap(merger, file, wasm) {
   } catch (e) {
     throw new UsageError(`${file}: image: cannot read '${image}' (${imagePath}): ${e.code ?? e.message}`);
   }
-  return wasmCall(() => merger.addMap(file, yaml, image, bytes));
+  return wasmCall(() => maps.addMap(file, yaml, image, bytes));
 }
 
 function describe(report) {
@@ -40,13 +42,13 @@ function describe(report) {
   return lines.join('\n');
 }
 
-async function writeMerged(merger, out) {
+async function writeMerged(maps, out) {
   const base = out.replace(/\.ya?ml$/i, '');
   const pgmPath = `${base}.pgm`;
   const pngPath = `${base}.png`;
-  const pgm = wasmCall(() => merger.mergedPgm());
-  const png = wasmCall(() => merger.mergedPng());
-  const yaml = wasmCall(() => merger.mergedYaml(path.basename(pgmPath)));
+  const pgm = wasmCall(() => maps.mergedPgm());
+  const png = wasmCall(() => maps.mergedPng());
+  const yaml = wasmCall(() => maps.mergedYaml(path.basename(pgmPath)));
   try {
     await writeFile(pgmPath, pgm);
     await writeFile(pngPath, png);
@@ -57,29 +59,29 @@ async function writeMerged(merger, out) {
   return [out, pgmPath, pngPath];
 }
 
-async function mergeMaps(argv, wasm) {
+async function mergeSavedMaps(argv, wasm) {
   const { positional, options } = parseArgs(argv, { out: 'value', json: 'flag' });
   if (positional.length < 2) throw new UsageError('merge-maps: expected two or more MAP.yaml files');
-  if (positional.length > 16) throw new UsageError('merge-maps: at most 16 maps');
+  if (positional.length > MAX_SAVED_MAPS) throw new UsageError(`merge-maps: at most ${MAX_SAVED_MAPS} maps`);
   if (options.out !== undefined && !/\.ya?ml$/i.test(options.out)) {
     throw new UsageError(`--out: '${options.out}' should end in .yaml`);
   }
   const t0 = performance.now();
-  const merger = new wasm.MapMerge();
+  const maps = SavedMaps.open(wasm);
   for (const file of positional) {
-    const index = await addMap(merger, file, wasm);
-    const info = JSON.parse(merger.mapInfoJson(index));
+    const index = await readMap(maps, file, wasm);
+    const info = maps.mapInfo(index);
     process.stderr.write(`read ${file}: ${info.width} x ${info.height} cells at ${info.resolution} m\n`);
   }
   const tRead = performance.now();
   const n = positional.length;
   process.stderr.write(`merging ${n} maps (${n * (n - 1) / 2} pairs)...\n`);
-  const report = JSON.parse(merger.merge());
+  const report = maps.merge();
   const tMerge = performance.now();
   for (const p of report.merge.pairs) process.stderr.write(`  ${p.a} + ${p.b}: ${p.status}: ${p.reason}\n`);
   let written = [];
   if (options.out !== undefined && report.merge.status === 'merged') {
-    written = await writeMerged(merger, options.out);
+    written = await writeMerged(maps, options.out);
     process.stderr.write(`wrote ${written.join(', ')}\n`);
   } else if (options.out !== undefined) {
     process.stderr.write(`no_merge: nothing written to ${options.out}\n`);
@@ -88,8 +90,8 @@ async function mergeMaps(argv, wasm) {
   report.timings_ms = { read: tRead - t0, merge: tMerge - tRead, write: tEnd - tMerge, total: tEnd - t0 };
   if (options.json) process.stdout.write(JSON.stringify(report) + '\n');
   else console.log(describe(report));
-  merger.free();
+  maps.free();
   return 0;
 }
 
-export const commands = { 'merge-maps': mergeMaps };
+export const commands = { 'merge-maps': mergeSavedMaps };

@@ -4,7 +4,7 @@ import { writeFile } from 'node:fs/promises';
 import path from 'node:path';
 import { parseArgs, UsageError, wasmCall, openScenario } from './args.mjs';
 import { workersOf } from './describe-pool.mjs';
-import { simulate, mergeMaps } from './run-loop.mjs';
+import { simulate, mergeRobotMaps } from './run-loop.mjs';
 
 export const METHODS = ['auto', 'thesis', 'map-only'];
 
@@ -47,7 +47,7 @@ async function merge(argv, wasm) {
   const workers = method === 'map-only' ? 0 : mappers;
   const lab = await openScenario(positional[0], options, wasm);
   await simulate(lab, { method, workers, mappers, progress: false });
-  const view = mergeMaps(lab, method);
+  const view = mergeRobotMaps(lab, method);
   const report = view.report;
   console.log(describeMerge(report));
   if (!report || report.status !== 'merged') {

@@ -1,10 +1,12 @@
 // The `run-log` command: replay a CARMEN laser log (FLASER / ROBOTLASER1 /
 // RAWLASER1 + ODOM; .log, .clf, gzip-compressed or not) through the log SLAM
 // (scan-to-map matching, pose graph, loop closures) and report every scan's
-// final pose (docs/interfaces.md, "Real laser logs: run-log").
+// final pose (docs/interfaces.md, "Real laser logs: run-log"), over the
+// log replay's facade web/log-replay.js.
 import { readFile, writeFile } from 'node:fs/promises';
 import path from 'node:path';
 import { performance } from 'node:perf_hooks';
+import { LogReplay } from '../log-replay.js';
 import { parseArgs, UsageError, wasmCall } from './args.mjs';
 
 export const usage = `  node web/cli.mjs run-log LOG [--json] [--out MAP.yaml] [--from N] [--to M]
@@ -38,9 +40,9 @@ async function runLog(argv, wasm) {
   } catch (e) {
     throw new UsageError(`cannot read log '${file}': ${e.code ?? e.message}`);
   }
-  const replay = wasmCall(() => new wasm.LogReplay(bytes));
+  const replay = wasmCall(() => LogReplay.open(wasm, bytes));
   const tParsed = performance.now();
-  wasmCall(() => replay.setRange(from, to === undefined ? -1 : Math.min(to, 2 ** 31 - 1)));
+  wasmCall(() => replay.setRange(from, to));
   let left = Infinity;
   let lastNote = performance.now();
   while (left > 0) {
@@ -56,7 +58,6 @@ async function runLog(argv, wasm) {
   const timings = {
     parse: tParsed - t0, slam: tSlam - tParsed, map: tEnd - tSlam, total: tEnd - t0,
   };
-  const report = replay.reportJson(JSON.stringify(timings));
   if (options.out !== undefined) {
     const base = options.out.replace(/\.ya?ml$/i, '');
     const pgmPath = `${base}.pgm`;
@@ -69,9 +70,9 @@ async function runLog(argv, wasm) {
     }
   }
   if (options.json) {
-    process.stdout.write(report + '\n');
+    process.stdout.write(replay.reportText(timings) + '\n');
   } else {
-    const r = JSON.parse(report);
+    const r = replay.report(timings);
     const m = r.map;
     console.log(`${file}: ${r.scans.length} of ${r.laser_records} laser records replayed (${r.from}..${r.to}), ` +
       `${r.slam.keys} key scans, ${r.loop_closures.length} loop closures`);

@@ -7,8 +7,8 @@
 // worker threads it keeps them fed between slices: some map some of the
 // robots (web/cli/slam-pool.mjs), others describe the camera frames a
 // merge will describe (web/cli/describe-pool.mjs), so that the report is
-// the same for any number of workers. mergeMaps() then runs the merge in
-// small units of work, reporting its stage on stderr.
+// the same for any number of workers. mergeRobotMaps() then merges the
+// robots' maps in small units of work, reporting its stage on stderr.
 import { performance } from 'node:perf_hooks';
 import { wasmCall } from './args.mjs';
 import { DescribePool } from './describe-pool.mjs';
@@ -74,11 +74,11 @@ export async function simulate(lab, { method = 'auto', workers = 0, mappers = 0,
 const MERGE_UNITS = 64;
 
 /**
- * Merges the maps of the lab's run with `method`, reporting progress on
+ * Merges the robots' maps of the lab's run with `method`, reporting progress on
  * stderr once a second and at each new stage. Returns the merge view
  * (tables and report).
  */
-export function mergeMaps(lab, method) {
+export function mergeRobotMaps(lab, method) {
   let progress = wasmCall(() => lab.mergeStart(method));
   let last = 0;
   let lastStage = '';

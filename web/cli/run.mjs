@@ -5,7 +5,7 @@ import { performance } from 'node:perf_hooks';
 import { UsageError, parseArgs, wasmCall, openScenario } from './args.mjs';
 import { workersOf } from './describe-pool.mjs';
 import { methodOf, describeMerge } from './merge.mjs';
-import { simulate, mergeMaps } from './run-loop.mjs';
+import { simulate, mergeRobotMaps } from './run-loop.mjs';
 
 export const usage = `usage:
   node web/cli.mjs run SCENARIO.json [--seed N] [--duration S] [--method auto|thesis|map-only] [--json]
@@ -31,7 +31,7 @@ async function run(argv, wasm) {
   const budget = frameBudgetOf(options);
   if (budget !== undefined) wasmCall(() => lab.setFrameBudget(budget));
   const { simulateMs, waitMs, mappingMs } = await simulate(lab, { method, workers, mappers, progress: true });
-  mergeMaps(lab, method);
+  mergeRobotMaps(lab, method);
   const totalMs = performance.now() - t0;
   const timings = { simulate: simulateMs, features: waitMs, slam: mappingMs, total: totalMs };
   if (options.json) {

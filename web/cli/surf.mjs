@@ -7,13 +7,15 @@
 // Each command is `async (args, wasm) => exitCode`, with `args` the words
 // after the command name and `wasm` the loaded wasm-bindgen module
 // (web/cli/wasm.mjs). Images are read here and decoded inside wasm, so node
-// and the page see the same pixels. Progress and errors go to stderr; with
+// and the page see the same pixels; web/images.js hands the binding's
+// documents back, as its text for --json and as objects otherwise. Progress and errors go to stderr; with
 // --json the JSON is the only thing on stdout. Bad input: a message and exit 2
 // (web/cli/args.mjs's UsageError; an error thrown by the decoder in wasm is
 // bad input too, a wasm trap is a bug).
 import { readFile } from 'node:fs/promises';
 import { performance } from 'node:perf_hooks';
 import { UsageError, parseArgs, wasmCall } from './args.mjs';
+import * as images from '../images.js';
 
 async function readImage(path) {
   try {
@@ -27,11 +29,10 @@ async function features(args, wasm) {
   const { positional, options } = parseArgs(args, { json: 'flag' });
   if (positional.length !== 1) throw new UsageError('features: expected one image');
   const bytes = await readImage(positional[0]);
-  const json = wasmCall(() => wasm.surf_features(bytes));
   if (options.json) {
-    process.stdout.write(json + '\n');
+    process.stdout.write(wasmCall(() => images.featuresText(wasm, bytes)) + '\n');
   } else {
-    const r = JSON.parse(json);
+    const r = wasmCall(() => images.features(wasm, bytes));
     console.log(`${positional[0]}: ${r.width} x ${r.height}, ${r.keypoints.length} SURF keypoints`);
     for (const k of r.keypoints.slice(0, 10)) {
       console.log(
@@ -48,11 +49,10 @@ async function match(args, wasm) {
   const { positional, options } = parseArgs(args, { json: 'flag' });
   if (positional.length !== 2) throw new UsageError('match: expected two images');
   const [a, b] = await Promise.all(positional.map(readImage));
-  const json = wasmCall(() => wasm.surf_match(a, b));
   if (options.json) {
-    process.stdout.write(json + '\n');
+    process.stdout.write(wasmCall(() => images.matchText(wasm, a, b)) + '\n');
   } else {
-    const r = JSON.parse(json);
+    const r = wasmCall(() => images.match(wasm, a, b));
     console.log(`${r.keypoints[0]} and ${r.keypoints[1]} keypoints, ${r.matches} matches, ${r.inliers} MSAC inliers`);
     if (r.homography) {
       const f = (v) => v.toFixed(5).padStart(12);

@@ -60,7 +60,7 @@ function beside(a, b) {
 export class PlaceByHand {
   /**
    * `root`: the view's element (holding ADJUST_HTML and the overlay canvas);
-   * `client`: the MergeClient; `hooks`: `maps()` (the opened maps, with
+   * `client`: the SavedMapsClient; `hooks`: `maps()` (the opened maps, with
    * `index`), `report()`, `size()` (the overlay's size for drawing),
    * `refined(out)` (a refine's `{pair, report, files}`), `say(text, kind)`,
    * `busy(on, text)`, `changed()` (the view's state changed: redraw legend).

@@ -1,6 +1,6 @@
 // The page's side of its workers (merge-worker.js, log-worker.js):
 // requests as promises, progress lines to a callback. A worker is started
-// on first use, so a page that never opens its own maps or logs never
+// on first use, so a page that never opens saved maps or logs never
 // loads a second wasm.
 
 export class WorkerClient {
@@ -47,8 +47,8 @@ export class WorkerClient {
 
 }
 
-/** The merge worker's requests. */
-export class MergeClient extends WorkerClient {
+/** The saved-maps merge worker's requests (merge-worker.js). */
+export class SavedMapsClient extends WorkerClient {
   constructor(onProgress) {
     super(new URL('./merge-worker.js', import.meta.url), onProgress);
   }

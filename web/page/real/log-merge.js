@@ -3,10 +3,11 @@
 // Two or more logs, or one log cut into stretches of its laser records,
 // are replayed as robots of their own (log-worker.js). Logs carry no
 // camera, so what can join them is the maps' own evidence: each robot's
-// finished map goes to the offline merge of `merge-maps` (`MapMerge`,
-// crate/src/merge/saved/mod.rs: wall-surface points, rotations from Hough
-// spectra, coarse correlation and refinement, then a verdict on the
-// agreement) exactly as a saved ROS map would, PGM and YAML.
+// finished map goes to the saved-maps merge of `merge-maps`
+// (web/saved-maps.js over crate/src/merge/saved/mod.rs: wall-surface
+// points, rotations from Hough spectra, coarse correlation and refinement,
+// then a verdict on the agreement) exactly as a saved ROS map would, PGM
+// and YAML.
 //
 // Frames: a replay draws its map in the log's own odometry frame, the
 // stretch's first scan at its odometry pose `s` (docs/interfaces.md,
@@ -19,6 +20,7 @@
 // The images themselves are not turned: the search works in image frames,
 // so the frames only change how its answer is written.
 
+import { SavedMaps } from '../../saved-maps.js';
 import { compose } from './overlay.js';
 import { previewOf } from './preview.js';
 
@@ -43,7 +45,8 @@ export function robotYaml(image, resolution, origin) {
 /**
  * A finished robot's map for the merge: `{name, yaml, image}` with its
  * YAML origin in the robot's own frame (its first scan at the origin).
- * `robot`: `{name, report, replay}` (report: the run-log report).
+ * `robot`: `{name, report, replay}` (report: the run-log report; replay:
+ * its LogReplay, web/log-replay.js).
  */
 export function robotMap({ name, report, replay }) {
   const start = report.scans[0].pose;
@@ -53,40 +56,41 @@ export function robotMap({ name, report, replay }) {
 }
 
 /**
- * Merges the finished robots' maps with `wasm.MapMerge`; `progress(text)`
- * after each pair. Returns `{merger, report, files}`: the merge-maps
- * report (with `timings_ms.merge`), and the merged map's PGM, PNG and YAML
- * (null on no_merge). The caller frees `merger`.
+ * Merges the finished robots' maps as saved maps (web/saved-maps.js on the
+ * wasm-bindgen module `wasm`); `progress(text)` after each pair. Returns
+ * `{savedMaps, report, files}`: the maps merged (a SavedMaps), the
+ * merge-maps report (with `timings_ms.merge`), and the merged map's PGM,
+ * PNG and YAML (null on no_merge). The caller frees `savedMaps`.
  */
 export function mergeRobots(wasm, robots, progress = () => {}) {
-  const merger = new wasm.MapMerge();
+  const savedMaps = SavedMaps.open(wasm);
   try {
     for (const r of robots) {
       const m = robotMap(r);
-      merger.addMap(m.name, m.yaml, m.imageName, m.image);
+      savedMaps.addMap(m.name, m.yaml, m.imageName, m.image);
     }
     const t0 = performance.now();
-    const report = JSON.parse(merger.mergeWithProgress(progress));
+    const report = savedMaps.mergeWithProgress(progress);
     report.timings_ms = { merge: performance.now() - t0 };
     let files = null;
     if (report.merge.status === 'merged') {
-      files = { pgm: merger.mergedPgm(), png: merger.mergedPng(), yaml: merger.mergedYaml('merged.pgm') };
+      files = { pgm: savedMaps.mergedPgm(), png: savedMaps.mergedPng(), yaml: savedMaps.mergedYaml('merged.pgm') };
     }
-    return { merger, report, files };
+    return { savedMaps, report, files };
   } catch (e) {
-    merger.free();
+    savedMaps.free();
     throw e;
   }
 }
 
 /** The joined maps for the overlay (overlay.js's `drawPlaced`): `[{map, pose}]`, each map in its robot's colour. */
-export async function placedMaps({ merger, report }, robots) {
+export async function placedMaps({ savedMaps, report }, robots) {
   const placed = [];
   for (const t of report.merge.transforms) {
     const i = robots.findIndex((r) => `${r.name}.yaml` === t.map);
     if (i < 0) continue;
-    const info = JSON.parse(merger.mapInfoJson(i));
-    const { thumb, ...preview } = await previewOf(merger.mapPixels(i), info.width, info.height, robots[i].colour);
+    const info = savedMaps.mapInfo(i);
+    const { thumb, ...preview } = await previewOf(savedMaps.mapPixels(i), info.width, info.height, robots[i].colour);
     thumb.close();
     placed.push({ map: { ...info, preview }, pose: t.pose });
   }

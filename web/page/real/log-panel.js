@@ -12,7 +12,7 @@
 // Several logs, or one log cut into N stretches of its laser records, are
 // several robots (issue 21, item 3): each replayed on its own, in its own
 // colour and tile, then **Merge maps** joins their finished maps with the
-// offline merge of `merge-maps` (log-merge.js, log-merge-view.js).
+// saved-maps merge of `merge-maps` (log-merge.js, log-merge-view.js).
 
 import { WorkerClient } from './client.js';
 import { LogMergeView, MERGE_HTML } from './log-merge-view.js';

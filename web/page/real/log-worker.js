@@ -1,7 +1,7 @@
 // CARMEN logs replayed off the page's main thread (issue 21, the page).
 //
 // A module Web Worker that loads the same wasm build as the page and holds
-// one `LogReplay` (crate/src/bindings/logs.rs) per robot: each log opened
+// one log replay (web/log-replay.js) per robot: each log opened
 // is one robot, or N robots when the page cuts it into N stretches of its
 // laser records (each stretch replayed on its own, as if another robot had
 // driven it). The page asks for a few scans at a time (its play, step and
@@ -12,7 +12,7 @@
 // current poses, at most every MAP_EVERY_MS), the odometry's path beside
 // SLAM's and each loop closure. At the end it settles each pose graph and
 // hands back each map as PGM, PNG and YAML; then `merge` joins the robots'
-// maps (log-merge.js: the offline merge of `merge-maps`, each map in its
+// maps (log-merge.js: the saved-maps merge of `merge-maps`, each map in its
 // robot's own frame) and draws the joined maps into a second canvas.
 // Messages in: `{id, type: 'canvas' | 'mergeCanvas' | 'open' | 'cut' |
 // 'step' | 'redraw' | 'finish' | 'merge' | 'drawMerge' | 'clear', ...}`;
@@ -20,6 +20,8 @@
 // `{type: 'progress', text}` while merging.
 
 import init, * as wasm from '../../pkg/slamlab.js';
+import { LogReplay } from '../../log-replay.js';
+import { MAX_SAVED_MAPS } from '../../saved-maps.js';
 import { drawMergedPaths, drawReplays, mapPicture } from './log-draw.js';
 import { mergedPaths, mergeRobots, placedMaps, stretches } from './log-merge.js';
 import { drawPlaced } from './overlay.js';
@@ -27,7 +29,7 @@ import { drawPlaced } from './overlay.js';
 const ready = init();
 const MAP_EVERY_MS = 400;
 /** The most robots at once (the merge's limit). */
-const MAX_ROBOTS = 16;
+const MAX_ROBOTS = MAX_SAVED_MAPS;
 /** The logs opened: `{name, bytes: Uint8Array, records}`. */
 let logs = [];
 /** `{name, log, from, to, colour, replay, picture, view, mapAt, finished, summary}`. */
@@ -71,7 +73,7 @@ function addRobots(some, cut, colours) {
       let name = parts.length > 1 ? `${stem(log.name)}-${k + 1}` : stem(log.name);
       while (names.has(name)) name += '_';
       names.add(name);
-      const replay = new wasm.LogReplay(log.bytes);
+      const replay = LogReplay.open(wasm, log.bytes);
       replay.setRange(from, to);
       const colour = colours[robots.length % colours.length];
       robots.push({ name, log: log.name, from, to, colour, replay, picture: null, view: null, mapAt: -Infinity, finished: false });
@@ -101,7 +103,7 @@ function open({ files, cut, colours }) {
   for (const f of files) {
     const bytes = new Uint8Array(f.bytes);
     try {
-      const probe = new wasm.LogReplay(bytes);
+      const probe = LogReplay.open(wasm, bytes);
       const records = probe.laserRecords();
       probe.free();
       logs.push({ name: f.name, bytes, records });
@@ -128,7 +130,7 @@ async function refreshMap(robot, force) {
   const now = performance.now();
   if (!force && now - robot.mapAt < MAP_EVERY_MS) return;
   if (!robot.replay.drawLive()) return;
-  robot.picture = await mapPicture(robot.replay.livePixels(), JSON.parse(robot.replay.liveInfoJson()));
+  robot.picture = await mapPicture(robot.replay.livePixels(), robot.replay.liveInfo());
   robot.mapAt = performance.now();
   robot.drawnDone = done;
 }
@@ -142,7 +144,7 @@ async function step({ n, size }) {
   for (const r of robots) {
     const rest = r.replay.step(n);
     left += rest;
-    r.view = JSON.parse(r.replay.viewJson());
+    r.view = r.replay.view();
     await refreshMap(r, rest === 0);
   }
   draw(size);
@@ -159,9 +161,9 @@ function finish() {
     if (!r.finished) {
       const t0 = performance.now();
       r.replay.finish();
-      r.report = JSON.parse(r.replay.reportJson(JSON.stringify({ finish: performance.now() - t0 })));
+      r.report = r.replay.report({ finish: performance.now() - t0 });
       r.summary = { scans: r.report.scans.length, closures: r.report.loop_closures.length, map: r.report.map };
-      r.view = JSON.parse(r.replay.viewJson());
+      r.view = r.replay.view();
       r.drawnDone = -1; // the settled poses draw a new map
       r.finished = true;
     }
@@ -177,7 +179,7 @@ function finish() {
 async function merge(id) {
   if (robots.length < 2) throw new Error('two or more robots are needed to merge: open another log or cut this one');
   if (robots.some((r) => !r.finished)) throw new Error('finish the replays first');
-  merged?.merger.free();
+  merged?.savedMaps.free();
   merged = mergeRobots(wasm, robots, (text) => postMessage({ type: 'progress', id, text }));
   merged.placed = await placedMaps(merged, robots);
   merged.paths = mergedPaths(merged.report, robots);
@@ -210,7 +212,7 @@ const handlers = {
   },
   clear: () => {
     for (const r of robots) r.replay.free();
-    merged?.merger.free();
+    merged?.savedMaps.free();
     [logs, robots, merged] = [[], [], null];
     return describe();
   },

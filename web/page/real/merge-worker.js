@@ -1,13 +1,14 @@
-// The merge of the user's own maps, off the page's main thread.
+// The saved-maps merge of "Your maps", off the page's main thread.
 //
 // A module Web Worker that loads the same wasm build as the page and holds
-// one `MapMerge` (crate/src/bindings/maps.rs). The page sends it the picked
-// files' bytes; it reads them into maps (files.js matches each YAML to its
-// image), draws each map into a small coloured picture for the page
-// (preview.js), merges on request (the whole merge runs here, so the page
-// never waits on it), hands back the report and the merged map's PGM,
-// PNG and YAML, and draws the merged overlay (overlay.js) into the page's
-// canvas, which the page hands over once. Messages in:
+// one set of saved maps (web/saved-maps.js, the facade over the binding's
+// `MapMerge`). The page sends it the picked files' bytes; it reads them
+// into maps (files.js matches each YAML to its image), draws each map into
+// a small coloured picture for the page (preview.js), merges on request
+// (the whole merge runs here, so the page never waits on it), hands back
+// the report and the merged map's PGM, PNG and YAML, and draws the merged
+// overlay (overlay.js) into the page's canvas, which the page hands over
+// once. Messages in:
 // `{id, type: 'add', files, resolution, colours}`, `{id, type: 'merge'}`,
 // `{id, type: 'canvas', canvas}`, `{id, type: 'draw', width, height, dpr,
 // alpha}`, `{id, type: 'clear'}`, and for placing a map by hand (the
@@ -20,12 +21,14 @@
 // used (`{view: {k, e, f, width, height, dpr}}`).
 
 import init, * as wasm from '../../pkg/slamlab.js';
+import { SavedMaps, mapImagePath } from '../../saved-maps.js';
 import { groupFiles } from './files.js';
 import { previewOf } from './preview.js';
 import { compose, drawPlaced, fitView } from './overlay.js';
 
 const ready = init();
-let merger = null;
+/** The maps read so far (a SavedMaps), null before the first. */
+let savedMaps = null;
 let colourIndex = 0;
 /** What the overlay needs of each map read (by name), the last merge's placing, the canvas. */
 let pictures = new Map();
@@ -42,21 +45,21 @@ function message(e) {
 
 /** Reads the picked files into maps; the good ones load even if some are bad. */
 async function add({ files, resolution, colours }) {
-  merger ??= new wasm.MapMerge();
-  const { maps, errors } = groupFiles(files, (name, yaml) => wasm.mapImagePath(name, yaml), resolution);
+  savedMaps ??= SavedMaps.open(wasm);
+  const { maps, errors } = groupFiles(files, (name, yaml) => mapImagePath(wasm, name, yaml), resolution);
   const added = [];
   const transfer = [];
   for (const m of maps) {
     let index;
     try {
-      index = merger.addMap(m.name, m.yaml, m.imageName, m.image);
+      index = savedMaps.addMap(m.name, m.yaml, m.imageName, m.image);
     } catch (e) {
       errors.push(message(e));
       continue;
     }
-    const info = JSON.parse(merger.mapInfoJson(index));
+    const info = savedMaps.mapInfo(index);
     const colour = colours[colourIndex++ % colours.length];
-    const { thumb, ...preview } = await previewOf(merger.mapPixels(index), info.width, info.height, colour);
+    const { thumb, ...preview } = await previewOf(savedMaps.mapPixels(index), info.width, info.height, colour);
     pictures.set(info.name, { ...info, index, preview });
     transfer.push(thumb);
     added.push({ ...info, index, imageName: m.imageName, colour, thumb });
@@ -67,7 +70,7 @@ async function add({ files, resolution, colours }) {
 /** Merges every map read so far; the merged map's files come with the report. */
 function merge(id) {
   const t0 = performance.now();
-  const report = JSON.parse(merger.mergeWithProgress((text) => postMessage({ type: 'progress', id, text })));
+  const report = savedMaps.mergeWithProgress((text) => postMessage({ type: 'progress', id, text }));
   adjusting = null; // a new merge ends any placing by hand
   view = null;
   return withFiles(report, t0);
@@ -76,8 +79,8 @@ function merge(id) {
 /** Aligns map b on map a again from the page's guess; the report follows it. */
 function refine({ a, b, pose }) {
   const t0 = performance.now();
-  const pair = JSON.parse(merger.refine(a, b, pose[0], pose[1], pose[2]));
-  const out = withFiles(JSON.parse(merger.reportJson()), t0);
+  const pair = savedMaps.refine(a, b, pose);
+  const out = withFiles(savedMaps.report(), t0);
   adjusting = null;
   view = null;
   out.result.pair = pair;
@@ -90,9 +93,9 @@ function withFiles(report, t0) {
   let files = null;
   const transfer = [];
   if (report.merge.status === 'merged') {
-    const pgm = merger.mergedPgm();
-    const png = merger.mergedPng();
-    files = { pgm, png, yaml: merger.mergedYaml('merged.pgm') };
+    const pgm = savedMaps.mergedPgm();
+    const png = savedMaps.mergedPng();
+    files = { pgm, png, yaml: savedMaps.mergedYaml('merged.pgm') };
     transfer.push(pgm.buffer, png.buffer);
   }
   report.timings_ms = { merge: t1 - t0, write: performance.now() - t1 };
@@ -109,13 +112,13 @@ self.onmessage = async ({ data }) => {
     let out;
     if (type === 'add') out = await add(data);
     else if (type === 'merge') {
-      if (!merger) throw new Error('open two or more maps first');
+      if (!savedMaps) throw new Error('open two or more maps first');
       out = merge(id);
     } else if (type === 'canvas') {
       overlay = data.canvas;
       out = { result: {}, transfer: [] };
     } else if (type === 'refine') {
-      if (!merger) throw new Error('open two or more maps first');
+      if (!savedMaps) throw new Error('open two or more maps first');
       out = refine(data);
     } else if (type === 'draw') {
       out = { result: { view: draw(data) }, transfer: [] };
@@ -128,8 +131,8 @@ self.onmessage = async ({ data }) => {
       view = null;
       out = { result: { view: draw(lastSize) }, transfer: [] };
     } else if (type === 'clear') {
-      merger?.free();
-      merger = null;
+      savedMaps?.free();
+      savedMaps = null;
       colourIndex = 0;
       pictures = new Map();
       placed = [];

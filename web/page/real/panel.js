@@ -1,7 +1,7 @@
 // "Your maps": merge saved ROS map_server maps in the page (issue 20).
 //
 // A view over the lab (like the summary) where a user opens two to sixteen
-// maps of their own — each YAML with its PGM or PNG image, picked together
+// saved maps — each YAML with its PGM or PNG image, picked together
 // or dropped, or an image alone at a typed resolution — sees each one,
 // merges them automatically and reads the verdict with its reason and
 // confidence, each map's transform (metres, degrees, and the arguments of
@@ -13,7 +13,7 @@
 // lab's own scenario and runs behind this view are never touched.
 
 import { ADJUST_HTML, PlaceByHand } from './adjust.js';
-import { MergeClient } from './client.js';
+import { SavedMapsClient } from './client.js';
 import { OverlayCanvas, mergeHtml, saveMerge, showMerge, swatch } from './merge-result.js';
 
 /** One colour per map (up to 16), told apart on white. */
@@ -47,7 +47,7 @@ const HTML = `
     extra: ADJUST_HTML,
   })}`;
 
-export class RealMaps {
+export class SavedMapsView {
   /**
    * `root`: the view's element; `opener`: the toolbar button;
    * `download(name, data, type)`; `covers`: the views over the lab (cover.js).
@@ -62,7 +62,7 @@ export class RealMaps {
     this.files = null;
     this.busy = false;
     this.queue = Promise.resolve();
-    this.client = new MergeClient((text) => this.progress(text));
+    this.client = new SavedMapsClient((text) => this.progress(text));
     this.overlay = new OverlayCanvas(root, 'real', this.client);
     this.adjust = new PlaceByHand(root, this.client, {
       maps: () => this.maps,

@@ -1,0 +1,134 @@
+// The log replay as JavaScript sees it: one facade over the raw
+// wasm-bindgen `LogReplay` (crate/src/bindings/logs.rs), used by the page's
+// "Your log" worker (web/page/real/log-worker.js, web/page/real/log-merge.js)
+// and by the `run-log` command (web/cli/run-log.mjs).
+//
+// A log replay reads a laser log (CARMEN: FLASER / ROBOTLASER1 / RAWLASER1
+// and ODOM records, plain or gzip), optionally keeps a stretch of its laser
+// records, replays it through the log SLAM a few scans at a time (scan
+// matching, pose graph, loop closures), settles the pose graph at the end
+// and reports every scan's pose and the map (docs/interfaces.md, "Real
+// laser logs: run-log").
+//
+// As web/lab.js does for `Lab`, this module parses every JSON text the
+// binding returns once, here, and hands back objects: `replay.view()`
+// rather than `JSON.parse(replay.viewJson())`. Method names follow the
+// binding's, without the `Json` suffix where the result is parsed; bytes
+// (map pixels, PGM, PNG) and the YAML text pass straight through. The
+// binding's errors (a malformed record, a bad range) are thrown unchanged,
+// as `Error`s whose message names the problem (with the line number for a
+// record); a `WebAssembly.RuntimeError` is a bug.
+//
+// A new binding method gets its facade method in the section it belongs to
+// (opening, stepping, results, the live map), parsed here if it returns
+// JSON. This module imports nothing: the caller hands it the loaded
+// wasm-bindgen module.
+
+/** The largest `to` the binding takes (an i32); larger means the end. */
+const LAST_RECORD = 2 ** 31 - 1;
+
+/** Accepts timings as an object or as JSON text. */
+const timingsText = (t) => (typeof t === 'string' ? t : JSON.stringify(t ?? {}));
+
+export class LogReplay {
+  /**
+   * A replay of the CARMEN log in `bytes` (Uint8Array; plain or gzip) on
+   * the loaded wasm-bindgen module `wasm`; throws with the line number of
+   * a malformed record.
+   */
+  static open(wasm, bytes) {
+    return new LogReplay(new wasm.LogReplay(bytes));
+  }
+
+  /** Wraps a raw wasm-bindgen `LogReplay` (kept as `this.raw` for tests and the console). */
+  constructor(raw) {
+    this.raw = raw;
+  }
+
+  /** Frees the replay held in wasm memory; the object is unusable afterwards. */
+  free() {
+    this.raw.free();
+  }
+
+  // --- The log --------------------------------------------------------------------
+
+  /** How many laser records the log holds. */
+  laserRecords() {
+    return this.raw.laserRecords();
+  }
+
+  /**
+   * Replays laser records `from..=to` only (0-based; `to` left out, null or
+   * negative: to the end); throws when the stretch holds no record.
+   */
+  setRange(from, to) {
+    const last = to === undefined || to === null || to < 0 ? -1 : Math.min(to, LAST_RECORD);
+    this.raw.setRange(from, last);
+  }
+
+  // --- The replay -----------------------------------------------------------------
+
+  /** Replays up to `n` more scans; returns how many are left. */
+  step(n) {
+    return this.raw.step(n);
+  }
+
+  /** Replays what is left, settles the pose graph and draws the map. */
+  finish() {
+    this.raw.finish();
+  }
+
+  /**
+   * The replay so far: `{done, total, odometry, poses, closures}`, with
+   * each replayed scan's odometry and current SLAM pose as flat
+   * `[x, y, theta, ...]` lists and each loop closure as
+   * `{segment: [x1, y1, x2, y2], from_scan, to_scan, score}`.
+   */
+  view() {
+    return JSON.parse(this.raw.viewJson());
+  }
+
+  // --- The results (after finish) ----------------------------------------------------
+
+  /** The run-log report as an object; `timings` (ms, object or JSON text) becomes its `timings_ms`. */
+  report(timings = {}) {
+    return JSON.parse(this.reportText(timings));
+  }
+
+  /** The same as the binding's JSON text, byte for byte (what `run-log --json` prints). */
+  reportText(timings = {}) {
+    return this.raw.reportJson(timingsText(timings));
+  }
+
+  /** The map as a binary PGM (ROS map_server; Uint8Array). */
+  mapPgm() {
+    return this.raw.mapPgm();
+  }
+
+  /** The map as a PNG (Uint8Array). */
+  mapPng() {
+    return this.raw.mapPng();
+  }
+
+  /** The map_server YAML text naming `image` (the PGM's file name). */
+  mapYaml(image) {
+    return this.raw.mapYaml(image);
+  }
+
+  // --- The live map (the scans so far at their current poses) ------------------------
+
+  /** Draws the live map; false before the first scan (nothing drawn). */
+  drawLive() {
+    return this.raw.drawLive();
+  }
+
+  /** The live map's `{width, height, resolution_m, origin_m, occupied_cells, scans, dropped_updates}`; throws before `drawLive`. */
+  liveInfo() {
+    return JSON.parse(this.raw.liveInfoJson());
+  }
+
+  /** The live map's grey pixels (PGM shades), top row first (Uint8Array). */
+  livePixels() {
+    return this.raw.livePixels();
+  }
+}
