@@ -7,9 +7,9 @@
 //! odometry made from those poses (seeded, `slam::eval::relations::DriftModel`)
 //! and scored against them, at four drift seeds. One seed's figure moves by
 //! several centimetres with which loop closures a small change lets the
-//! replay find (BENCHMARKS.md, sessions 18–37), so the bounds hold the mean
-//! over the seeds; each seed must beat its odometry. Bounds are the figures
-//! measured on this code (BENCHMARKS.md, "Real laser logs") with a small
+//! replay find (docs/history/issue-21-real-laser-logs.md), so the bounds hold
+//! the mean over the seeds; each seed must beat its odometry. Bounds are the
+//! figures measured on this code (BENCHMARKS.md, "Log replay") with a small
 //! margin (the replay is deterministic); the issue's targets (0.10 m, 1 deg,
 //! a quarter of odometry's) are not met yet on most logs, so the bounds are
 //! honest ones. On the corrected logs the scans must
@@ -92,30 +92,25 @@ fn against_odometry(name: &str, o: &Outcome, share: f64) {
 
 /// Our poses may put the returns in at most this many times the cells the
 /// reference's poses do ([`support::cells_hit`], a measure needing no
-/// reference). Measured, session 30: 0.97 (ACES), 0.99 (CSAIL
-/// corrected), 0.90 (Intel), 0.84 (Freiburg 079). Session 37, at the four
-/// drift seeds: ACES 0.978–1.001, CSAIL corrected 0.943–0.971, Intel
-/// 0.867–0.902, Freiburg 079 0.845–0.858 (weakly matched scans taken into
-/// the local map made ACES 1.033–1.038).
+/// reference). Measured at the four drift seeds: ACES 0.978–1.001, CSAIL
+/// corrected 0.943–0.971, Intel 0.867–0.902, Freiburg 079 0.845–0.858
+/// (weakly matched scans taken into the local map made ACES 1.033–1.038).
 const CELLS_MARGIN: f64 = 1.02;
 
 #[test]
 fn mit_csail_raw_log_against_gmapping() {
     let (o, recorded) = support::csail_raw();
     // Measured: 0.193 m / 0.95 deg against odometry's 6.628 m / 18.80 deg
-    // (0.213 m / 1.03 deg before session 30's square walls' prior)
-    // (0.432 m / 1.00 deg before session 17 refused closures on the search
-    // window's edge; the issue's 0.10 m / 1 deg is not met on
-    // this log: see BENCHMARKS.md).
+    // (the issue's 0.10 m / 1 deg is not met on this log: see BENCHMARKS.md,
+    // "Log replay", and docs/history/issue-21-real-laser-logs.md).
     check("mit-csail.clf.gz", &o, 0.20, 1.0, 0.25);
     assert!(o.closures > 0, "the CSAIL tour revisits corridors");
     println!("recorded {recorded:.0} s, replayed in {:.1} s", o.seconds);
 }
 
 // The corrected logs' bounds hold the mean over the four drift seeds.
-// Measured, session 37 (before its weak matches): Intel 0.099 m / 0.72 deg
-// (0.098 / 0.69); ACES 0.171 / 0.46 (0.171 / 0.47); CSAIL corrected
-// 0.205 / 1.01 (0.224 / 1.12); Freiburg 079 0.054 / 0.77 (0.054 / 0.77).
+// Measured: Intel 0.099 m / 0.72 deg; ACES 0.171 / 0.46; CSAIL corrected
+// 0.205 / 1.01; Freiburg 079 0.054 / 0.77.
 
 #[test]
 fn intel_with_drifting_odometry() {
@@ -148,7 +143,7 @@ fn freiburg_079_with_drifting_odometry() {
 /// Kümmerle et al.'s relations with the person replaced by checks), at the
 /// default drift seed: our poses within 0.035 m / 0.40 deg on average, no
 /// further off than the reference's own poses, and at most a quarter of
-/// the odometry's error. Measured, session 40 (ours / the reference's,
+/// the odometry's error. Measured (ours / the reference's,
 /// all gaps): raw MIT CSAIL 0.019 m / 0.30 deg (0.029 / 0.69), Intel
 /// 0.021 / 0.29 (0.027 / 0.47), ACES 0.027 / 0.34 (0.033 / 0.40), CSAIL
 /// corrected 0.017 / 0.26 (0.029 / 0.68), Freiburg 079 0.015 / 0.30

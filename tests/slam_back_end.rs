@@ -5,10 +5,9 @@
 //! filter alone drifts by more than a metre before the robot is back where
 //! it started; the back end closes the loop there and moves the whole lap.
 //! Both sides are asserted: without the back end the run drifts (ATE over
-//! 0.2 m: measured 0.898 m in session 23, 0.325 m since session 26's
-//! spacing-sized normals took out most of the front end's bias), with it
-//! the ATE is under the issue's 0.1 m and under a third of the drift
-//! (measured 0.040 m in session 23, 0.053 m in session 26). Slow in a debug
+//! 0.2 m; measured 0.325 m), with it the ATE is under the issue's 0.1 m and
+//! under a third of the drift (measured 0.053 m; the history is in
+//! docs/history/issue-22-many-robots.md, rounds 11 and 14). Slow in a debug
 //! build: `cargo test --release -p slamlab --test slam_back_end`.
 
 use slamlab::scenario::Scenario;

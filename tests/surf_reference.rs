@@ -7,7 +7,7 @@
 //!   It is in the non-free contrib module, which no installable package
 //!   ships, so it is built from source: the `opencv-contrib-python` source
 //!   distribution on PyPI carries both trees (the cmake line is in
-//!   BENCHMARKS.md). Point `OPENCV_PREFIX` at the install.
+//!   docs/history/issue-4-surf.md). Point `OPENCV_PREFIX` at the install.
 //! - **dlib's** `get_surf_points` (dlib 19.24, Debian's `libdlib-dev`,
 //!   `tests/bench/dlib_surf.cpp`).
 //!
@@ -141,7 +141,7 @@ fn reference_features(r: &Reference, img: &GrayImage, name: &str, max: usize) ->
 /// The OpenCV driver: `$OPENCV_SURF`, or built from
 /// `tests/bench/opencv_surf.cpp` against the OpenCV installed under
 /// `$OPENCV_PREFIX` (built from source with the contrib modules and
-/// `-DOPENCV_ENABLE_NONFREE=ON`; see BENCHMARKS.md).
+/// `-DOPENCV_ENABLE_NONFREE=ON`; see docs/history/issue-4-surf.md).
 fn opencv_binary() -> PathBuf {
     if let Ok(p) = std::env::var("OPENCV_SURF") {
         return PathBuf::from(p);

@@ -14,7 +14,7 @@
 //! `--turn` turns the lattice by whole degrees in the raster (the hour's
 //! maps: robots start at random headings, so their walls are staircases).
 //! It also builds for `wasm32-wasip1` and runs in node's WASI, to measure
-//! the wasm build (BENCHMARKS.md, session 21).
+//! the wasm build (BENCHMARKS.md, "Many robots").
 
 use slamlab::merge::peaksearch::{pyramid_of, PeakSearch, ScoreImage};
 use std::time::Instant;

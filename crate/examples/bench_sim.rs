@@ -15,7 +15,7 @@
 //! listed time, the median time of a redraw after 2 s more of the run with
 //! the robots' paths kept on their layer (`render/trails.rs`), and of the
 //! same picture with the paths drawn from nothing (every path stroked
-//! whole, as before session 18; the walls from their kept layer in both).
+//! whole; the walls from their kept layer in both).
 
 use slamlab::lab::Lab;
 use slamlab::render::{render_world_cached, TrailLayer, ViewLayers};

@@ -1,4 +1,5 @@
-//! Native benchmark of painting wall textures (BENCHMARKS.md, session 10).
+//! Native benchmark of painting wall textures (BENCHMARKS.md, "Simulation,
+//! camera and drawing").
 //!
 //! `cargo run --release -p slamlab --example bench_textures [-- CHUNKS]`
 //!

@@ -195,7 +195,7 @@ fn front_edge(
 /// noise of the square walls' prior, and how much wander it sees. Twice:
 /// each key's direction from its normals, and refined by its straight
 /// walls (runs of at least 1 m fitted by lines; sharper on clean walls,
-/// wider on these logs: BENCHMARKS.md, issue 21, session 31).
+/// wider on these logs: docs/history/issue-21-real-laser-logs.md, round 16).
 fn square_spread(slam: &LogSlam, reference: &[Pose2], key_scan: &[usize]) {
     use slamlab::slam::manhattan::{building_direction, fold, scan_direction};
     let normals = slam.config.manhattan.clone().unwrap_or_default();

@@ -1,5 +1,5 @@
 //! Relation errors (Kümmerle et al. 2009) of the log SLAM on the real logs
-//! of `../shared/data/carmen` (BENCHMARKS.md, "Real laser logs").
+//! of `../shared/data/carmen` (BENCHMARKS.md, "Log replay").
 //!
 //! `cargo run --release -p slamlab --example log_relations [LOG ...]`
 //!

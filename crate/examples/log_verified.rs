@@ -11,8 +11,8 @@
 //! (GMapping 0.05–0.07 m, graph mapping 0.004–0.056 m) are errors against
 //! such relations. The lab's own figure (`log_relations`) scores against the
 //! corrected logs' poses instead, which carry their own noise (BENCHMARKS.md,
-//! issue 21, session 30: the truth itself would score about 0.08 m against
-//! them on ACES and CSAIL corrected).
+//! "Log replay": the truth itself would score about 0.08 m against them on
+//! ACES and CSAIL corrected).
 //!
 //! This example makes relations in Kümmerle's manner with the person
 //! replaced by checks ([`slamlab::slam::eval::verified`]): candidate pairs near

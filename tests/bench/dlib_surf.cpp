@@ -1,5 +1,5 @@
-// Reference SURF for the quality comparison in BENCHMARKS.md ("SURF against
-// dlib"): runs dlib's get_surf_points (Debian's libdlib-dev, dlib 19.24) on
+// Reference SURF for the quality comparison in BENCHMARKS.md ("SURF"; the
+// history: docs/history/issue-4-surf.md): runs dlib's get_surf_points (Debian's libdlib-dev, dlib 19.24) on
 // a binary PGM and prints one keypoint per line:
 //
 //   x y scale angle laplacian d0 ... d63

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The log SLAM judged over many logs and drift seeds (issue 21, BENCHMARKS.md session 37 on).
+"""The log SLAM judged over many logs and drift seeds (issue 21; BENCHMARKS.md, "Log replay").
 
 A single drift seed's relation error on one log moves by centimetres with which loop closures a
 small change lets the replay find. So a setting is judged on every log at several drift seeds:
@@ -10,7 +10,7 @@ each log's mean relation error over all pairs (m) over the seeds, and the mean o
                                    [--save OUT.json] [--against BASE.json] [--jobs 2]
 
 The five logs of ../shared/data/carmen (or $SLAMLAB_DATA/carmen) always run; --unseen DIR adds
-every corrected log in DIR/carmen that is not one of them (session 32 took nine from the public
+every corrected log in DIR/carmen that is not one of them (nine were taken from the public
 `acschaefer/ple` repository, `data/carmen`; they are read from where they lie, never copied into
 this repository). The raw MIT CSAIL log has its robot's own odometry, which no seed touches: it
 is replayed once and its figure counted at every seed. --save keeps every log's figure at every seed; --against a saved run also counts the

@@ -1,7 +1,8 @@
-// Reference SURF for the quality comparison in BENCHMARKS.md ("SURF against
-// reference implementations"): runs OpenCV's cv::xfeatures2d::SURF (the
-// non-free contrib module, built from source with OPENCV_ENABLE_NONFREE) on
-// a binary PGM and prints one keypoint per line, as dlib_surf.cpp does:
+// Reference SURF for the quality comparison in BENCHMARKS.md ("SURF"; how
+// it is built: docs/history/issue-4-surf.md): runs OpenCV's
+// cv::xfeatures2d::SURF (the non-free contrib module, built from source
+// with OPENCV_ENABLE_NONFREE) on a binary PGM and prints one keypoint per
+// line, as dlib_surf.cpp does:
 //
 //   x y size angle laplacian d0 ... d63
 //

@@ -1,6 +1,6 @@
 // A room whose round wall is traced as many short unnamed segments, the way
 // a floor plan digitised from a drawing arrives: the stress case for wall
-// textures in BENCHMARKS.md ("A traced room"). Writes scenario JSON to
+// textures in docs/history/issue-2-3-simulation-and-camera.md ("A traced room"). Writes scenario JSON to
 // stdout.
 //
 //   node tests/bench/traced_room.mjs [SEGMENTS] > /tmp/traced.json

@@ -20,7 +20,8 @@
 // doubles a frame, so that no unmeasured batch starts a long task. A batch
 // is taken a step at a time and stops when its budget is spent: a step can
 // cost several times the average, and 12-14 steps of 16 robots made 100-116
-// ms frames when one of them did (session 18, a 45 s run at 20x).
+// ms frames when one of them did (a 45 s run at 20x,
+// docs/history/issue-22-many-robots.md, round 6).
 import { clamp } from './geometry.js';
 import { fmt } from './dom.js';
 import { setStatus } from './status.js';

@@ -232,7 +232,7 @@ pub struct TextureBank {
 /// bilinear filtering's job at render time. Anti-aliased filling (tiny-skia
 /// covers each pixel row with four sub-scanlines) cost half of all
 /// painting, and painting was the largest part of describing a run's
-/// frames (BENCHMARKS.md, session 10).
+/// frames (docs/history/issue-6-map-merging.md, round 8).
 fn rgb(c: [u8; 3], a: u8) -> Paint<'static> {
     let mut p = Paint::default();
     p.set_color(Color::from_rgba8(c[0], c[1], c[2], a));

@@ -612,9 +612,8 @@ impl CoarseMap {
 /// spectra's rotation, and the other three rotations are that raster
 /// turned a quarter at a time, cell for cell ([`Raster::quarter_turn`]);
 /// the correlation adds only the rows' non-zero runs ([`RowRuns`]). (On
-/// the hour's sixteen maps both halve the 120 overlaps' time, 3.2 → 1.5 s
-/// natively, every overlap the same to the bit: BENCHMARKS.md, session
-/// 28.)
+/// the hour's sixteen maps both halve the 120 overlaps' time, every overlap
+/// the same to the bit: docs/history/issue-22-many-robots.md, round 16.)
 pub fn coarse_overlap(
     a: &CoarseMap,
     b: &CoarseMap,

@@ -63,9 +63,8 @@
 //!
 //! Each bound costs one lookup per wall cell of both maps (long runs of
 //! neighbouring wall cells are added as slices, `Points`), so the saving
-//! depends on how fast the bounds fall below the peaks kept; the
-//! benchmark in BENCHMARKS.md ("The map search, branch and bound") has the
-//! figures. The answer does not depend on it: the test module checks it
+//! depends on how fast the bounds fall below the peaks kept; BENCHMARKS.md
+//! ("Many robots") has the figures. The answer does not depend on it: the test module checks it
 //! against the exhaustive correlation.
 //!
 //! [`Correlation::peaks`]: super::raster_correlation::Correlation::peaks

@@ -41,11 +41,11 @@
 //! odometry and 1 cm range noise, a robot following one wall veered towards
 //! it, 0.45 m after 100 m, and only when the far wall was in range; the
 //! outer-wall robots of the 16-robot hour drifted a degree a lap the same
-//! way (BENCHMARKS.md, sessions 25 and 26). So the neighbourhood grows with
-//! the range: its radius is the larger of 0.12 m and the spacing of
-//! [`SPACING_BEAMS`] beams at the point's range (0.56 m at 4 m). Near the
-//! robot nothing changes; far points get enough neighbours that noise no
-//! longer decides which of them count.
+//! way (docs/history/issue-22-many-robots.md, rounds 13 and 14). So the
+//! neighbourhood grows with the range: its radius is the larger of 0.12 m
+//! and the spacing of [`SPACING_BEAMS`] beams at the point's range (0.56 m
+//! at 4 m). Near the robot nothing changes; far points get enough
+//! neighbours that noise no longer decides which of them count.
 
 use crate::sensors::laser::{LASER_BEAMS, LASER_FOV_RAD};
 use glam::DVec2;

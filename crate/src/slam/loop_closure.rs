@@ -267,7 +267,7 @@ fn widening_m(cfg: &LoopConfig, path_m: f64) -> f64 {
 /// open. Karto sizes its loop search by the covariance accumulated along
 /// the chain; a reach proportional to the path is that bound for drift
 /// that grows with distance. The path is the shortest through the
-/// closures accepted so far (session 33): a place already tied to the
+/// closures accepted so far: a place already tied to the
 /// newer part of the tour has had its drift taken out, and the search
 /// there stays near the fixed window. Against the path the estimate
 /// travelled, that takes the five shared logs' replays from 4× to about
@@ -286,8 +286,8 @@ fn widening_m(cfg: &LoopConfig, path_m: f64) -> f64 {
 /// [`find_closure_among`] on the other tries). Grown on every try it made
 /// one of the tuned logs worse by a centimetre and the replays 4–10×
 /// slower; one try in four keeps most of the halls' gains at a third of
-/// that cost and leaves the five shared logs as they were (BENCHMARKS.md,
-/// issue 21, sessions 32–34).
+/// that cost and leaves the five shared logs as they were
+/// (docs/history/issue-21-real-laser-logs.md, rounds 17–19).
 pub fn closure_window(cfg: &LoopConfig, path_m: f64) -> Window {
     Window {
         linear_m: cfg.window.linear_m + widening_m(cfg, path_m),

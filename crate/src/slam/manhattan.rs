@@ -5,7 +5,7 @@
 //! match is good to a tenth of a degree, but a local map of a few metres
 //! is drawn with the very heading it is meant to hold, so a few tenths of
 //! a degree come and go over tens of metres (on the real logs, about 0.45°
-//! by twenty scans; BENCHMARKS.md, issue 21). Across a building that is
+//! by twenty scans; docs/history/issue-21-real-laser-logs.md, round 15). Across a building that is
 //! decimetres.
 //!
 //! Most buildings are built square: their walls run in two directions at
@@ -48,12 +48,11 @@
 //! and settles in rounds ([`settle_priors`]): the keys within the gate are
 //! pulled in, which turns the stretches they hang on, and the next round
 //! gates again at the headings that left, until the keys given a prior no
-//! longer change. Measured on fourteen real logs (BENCHMARKS.md, issue 21,
-//! session 33): the five shared logs do not move (a millimetre on one drift
-//! seed of three); Örebro 1.43 → 0.39 m and the Freiburg campus 1.78 →
-//! 1.04 m; at a 10° gate the raw MIT CSAIL log bends a part of the
-//! building that stands that far off square (0.19 → 0.41 m), which is the
-//! limit of the idea. The simulated robots, whose matches never fail that way, keep
+//! longer change. On the real logs this brings such stretches back and
+//! leaves the five shared logs as they were; a 10° gate would bend a part
+//! of the raw MIT CSAIL log's building that stands that far off square,
+//! which is the limit of the idea (docs/history/issue-21-real-laser-logs.md,
+//! round 18). The simulated robots, whose matches never fail that way, keep
 //! 2° and one round.
 //!
 //! ## What the numbers say
@@ -61,12 +60,10 @@
 //! building's on the corrected logs, at the reference's headings and at
 //! ours alike (`log_closures`): a single key's direction is no better than
 //! its heading, so the prior is loose (σ 2°) and works by numbers — a
-//! chain's wander is pulled in by hundreds of keys at once. Against σ 0.5°
-//! (worse on ACES and CSAIL corrected) and 1°, σ 2° lowers the relation
-//! errors of the raw MIT CSAIL log 0.213 → 0.193 m, ACES 0.161 → 0.155,
-//! CSAIL corrected 0.240 → 0.234, and over three more drift seeds ACES by
-//! 0.007–0.031 m and CSAIL corrected by up to 0.046 m; Intel and Freiburg
-//! 079 move by a millimetre or two (BENCHMARKS.md, issue 21, session 30).
+//! chain's wander is pulled in by hundreds of keys at once. σ 2° scored
+//! better than 0.5° and 1° on the logs it acts on, and leaves the logs whose
+//! chains do not wander as they were (docs/history/issue-21-real-laser-logs.md,
+//! round 15).
 //!
 //! ## Straight walls (a setting, off)
 //! A normal is fitted to the few returns within `normal_radius_m` of a
@@ -78,8 +75,9 @@
 //! range noise this is sharper. On the real logs it is not (long walls are
 //! no squarer than short ones) and the relation errors do not improve; for
 //! the simulated robots, with the building's direction taken from ten keys
-//! instead of fifty, it trades one hour's failures for another's. Both are
-//! measured in BENCHMARKS.md, session 31; it stays off.
+//! instead of fifty, it trades one hour's failures for another's. So it
+//! stays off (docs/history/issue-21-real-laser-logs.md, round 16, and
+//! issue-22-many-robots.md, round 19).
 
 use super::degeneracy::{covariance2, scan_normals_within, symmetric_eigen2, MAX_GAP_M};
 use super::posegraph::{Edge, PoseGraph};

@@ -99,15 +99,15 @@
 //! | 0.3, 8, 3             | 0.0437 m | 6 |
 //!
 //! Side by side on the hour of seed 22, 0.2 m takes 12 % less CPU than the
-//! knee, and in node the hour's SLAM goes from 104 s of CPU to 71 s
-//! (BENCHMARKS.md, issue 22, session 35); 0.3 m saves a little more but
-//! starts to cost accuracy.
+//! knee and about a third less of the SLAM's CPU in node than every scan
+//! (docs/history/issue-22-many-robots.md, round 23); 0.3 m saves a little
+//! more but starts to cost accuracy.
 //!
 //! The robot-hours over 0.1 m are whole maps turned in their first seconds
-//! (BENCHMARKS.md, session 31), the same robots in every row. The first
-//! minutes are where a map can be turned for good (a few scans, a
-//! degenerate view); a map ten minutes old is matched against walls seen
-//! many times. [`MotionFilter::EVERY_SCAN`] processes every scan throughout
+//! (docs/history/issue-22-many-robots.md, round 19), the same robots in
+//! every row. The first minutes are where a map can be turned for good (a
+//! few scans, a degenerate view); a map ten minutes old is matched against
+//! walls seen many times. [`MotionFilter::EVERY_SCAN`] processes every scan throughout
 //! (`SlamConfig::motion`; `SLAM_MOTION_M`, `SLAM_MOTION_DEG`,
 //! `SLAM_MOTION_S`, `SLAM_MOTION_FIRST_S` in `examples/slam_trace.rs` and
 //! `examples/sim_drift.rs`).
