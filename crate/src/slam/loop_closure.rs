@@ -33,7 +33,7 @@
 
 use super::degeneracy::scan_normals_within;
 use super::icp::{IcpFit, IcpTarget};
-use super::match_covariance::{edge_information, response_covariance, ResponseWindow};
+use super::match_covariance::edge_information;
 use super::multires::{field_covering, field_from_points, match_scan, rival_score, Window};
 use super::posegraph::Edge;
 use crate::geom::{wrap_angle, Pose2};
@@ -96,39 +96,30 @@ pub struct Closure {
 
 /// Looks for a closure of key `i` (pose `nodes[i]`, points `key_points[i]`
 /// in its robot frame) against the older keys of the nearest earlier pass
-/// through its place ([`find_closure_among`] with one visit). With `response`, the edge's
-/// information is the match's own ([`super::match_covariance`]) instead of
-/// `cfg.sigma_m` / `cfg.sigma_rad`.
+/// through its place, in the fixed window ([`find_closure_among`] without
+/// links). The edge's σ is `cfg.sigma_m` / `cfg.sigma_rad`.
 pub fn find_closure(
     nodes: &[Pose2],
     key_points: &[Vec<DVec2>],
     i: usize,
     resolution_m: f64,
     cfg: &LoopConfig,
-    response: Option<&ResponseWindow>,
 ) -> Option<Closure> {
-    find_closure_among(nodes, key_points, i, resolution_m, cfg, response, 1, None)
+    find_closure_among(nodes, key_points, i, resolution_m, cfg, None)
 }
 
-/// [`find_closure`] against up to `visits` earlier passes through the
-/// place, not only the nearest: the candidate keys within the radius are
-/// split into visits (runs of keys, a new one after a gap of more than
-/// `2 · submap_half` keys), each visit's nearest key is a centre, and the
-/// best-scoring match of the `visits` nearest centres is returned.
-/// `links` are the closures accepted so far (`(older key, newer key)`):
-/// with a window that grows with the path ([`closure_window`]), the path
-/// is the shortest through them ([`paths_to`]). `None` searches the fixed
-/// window only, whatever `cfg.window_per_m` says: the driver grows the
-/// window on some tries only.
-#[allow(clippy::too_many_arguments)]
+/// [`find_closure`] in a window that may grow with the path: `links` are
+/// the closures accepted so far (`(older key, newer key)`); with a window
+/// that grows with the path ([`closure_window`]), the path is the shortest
+/// through them ([`paths_to`]). `None` searches the fixed window only,
+/// whatever `cfg.window_per_m` says: the driver grows the window on some
+/// tries only.
 pub fn find_closure_among(
     nodes: &[Pose2],
     key_points: &[Vec<DVec2>],
     i: usize,
     resolution_m: f64,
     cfg: &LoopConfig,
-    response: Option<&ResponseWindow>,
-    visits: usize,
     links: Option<&[(usize, usize)]>,
 ) -> Option<Closure> {
     // The path from each key to key i, only when the reach grows with it.
@@ -137,22 +128,16 @@ pub fn find_closure_among(
         _ => Vec::new(),
     };
     let path = |j: usize| paths.get(j).copied().unwrap_or(0.0);
-    visit_centres(nodes, i, cfg, &paths)
-        .into_iter()
-        .take(visits.max(1))
-        .filter_map(|c| {
-            match_visit(
-                nodes,
-                key_points,
-                i,
-                c,
-                path(c),
-                resolution_m,
-                cfg,
-                response,
-            )
-        })
-        .max_by(|a, b| a.score.total_cmp(&b.score))
+    let centre = *visit_centres(nodes, i, cfg, &paths).first()?;
+    match_visit(
+        nodes,
+        key_points,
+        i,
+        centre,
+        path(centre),
+        resolution_m,
+        cfg,
+    )
 }
 
 /// The nearest key of each visit to key `i`'s place (see
@@ -324,7 +309,6 @@ pub(super) fn on_window_edge(
 
 /// Matches key `i` against the key scans around `centre`, `path_m` along
 /// the tour from it ([`closure_window`]).
-#[allow(clippy::too_many_arguments)]
 pub(super) fn match_visit(
     nodes: &[Pose2],
     key_points: &[Vec<DVec2>],
@@ -333,7 +317,6 @@ pub(super) fn match_visit(
     path_m: f64,
     resolution_m: f64,
     cfg: &LoopConfig,
-    response: Option<&ResponseWindow>,
 ) -> Option<Closure> {
     let mut world = Vec::new();
     for j in visit_keys(i, centre, cfg) {
@@ -346,8 +329,8 @@ pub(super) fn match_visit(
     let points = &key_points[i];
     let field = field_from_points(&world, resolution_m, 8, cfg.window.linear_m + 1.0);
     let found = match_scan(&field, points, &nodes[i], &cfg.window);
-    let (field, m, window) = match found.filter(|m| m.score >= cfg.min_score) {
-        Some(m) => (field, m, cfg.window.clone()),
+    let (m, window) = match found.filter(|m| m.score >= cfg.min_score) {
+        Some(m) => (m, cfg.window.clone()),
         None => {
             let window = closure_window(cfg, path_m);
             if window.linear_m <= cfg.window.linear_m {
@@ -368,7 +351,7 @@ pub(super) fn match_visit(
             if rival > cfg.unique_ratio * m.search_score {
                 return None;
             }
-            (field, m, window)
+            (m, window)
         }
     };
     let mut edge = Edge::new(
@@ -379,12 +362,6 @@ pub(super) fn match_visit(
         cfg.sigma_rad,
     );
     edge.loop_closure = true;
-    if let Some(info) = response
-        .and_then(|w| response_covariance(&field, &key_points[i], &m.pose, w))
-        .and_then(|c| edge_information(&c, m.pose.theta))
-    {
-        edge.information = info;
-    }
     Some(Closure {
         edge,
         score: m.score,
@@ -621,7 +598,7 @@ mod tests {
             ..LoopConfig::default()
         };
         let find = |cfg: &LoopConfig, links: Option<&[(usize, usize)]>| {
-            find_closure_among(&nodes, &key_points, i, 0.05, cfg, None, 1, links)
+            find_closure_among(&nodes, &key_points, i, 0.05, cfg, links)
         };
         let grown = find(&cfg, Some(&[])).expect("a closure in the grown window");
         assert_eq!(grown.window.linear_m, 4.0);

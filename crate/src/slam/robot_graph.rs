@@ -688,7 +688,6 @@ impl RobotGraph {
             id,
             resolution_m,
             &self.config.loops,
-            None,
         )?;
         self.stats.closures_found += 1;
         let fit = self.refine_closure(&found, &points[id], resolution_m);

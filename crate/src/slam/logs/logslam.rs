@@ -123,7 +123,6 @@
 //! The poses are in the log's odometry frame: the first scan's pose is its
 //! odometry pose, and the graph's first node stays fixed there.
 
-use super::refine::{refine, RefineConfig};
 use super::scan::LogScan;
 use crate::geom::{wrap_angle, Pose2};
 use crate::slam::grid::{GridConfig, OccupancyGrid, GROW_STEP_CELLS};
@@ -133,7 +132,6 @@ use crate::slam::loop_closure::{
     LoopConfig,
 };
 use crate::slam::manhattan::{scan_direction, settle_priors, ManhattanConfig};
-use crate::slam::match_covariance::{edge_information, response_covariance, ResponseWindow};
 use crate::slam::multires::{field_from_points, match_scan, ScanMatch, Window};
 use crate::slam::posegraph::{Edge, PoseGraph};
 use glam::DVec2;
@@ -181,46 +179,10 @@ pub struct LogSlamConfig {
     /// Also match around the constant-velocity prediction when it
     /// disagrees with the odometry's (see the module doc).
     pub velocity_prior: bool,
-    /// Dynamic Covariance Scaling of the loop closures (Agarwal et al.
-    /// 2013; [`crate::slam::posegraph`]): Φ, or 0 for plain least squares.
-    pub dcs_phi: f64,
-    /// Whether DCS also weighs the optimisations that accept closures (else
-    /// only the final one, started from the accepted graph).
-    pub dcs_incremental: bool,
-    /// Weigh each matched key edge by its own match's covariance (the
-    /// spread of the matcher's response, [`crate::slam::match_covariance`])
-    /// instead of `key_sigma_m` / `key_sigma_rad`.
-    pub key_covariance: bool,
-    /// The same for loop closures (instead of `loops.sigma_m` /
-    /// `loops.sigma_rad`).
-    pub loop_covariance: bool,
-    /// With `key_covariance`: add `key_sigma_m` / `key_sigma_rad` to the
-    /// match's covariance (independent errors add): the local map the key
-    /// was matched against has its own error, which the response cannot see.
-    pub key_covariance_plus_sigma: bool,
-    /// With `key_covariance`: take only the positional block from the
-    /// response and keep `key_sigma_rad` for the heading.
-    pub key_covariance_position_only: bool,
-    /// Where the response is sampled for those covariances.
-    pub response: ResponseWindow,
-    /// Scan-to-scan edges from each new key to this many keys before the
-    /// previous one (Karto's chain of recent scans; 0: off).
-    pub chain_keys: usize,
-    /// Least score of such a scan-to-scan match.
-    pub chain_min_score: f64,
-    /// Closure candidates: the nearest key of up to this many earlier
-    /// visits to the place ([`crate::slam::loop_closure::find_closure_among`]).
-    pub loop_visits: usize,
     /// Refuse a closure whose match lies on the edge of the closure search
     /// window (the best pose inside the window is then not a peak of the
     /// response: the true one may lie outside, as for the local match).
     pub loop_edge_reject: bool,
-    /// Refuse a closure whose match leaves the new key pinned by fewer than
-    /// this many points' worth of constraint in its weakest direction, as
-    /// a point-to-line fit onto the visit's scans at the matched pose sees
-    /// it ([`crate::slam::loop_closure::closure_fit`]; 0: off). A corridor pins a scan only across
-    /// itself, and a closure there can slide along it by metres.
-    pub loop_min_weak: f64,
     /// With a closure window that grows with the path
     /// (`loops.window_per_m` > 0): the grown window is searched on one try
     /// in this many (tries are `loop_every` keys apart), and on every try
@@ -239,8 +201,6 @@ pub struct LogSlamConfig {
     /// ([`crate::slam::loop_closure::loosened_along_weak`]; 0 or 1: one σ for
     /// all). A corridor's closure is right across it and unsure along it.
     pub loop_loosen_ratio: f64,
-    /// The closing refinement after the replay ([`super::refine`]).
-    pub refine: RefineConfig,
     /// Square walls' heading prior after the replay ([`crate::slam::manhattan`];
     /// `None`: off). On: a building whose walls are not square gets no
     /// prior.
@@ -284,26 +244,10 @@ impl Default for LogSlamConfig {
             key_sigma_m: 0.1,
             key_sigma_rad: 0.5f64.to_radians(),
             velocity_prior: true,
-            dcs_phi: 0.0,
-            dcs_incremental: false,
-            key_covariance: false,
-            loop_covariance: false,
-            key_covariance_plus_sigma: false,
-            key_covariance_position_only: false,
-            response: ResponseWindow {
-                half_m: 0.3,
-                half_rad: 3f64.to_radians(),
-                drop: 0.1,
-            },
-            chain_keys: 0,
-            chain_min_score: 0.5,
-            loop_visits: 1,
             loop_edge_reject: true,
-            loop_min_weak: 0.0,
             grown_every: 4,
             far_min_score: 0.7,
             loop_loosen_ratio: 10.0,
-            refine: RefineConfig::default(),
             manhattan: Some(ManhattanConfig::for_logs()),
         }
     }
@@ -344,17 +288,11 @@ pub struct LogSlamStats {
     pub closures_tried: usize,
     pub closures_found: usize,
     pub closures_rejected: usize,
-    /// Scan-to-scan edges to earlier keys (`chain_keys`).
-    pub chain_edges: usize,
     /// Closures refused for lying on the search window's edge.
     pub closures_on_edge: usize,
     /// Closures refused for moving their key beyond the fixed window with
     /// a score under `far_min_score`.
     pub closures_far_weak: usize,
-    /// Closures refused as not pinned in every direction (`loop_min_weak`).
-    pub closures_degenerate: usize,
-    /// Links the closing refinement added ([`super::refine`]).
-    pub refine_links: usize,
     /// Keys given a square walls' heading prior ([`crate::slam::manhattan`]).
     pub square_keys: usize,
 }
@@ -376,8 +314,6 @@ pub struct LogSlam {
     unmatched_since_key: bool,
     /// Whether each key's scan matched only weakly (`weak_match_score`).
     weak_keys: Vec<bool>,
-    /// The covariance of the match that made the next key (world frame).
-    key_cov: Option<[[f64; 3]; 3]>,
     pending: Vec<Closure>,
     /// The grown closure window is searched on every try up to this key:
     /// a try there found a match beyond the fixed window (`grown_every`).
@@ -454,7 +390,6 @@ impl LogSlam {
             odometry_stale: false,
             unmatched_since_key: false,
             weak_keys: Vec::new(),
-            key_cov: None,
             pending: Vec::new(),
             grow_until: 0,
             closures: Vec::new(),
@@ -491,24 +426,6 @@ impl LogSlam {
         let is_key = rel.position().length() >= self.config.key_distance_m
             || rel.theta.abs() >= self.config.key_angle_rad;
         if is_key {
-            self.key_cov = match (&found, &self.local) {
-                (Some(_), Some(field)) if self.config.key_covariance => {
-                    response_covariance(field, &points, &pose, &self.config.response).map(
-                        |mut c| {
-                            if self.config.key_covariance_plus_sigma {
-                                c[0][0] += self.config.key_sigma_m.powi(2);
-                                c[1][1] += self.config.key_sigma_m.powi(2);
-                                c[2][2] += self.config.key_sigma_rad.powi(2);
-                            }
-                            if self.config.key_covariance_position_only {
-                                c[2][2] = self.config.key_sigma_rad.powi(2);
-                            }
-                            c
-                        },
-                    )
-                }
-                _ => None,
-            };
             let weak = found
                 .as_ref()
                 .is_some_and(|m| m.score < self.config.min_match_score);
@@ -582,18 +499,7 @@ impl LogSlam {
             } else {
                 (self.config.key_sigma_m, self.config.key_sigma_rad)
             };
-            let mut edge = Edge::new(p, id, z, sm, sr);
-            let info = self
-                .key_cov
-                .take()
-                .and_then(|c| edge_information(&c, pose.theta));
-            if let (Some(info), false) = (info, self.unmatched_since_key) {
-                edge.information = info;
-            }
-            self.graph.edges.push(edge);
-            if !self.unmatched_since_key {
-                self.chain_edges(id, &points);
-            }
+            self.graph.edges.push(Edge::new(p, id, z, sm, sr));
         }
         self.unmatched_since_key = false;
         self.key_points.push(points);
@@ -611,31 +517,6 @@ impl LogSlam {
             self.try_close(id);
         }
         self.rebuild_local();
-    }
-
-    /// Scan-to-scan edges from key `id` (its scan `points`) to the
-    /// `chain_keys` keys before the previous one: the new scan matched
-    /// against each old key's scan alone, in the narrow window around the
-    /// new key's estimate.
-    fn chain_edges(&mut self, id: usize, points: &[DVec2]) {
-        let cfg = &self.config;
-        let from = id.saturating_sub(cfg.chain_keys + 1);
-        let pose = self.graph.nodes[id];
-        for j in from..id.saturating_sub(1) {
-            let f = self.graph.nodes[j].frame();
-            let world: Vec<DVec2> = self.key_points[j].iter().map(|&p| f.to_parent(p)).collect();
-            let field = field_from_points(&world, cfg.resolution_m, 4, cfg.narrow.linear_m + 1.0);
-            let Some(m) = match_scan(&field, points, &pose, &cfg.narrow) else {
-                continue;
-            };
-            if m.score < cfg.chain_min_score {
-                continue;
-            }
-            let z = self.graph.nodes[j].between(&m.pose);
-            let edge = Edge::new(j, id, z, cfg.key_sigma_m, cfg.key_sigma_rad);
-            self.graph.edges.push(edge);
-            self.stats.chain_edges += 1;
-        }
     }
 
     /// Rasterises the last `local_keys` key scans into the local map, but
@@ -666,14 +547,12 @@ impl LogSlam {
     fn try_close(&mut self, id: usize) {
         self.stats.closures_tried += 1;
         let links = self.grow_window(id).then(|| self.links());
-        let Some(found) = find_closure_among(
+        let Some(mut found) = find_closure_among(
             &self.graph.nodes,
             &self.key_points,
             id,
             self.config.resolution_m,
             &self.config.loops,
-            Some(&self.config.response).filter(|_| self.config.loop_covariance),
-            self.config.loop_visits,
             links.as_deref(),
         ) else {
             return;
@@ -690,23 +569,10 @@ impl LogSlam {
             self.stats.closures_on_edge += 1;
             return;
         }
-        // How the match pins the new key, when a setting asks (one fit).
-        let loosen = self.config.loop_loosen_ratio > 1.0 && !self.config.loop_covariance;
-        let fit = (loosen || self.config.loop_min_weak > 0.0).then(|| {
-            closure_fit(
-                &self.graph.nodes,
-                &self.key_points,
-                &found,
-                &self.config.loops,
-            )
-        });
-        if fit.is_some_and(|f| f.weak < self.config.loop_min_weak) {
-            self.stats.closures_degenerate += 1;
-            return;
-        }
-        let mut found = found;
-        if let Some(fit) = fit.filter(|_| loosen) {
+        // Loose along the direction the match pins least (a corridor's).
+        if self.config.loop_loosen_ratio > 1.0 {
             let loops = &self.config.loops;
+            let fit = closure_fit(&self.graph.nodes, &self.key_points, &found, loops);
             if let Some(info) = loosened_along_weak(
                 &self.graph.nodes,
                 &found,
@@ -781,11 +647,10 @@ impl LogSlam {
     /// Adds confirmed closures, optimises, and undoes it all if a closure
     /// stays badly unsatisfied.
     fn accept(&mut self, closures: Vec<Closure>) {
-        let phi = self.dcs().filter(|_| self.config.dcs_incremental);
         let edges: Vec<Edge> = closures.iter().map(|c| c.edge.clone()).collect();
         if !self
             .graph
-            .try_closures(&edges, 10, phi, self.config.max_closure_chi2)
+            .try_closures(&edges, 10, None, self.config.max_closure_chi2)
         {
             self.stats.closures_rejected += closures.len();
             return;
@@ -810,15 +675,7 @@ impl LogSlam {
     /// accepted closure; this settles it).
     pub fn finish(&mut self) -> Result<(), String> {
         if !self.closures.is_empty() {
-            self.graph.optimise_robust(20, self.dcs())?;
-            let cfg = &self.config;
-            self.stats.refine_links = refine(
-                &mut self.graph,
-                &self.key_points,
-                cfg.resolution_m,
-                &cfg.loops,
-                &cfg.refine,
-            )?;
+            self.graph.optimise(20)?;
         }
         if let Some(m) = &self.config.manhattan {
             let directions: Vec<Option<f64>> = self
@@ -826,17 +683,11 @@ impl LogSlam {
                 .iter()
                 .map(|p| scan_direction(p, m).map(|(d, _)| d))
                 .collect();
-            let dcs = self.dcs();
             self.stats.square_keys = settle_priors(&mut self.graph, &directions, m, |g| {
-                g.optimise_robust(20, dcs).map(|_| ())
+                g.optimise(20).map(|_| ())
             })?;
         }
         Ok(())
-    }
-
-    /// Φ of Dynamic Covariance Scaling, if on.
-    fn dcs(&self) -> Option<f64> {
-        Some(self.config.dcs_phi).filter(|&p| p > 0.0)
     }
 
     /// The current estimate of scan `k` (position in [`LogSlam::scans`]).

@@ -121,16 +121,9 @@ pub fn refine(
                 if linked.contains(&(centre, i)) {
                     continue;
                 }
-                let Some(c) = match_visit(
-                    &nodes,
-                    key_points,
-                    i,
-                    centre,
-                    0.0,
-                    resolution_m,
-                    &search,
-                    None,
-                ) else {
+                let Some(c) =
+                    match_visit(&nodes, key_points, i, centre, 0.0, resolution_m, &search)
+                else {
                     continue;
                 };
                 let edge_m = 2.0 * resolution_m;
