@@ -15,12 +15,9 @@
 //! 1. **Candidates**: key scans older than the local map (at least
 //!    `min_key_gap` keys back) whose estimated position lies within
 //!    `search_radius_m` of the new key scan's. The nearest one is the centre
-//!    of the candidate region ([`find_closure`]). A place passed several
-//!    times offers one candidate region per pass: [`find_closure_among`]
-//!    splits the candidates into visits (runs of consecutive keys), takes
-//!    each visit's nearest key as a centre, and keeps the best-scoring match
-//!    of the nearest few — an older pass may see the walls the nearest one
-//!    missed.
+//!    of the candidate region, the visit the new scan is matched against
+//!    ([`find_closure`]; [`find_closure_among`] with a reach that grows with
+//!    the path, [`closure_window`]).
 //! 2. **Match**: the key scans around that centre (`submap_half` either side,
 //!    consecutive, so they are consistent among themselves) are rasterised
 //!    into Olson's tables ([`super::multires`]), and the new scan is searched
@@ -128,7 +125,7 @@ pub fn find_closure_among(
         _ => Vec::new(),
     };
     let path = |j: usize| paths.get(j).copied().unwrap_or(0.0);
-    let centre = *visit_centres(nodes, i, cfg, &paths).first()?;
+    let centre = nearest_candidate(nodes, i, cfg, &paths)?;
     match_visit(
         nodes,
         key_points,
@@ -140,40 +137,20 @@ pub fn find_closure_among(
     )
 }
 
-/// The nearest key of each visit to key `i`'s place (see
-/// [`find_closure_among`]), nearest first. `paths[j]` is the path from key
-/// `j` to key `i` ([`paths_to`]; empty: the reach does not grow).
-pub(super) fn visit_centres(
-    nodes: &[Pose2],
-    i: usize,
-    cfg: &LoopConfig,
-    paths: &[f64],
-) -> Vec<usize> {
-    if i < cfg.min_key_gap {
-        return Vec::new();
-    }
+/// The candidate key nearest key `i`'s estimate, the centre of the
+/// visit a closure is matched against: at least `min_key_gap` keys back,
+/// within `search_radius_m` of it, a radius grown with the path `paths[j]`
+/// from key `j` ([`paths_to`]; empty: the radius does not grow). Of keys
+/// equally near, the earliest.
+fn nearest_candidate(nodes: &[Pose2], i: usize, cfg: &LoopConfig, paths: &[f64]) -> Option<usize> {
+    let newest_old = i.checked_sub(cfg.min_key_gap)?;
     let here = nodes[i].position();
     let widening = |j: usize| paths.get(j).map_or(0.0, |&p| widening_m(cfg, p));
-    let near: Vec<(usize, f64)> = (0..=i - cfg.min_key_gap)
+    (0..=newest_old)
         .map(|j| (j, nodes[j].position().distance(here)))
         .filter(|&(j, d)| d <= cfg.search_radius_m + widening(j))
-        .collect();
-    let mut centres: Vec<(usize, f64)> = Vec::new();
-    let mut last: Option<usize> = None;
-    for &(j, d) in &near {
-        let new_visit = last.is_none_or(|l| j - l > 2 * cfg.submap_half);
-        match centres.last_mut() {
-            Some(c) if !new_visit => {
-                if d < c.1 {
-                    *c = (j, d);
-                }
-            }
-            _ => centres.push((j, d)),
-        }
-        last = Some(j);
-    }
-    centres.sort_by(|a, b| a.1.total_cmp(&b.1));
-    centres.into_iter().map(|c| c.0).collect()
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(j, _)| j)
 }
 
 /// The shortest path (m) from each key `j ≤ i` to key `i` along the chain
@@ -282,7 +259,7 @@ pub fn closure_window(cfg: &LoopConfig, path_m: f64) -> Window {
 
 /// The keys of the visit around `centre` that key `i` is matched against:
 /// `submap_half` either side, none of the last `min_key_gap` before `i`.
-pub(super) fn visit_keys(i: usize, centre: usize, cfg: &LoopConfig) -> RangeInclusive<usize> {
+fn visit_keys(i: usize, centre: usize, cfg: &LoopConfig) -> RangeInclusive<usize> {
     let lo = centre.saturating_sub(cfg.submap_half);
     let hi = (centre + cfg.submap_half).min(i.saturating_sub(cfg.min_key_gap));
     lo..=hi
@@ -309,7 +286,7 @@ pub(super) fn on_window_edge(
 
 /// Matches key `i` against the key scans around `centre`, `path_m` along
 /// the tour from it ([`closure_window`]).
-pub(super) fn match_visit(
+fn match_visit(
     nodes: &[Pose2],
     key_points: &[Vec<DVec2>],
     i: usize,
@@ -375,8 +352,7 @@ pub(super) fn match_visit(
 pub const RIVAL_EXCLUDE_M: f64 = 0.5;
 
 /// Neighbourhood of a thinned key scan's point for its normal, and the
-/// association radius and Huber threshold of [`closure_fit`] (m):
-/// those of the closing refinement ([`super::logs::refine`]).
+/// association radius and Huber threshold of [`closure_fit`] (m).
 const PIN_NORMAL_RADIUS_M: f64 = 0.35;
 const PIN_RADIUS_M: f64 = 0.2;
 const PIN_HUBER_M: f64 = 0.02;
