@@ -117,7 +117,7 @@ pub fn drift_seed() -> u64 {
 /// short, as the raw MIT CSAIL log's wheels do against GMapping's poses).
 /// A method that takes the odometry's word along a corridor gains on the
 /// default model, whose distance is unbiased, and should be checked with it
-/// (BENCHMARKS.md, issue 21, session 38).
+/// (BENCHMARKS.md).
 pub fn drift_model() -> DriftModel {
     let scale: f64 = std::env::var("SLAMLAB_DRIFT_SCALE")
         .map(|s| s.parse().expect("SLAMLAB_DRIFT_SCALE: a number"))

@@ -25,7 +25,7 @@
 //!    for the drift since, exact thanks to branch and bound.
 //! 3. **Accept**: only a match whose mean field value reaches `min_score`
 //!    (most points on mapped walls) becomes an edge; the driver
-//!    ([`super::logslam`]) then optimises the graph and keeps the edge only if
+//!    ([`super::logs::logslam`]) then optimises the graph and keeps the edge only if
 //!    the result is consistent (see there).
 
 use super::degeneracy::scan_normals_within;
@@ -223,33 +223,27 @@ fn widening_m(cfg: &LoopConfig, path_m: f64) -> f64 {
 /// `window_per_m` for every metre of that path, up to `max_window_m`.
 ///
 /// The drift a revisit must undo grows with the path since the place was
-/// last seen: on the logs of `../shared/data` it never passed 0.36 m, but
-/// on a convention centre's hall (the Acapulco log, 812 m of path) it
-/// reached 3–8 m, far outside a fixed 1.5 m window, and the loops stayed
-/// open. Karto sizes its loop search by the covariance accumulated along
-/// the chain; a reach proportional to the path is that bound for drift
-/// that grows with distance. The path is the shortest through the
-/// closures accepted so far (session 33): a place already tied to the
-/// newer part of the tour has had its drift taken out, and the search
-/// there stays near the fixed window. Against the path the estimate
-/// travelled, that takes the five shared logs' replays from 4× to about
-/// 1.5× the time with the reach fixed, with the same closures on the
-/// halls; an outdoor campus, with few closures, still takes 9×.
+/// last seen: on the shared logs it stays within a few decimetres, but on
+/// a convention centre's hall (the Acapulco log, 812 m of path) it reaches
+/// metres, far outside a fixed 1.5 m window. Karto sizes its loop search
+/// by the covariance accumulated along the chain; a reach proportional to
+/// the path is that bound for drift that grows with distance. The path is
+/// the shortest through the closures accepted so far: a place already tied
+/// to the newer part of the tour has had its drift taken out, and the
+/// search there stays near the fixed window, which keeps the replays' time
+/// near that of a fixed reach.
 ///
-/// [`match_visit`] searches the fixed window first and the grown one only
-/// where the fixed one finds nothing good enough, and a match found there
-/// must have no rival: no pose more than [`RIVAL_EXCLUDE_M`] from it may
-/// score `unique_ratio` of its score (a corridor's doors repeat, and a
-/// window that reaches several metres along one finds the wrong door as
-/// readily as the right one). `LoopConfig::default` keeps it off (0 per
+/// The search takes the fixed window first and the grown one only where
+/// the fixed one finds nothing good enough, and a match found there must
+/// have no rival: no pose more than [`RIVAL_EXCLUDE_M`] from it may score
+/// `unique_ratio` of its score (a corridor's doors repeat, and a window
+/// that reaches several metres along one finds the wrong door as readily
+/// as the right one). `LoopConfig::default` keeps the growth off (0 per
 /// metre), as the simulated robots' back end does. A replayed log's driver
-/// ([`super::logslam`]) turns it on (0.03 per metre, 16 m at most) and
-/// grows it on one try in four only (`grown_every`; `links: None` to
-/// [`find_closure_among`] on the other tries). Grown on every try it made
-/// one of the tuned logs worse by a centimetre and the replays 4–10×
-/// slower; one try in four keeps most of the halls' gains at a third of
-/// that cost and leaves the five shared logs as they were (BENCHMARKS.md,
-/// issue 21, sessions 32–34).
+/// ([`super::logs::logslam`]) turns it on (0.03 per metre, 16 m at most)
+/// and grows it on one try in four only (`grown_every`; `links: None` to
+/// [`find_closure_among`] on the other tries): grown on every try, the
+/// replays are several times slower for little more (BENCHMARKS.md).
 pub fn closure_window(cfg: &LoopConfig, path_m: f64) -> Window {
     Window {
         linear_m: cfg.window.linear_m + widening_m(cfg, path_m),

@@ -1,124 +1,111 @@
 //! # SLAM for real laser logs: scan-to-map matching, a pose graph, loop closures
 //!
 //! The driver that replays a CARMEN log ([`crate::formats::carmen`]) in file order,
-//! in the manner of Karto / slam_toolbox (Konolige et al., IROS 2010) and
-//! Cartographer (Hess et al., ICRA 2016):
+//! in the manner of Karto / slam_toolbox (Konolige et al., "Efficient sparse
+//! pose adjustment for 2D mapping", IROS 2010) and Cartographer (Hess et al.,
+//! "Real-time loop closure in 2D LIDAR SLAM", ICRA 2016):
 //!
 //! 1. **Predict** each scan's pose from the previous one and the odometry
 //!    increment between them (`x̂_t = x_{t−1} ⊕ (u_{t−1}⁻¹ ⊕ u_t)`).
 //! 2. **Match** the scan against the local map — the points of the last
 //!    `local_keys` key scans at their current estimates — with Olson's
 //!    multi-resolution correlative search and a Gauss–Newton refinement
-//!    ([`crate::slam::multires`]). A narrow window first; if its best pose lies
-//!    on the window's edge or scores poorly, a wide window (real wheel
-//!    odometry slips: the raw MIT CSAIL log's heading jumps by 10–30°).
-//!    The wide window turns far (35°) but reaches only 0.6 m: in a corridor
+//!    ([`crate::slam::multires`]). A narrow window first; if its best pose
+//!    lies on the window's edge or scores poorly, a wide window: real wheel
+//!    odometry slips, and the raw MIT CSAIL log's heading jumps by 10–30°.
+//!    The wide window turns far (35°) but reaches only 0.6 m. In a corridor
 //!    the response is nearly flat along it, and a window that reaches a
 //!    metre lets a stretch further along that happens to score a little
-//!    better win — on ACES with another drift seed (3) two key edges slid
-//!    0.7 and 1.0 m along corridors that way, and the relation error of the
-//!    whole log went from 0.25 to 0.41 m (BENCHMARKS.md, session 18). The
-//!    other logs' figures are the same with either reach (the raw log's
-//!    odometry slips in heading; four drift seeds on the corrected logs).
+//!    better win, so key edges slide along corridors.
+//!
 //!    A scan whose best match still scores poorly keeps the prediction,
 //!    unless the narrow window's match lies inside that window and scores
-//!    at least `weak_match_score` (0.2, against `min_match_score`'s 0.35):
-//!    a poor fit close to where the odometry put the scan — a hall whose
+//!    at least `weak_match_score` (0.2, against `min_match_score`'s 0.35).
+//!    A poor fit close to where the odometry put the scan (a hall whose
 //!    far walls lie beyond the 20 m match range, a turn that shows new
-//!    ground — is still a better pose than the odometry alone, whose error
+//!    ground) is still a better pose than the odometry alone, whose error
 //!    the scans after it would otherwise inherit. Such a scan fits poorly
 //!    for a reason (people around the robot, ground no key has seen), so it
 //!    gives the local map nothing to match the next scans against: once
-//!    the next key follows it, it leaves the local map (it stays a node of
-//!    the graph, with its points for loop closures). Taken into the local
-//!    map, six weak matches on ACES, each within 0.11 m of the prediction,
-//!    made later keys slide along its corridors and cost it a closed loop.
-//!    Over fourteen logs and four drift seeds the mean relation error fell
-//!    0.272 → 0.232 m (a convention centre 0.42 → 0.32 m, a campus
-//!    0.86 → 0.46 m, CSAIL corrected 0.224 → 0.205 m, ACES as before;
-//!    BENCHMARKS.md, session 37).
+//!    the next key follows it, it leaves the local map. It stays a node of
+//!    the graph, with its points for loop closures. Kept in the local map,
+//!    weak matches make the keys after them slide along corridors.
+//!
 //!    Wheel odometry can also arrive late: the raw MIT CSAIL log's odometry
 //!    stands still for a few scans of a fast turn, then jumps by the whole
 //!    turn (85° in one step), which the matcher had already followed. So
-//!    after a scan whose odometry did not change, when
-//!    the motion the matcher saw last (a constant-velocity prediction, as
-//!    Cartographer's pose extrapolator makes) disagrees with the odometry's
-//!    by more than the narrow window, the scan is also matched around that
-//!    prediction, and the better-scoring match is kept.
+//!    after a scan whose odometry did not change, when the motion the
+//!    matcher saw last (a constant-velocity prediction, as Cartographer's
+//!    pose extrapolator makes) disagrees with the odometry's by more than
+//!    the narrow window, the scan is also matched around that prediction,
+//!    and the better-scoring match is kept (`velocity_prior`).
 //! 3. **Key scans** (every `key_distance_m` or `key_angle_rad` of motion)
-//!    become nodes of the pose graph ([`crate::slam::posegraph`]), linked to the
-//!    previous key by the matched relative pose (or, where no match held,
-//!    by odometry with a looser covariance). The matched edge's covariance
-//!    is one σ for all (`key_sigma_m`, `key_sigma_rad`), or with
-//!    `key_covariance` the match's own, from the spread of the matcher's
-//!    response ([`crate::slam::match_covariance`]; measured in BENCHMARKS.md,
-//!    off by default). Other scans are stored relative
-//!    to their key, so they follow it when the graph moves.
-//! 4. **Loop closures** ([`crate::slam::loop_closure`]): every `loop_every` keys
-//!    the new key is matched against older keys near its estimate (with
-//!    `loop_visits` > 1, against the nearest key of each of that many
-//!    earlier passes through the place, the best match kept). A closure
-//!    whose match lies on the edge of its search window is refused
-//!    (`loop_edge_reject`), as the local match widens its window in that
-//!    case: the best pose inside a window is only a peak of the response if
-//!    it lies inside, and a match pressed against the window's border is
-//!    often a wrong place that merely fits better than the right one within
-//!    reach (on the raw MIT CSAIL log the four closures so refused include
-//!    the two that slid 1.8–1.9 m along a corridor; its relation error went
-//!    from 0.43 to 0.22 m, BENCHMARKS.md). With `loop_min_weak` > 0 a
-//!    closure is also refused when the new key's points, laid at the match
-//!    onto the visit's scans, pin it in their weakest direction by fewer
-//!    than that many points' worth ([`crate::slam::loop_closure::closure_fit`]):
-//!    a corridor whose ends are out of sight pins nothing along it. Off by
-//!    default: it removes the corridor slides that make some settings'
-//!    figures jump, but costs the corridor-rich logs right closures too
-//!    (BENCHMARKS.md, session 29). What is kept of that measure: an
-//!    accepted closure's edge is as loose along the match's weakest
-//!    direction as the information there is weaker than across it, up to
-//!    `loop_loosen_ratio` (10) times the variance; a corridor's closure
-//!    then holds the corridor's two walls without pinning where along it
-//!    the key lies (relation errors lower on all five logs on average over
-//!    four drift seeds, BENCHMARKS.md, session 29). The search window
-//!    reaches ±1.5 m, and on one try in `grown_every` (4) further, by
-//!    0.03 m for every metre of the shortest path from the old key through
-//!    the chain and the closures accepted so far, up to 16 m
-//!    ([`crate::slam::loop_closure::closure_window`]): in a convention hall or
-//!    around a campus the drift a revisit must undo reaches metres. (Up
-//!    to 8 m, a 250 m campus left 52 of its 144 revisits out of reach,
-//!    needing 14–21 m; at 16 m, 11. The relations its scans fix between
-//!    revisits ([`crate::slam::eval::verified`]) went from 0.235 to 0.040 m off, an
-//!    MIT corridor's from 0.200 to 0.038 m, every other log as before;
-//!    24 and 32 m gave the same figures. BENCHMARKS.md, session 40.) A
-//!    match found only in the grown reach must score `far_min_score` and
-//!    have no rival near as good; after one, every try searches the grown
-//!    window for `confirm_keys` keys so that a second can confirm it.
-//! 5. **Chain of recent keys** (Karto's scan-to-scan links, off unless
-//!    `chain_keys` > 0): the new key's scan is also matched against each of
-//!    the `chain_keys` keys before the previous one, alone, and every match
-//!    scoring `chain_min_score` becomes a key edge. Those redundant
-//!    stretches stiffen the front end where a closure pulls on it.
-//! 6. **Consistency**: a single match can be wrong (two alike corridors).
+//!    become nodes of the pose graph ([`crate::slam::posegraph`]), linked to
+//!    the previous key by the matched relative pose with one σ for all
+//!    (`key_sigma_m`, `key_sigma_rad`), or, where no match held, by odometry
+//!    with a looser covariance. Other scans are stored relative to their
+//!    key, so they follow it when the graph moves. The spread of the
+//!    matcher's response ([`crate::slam::match_covariance`]) could weigh
+//!    each edge by its own match instead, but on these logs which closures
+//!    are found decides the result, not the key edges' weights
+//!    (BENCHMARKS.md).
+//! 4. **Loop closures** ([`crate::slam::loop_closure`]): every `loop_every`
+//!    keys the new key is matched against the older keys of the nearest
+//!    earlier pass near its estimate.
+//!    - A closure whose match lies on the edge of its search window is
+//!      refused (`loop_edge_reject`), as the local match widens its window
+//!      in that case: the best pose inside a window is only a peak of the
+//!      response if it lies inside, and a match pressed against the
+//!      window's border is often a wrong place that merely fits better than
+//!      the right one within reach (on the raw MIT CSAIL log, closures that
+//!      slid nearly two metres along a corridor).
+//!    - An accepted closure's edge is as loose along the match's weakest
+//!      direction as the point-to-line information there is weaker than
+//!      across it ([`crate::slam::loop_closure::closure_fit`]), up to
+//!      `loop_loosen_ratio` (10) times the variance: a corridor whose ends
+//!      are out of sight pins a closure only across itself, so its closure
+//!      holds the corridor's two walls without pinning where along it the
+//!      key lies. Refusing such closures outright would throw away the
+//!      right half of what they say, and the corridor-rich logs need them.
+//!    - The search window reaches ±1.5 m, and on one try in `grown_every`
+//!      (4) further, by 0.03 m for every metre of the shortest path from the
+//!      old key through the chain and the closures accepted so far, up to
+//!      16 m ([`crate::slam::loop_closure::closure_window`]): in a
+//!      convention hall or around a campus the drift a revisit must undo
+//!      reaches metres, and 16 m covers all but a few revisits of a 250 m
+//!      campus tour. A match found only in the grown reach must score
+//!      `far_min_score` and have no rival near as good; after one, every
+//!      try searches the grown window for `confirm_keys` keys so that a
+//!      second can confirm it. Growing the window on one try in four keeps
+//!      the long revisits in reach without paying the wide search on every
+//!      key.
+//! 5. **Consistency**: a single match can be wrong (two alike corridors).
 //!    Following Olson's pairwise consistency idea ("Recognizing places using
 //!    spectrally clustered local matches", RAS 2009), a closure is only
 //!    accepted once a second closure found within `confirm_keys` keys
 //!    agrees with it: the cycle *old₁ → new₁ → new₂ → old₂ → old₁*, made of
 //!    the two closures and the graph's current relative poses along the two
 //!    stretches (each locally accurate), must compose to nearly the
-//!    identity. Accepted closures go into the graph, which is optimised; an
-//!    optimisation that leaves a closure badly unsatisfied (χ² over
-//!    `max_closure_chi2`) is undone. (Re-checking every accepted closure's
-//!    χ² after later optimisations was tried and finds nothing to drop:
-//!    with key edges of σ 0.1 m the graph absorbs each closure, wrong ones
-//!    included, to χ² < 1.)
+//!    identity. Accepted closures go into the graph, which is optimised by
+//!    plain least squares; an optimisation that leaves a closure badly
+//!    unsatisfied (χ² over `max_closure_chi2`) is undone. Once accepted, a
+//!    closure stays: with key edges of σ 0.1 m the graph absorbs each one
+//!    to χ² < 1, so a later χ² test cannot tell a wrong one, and a robust
+//!    kernel (Dynamic Covariance Scaling) has no outlier to weigh down.
+//! 6. **Square walls** ([`crate::slam::manhattan`]), once the log is
+//!    replayed and the graph optimised: between closures the chain's
+//!    heading wanders by tenths of a degree, and most buildings are built
+//!    square. Each key whose scan's walls run in two directions at right
+//!    angles gets a loose heading prior towards the building's direction,
+//!    measured from the keys themselves, in rounds that let a stretch
+//!    hanging on odometry turn back in; a building that is not square gets
+//!    none.
 //!
-//! 7. **Closing refinement** ([`super::refine`], off unless
-//!    `refine.rounds` > 0): once the log is replayed, every key is linked
-//!    to every earlier visit to its place (Karto's near chains), each link
-//!    refined by point-to-line ICP, and the graph optimised again. It makes
-//!    revisits agree better with their own scans (a pairwise ICP moves them
-//!    6–40 % less) but leaves the relation errors against the reference
-//!    where they were, worse by 1.5 cm on CSAIL corrected (BENCHMARKS.md,
-//!    session 24), so it is not on by default.
+//! Karto's scan-to-scan chain of recent keys, closures against several
+//! earlier passes, each edge weighted by its match's response, and a
+//! closing pass that links every revisit after the replay were all tried
+//! and are not part of the driver: none improved the logs as a whole
+//! (BENCHMARKS.md).
 //!
 //! The poses are in the log's odometry frame: the first scan's pose is its
 //! odometry pose, and the graph's first node stays fixed there.
@@ -171,9 +158,10 @@ pub struct LogSlamConfig {
     /// Standard deviations of a matched key-to-key edge (m, rad). The
     /// matcher pins a heading better than a position (a 20 m beam moves a
     /// cell for a quarter of a degree): its key edges measured against the
-    /// reference poses (example `log_closures`) err by 0.015–0.043 m and
-    /// 0.32–0.64° on average. 0.05 m / 1° made a turn the cheaper way to
-    /// absorb a loop's error, so the graph bent headings.
+    /// reference poses (example `log_closures`) err by a few centimetres
+    /// and about half a degree. A tighter position with a looser heading
+    /// would make a turn the cheaper way to absorb a loop's error, and the
+    /// graph would bend headings.
     pub key_sigma_m: f64,
     pub key_sigma_rad: f64,
     /// Also match around the constant-velocity prediction when it
