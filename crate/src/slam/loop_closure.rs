@@ -15,12 +15,9 @@
 //! 1. **Candidates**: key scans older than the local map (at least
 //!    `min_key_gap` keys back) whose estimated position lies within
 //!    `search_radius_m` of the new key scan's. The nearest one is the centre
-//!    of the candidate region ([`find_closure`]). A place passed several
-//!    times offers one candidate region per pass: [`find_closure_among`]
-//!    splits the candidates into visits (runs of consecutive keys), takes
-//!    each visit's nearest key as a centre, and keeps the best-scoring match
-//!    of the nearest few — an older pass may see the walls the nearest one
-//!    missed.
+//!    of the candidate region, the visit the new scan is matched against
+//!    ([`find_closure`]; [`find_closure_among`] with a reach that grows with
+//!    the path, [`closure_window`]).
 //! 2. **Match**: the key scans around that centre (`submap_half` either side,
 //!    consecutive, so they are consistent among themselves) are rasterised
 //!    into Olson's tables ([`super::multires`]), and the new scan is searched
@@ -28,12 +25,12 @@
 //!    for the drift since, exact thanks to branch and bound.
 //! 3. **Accept**: only a match whose mean field value reaches `min_score`
 //!    (most points on mapped walls) becomes an edge; the driver
-//!    ([`super::logslam`]) then optimises the graph and keeps the edge only if
+//!    ([`super::logs::logslam`]) then optimises the graph and keeps the edge only if
 //!    the result is consistent (see there).
 
 use super::degeneracy::scan_normals_within;
 use super::icp::{IcpFit, IcpTarget};
-use super::match_covariance::{edge_information, response_covariance, ResponseWindow};
+use super::match_covariance::edge_information;
 use super::multires::{field_covering, field_from_points, match_scan, rival_score, Window};
 use super::posegraph::Edge;
 use crate::geom::{wrap_angle, Pose2};
@@ -96,39 +93,30 @@ pub struct Closure {
 
 /// Looks for a closure of key `i` (pose `nodes[i]`, points `key_points[i]`
 /// in its robot frame) against the older keys of the nearest earlier pass
-/// through its place ([`find_closure_among`] with one visit). With `response`, the edge's
-/// information is the match's own ([`super::match_covariance`]) instead of
-/// `cfg.sigma_m` / `cfg.sigma_rad`.
+/// through its place, in the fixed window ([`find_closure_among`] without
+/// links). The edge's σ is `cfg.sigma_m` / `cfg.sigma_rad`.
 pub fn find_closure(
     nodes: &[Pose2],
     key_points: &[Vec<DVec2>],
     i: usize,
     resolution_m: f64,
     cfg: &LoopConfig,
-    response: Option<&ResponseWindow>,
 ) -> Option<Closure> {
-    find_closure_among(nodes, key_points, i, resolution_m, cfg, response, 1, None)
+    find_closure_among(nodes, key_points, i, resolution_m, cfg, None)
 }
 
-/// [`find_closure`] against up to `visits` earlier passes through the
-/// place, not only the nearest: the candidate keys within the radius are
-/// split into visits (runs of keys, a new one after a gap of more than
-/// `2 · submap_half` keys), each visit's nearest key is a centre, and the
-/// best-scoring match of the `visits` nearest centres is returned.
-/// `links` are the closures accepted so far (`(older key, newer key)`):
-/// with a window that grows with the path ([`closure_window`]), the path
-/// is the shortest through them ([`paths_to`]). `None` searches the fixed
-/// window only, whatever `cfg.window_per_m` says: the driver grows the
-/// window on some tries only.
-#[allow(clippy::too_many_arguments)]
+/// [`find_closure`] in a window that may grow with the path: `links` are
+/// the closures accepted so far (`(older key, newer key)`); with a window
+/// that grows with the path ([`closure_window`]), the path is the shortest
+/// through them ([`paths_to`]). `None` searches the fixed window only,
+/// whatever `cfg.window_per_m` says: the driver grows the window on some
+/// tries only.
 pub fn find_closure_among(
     nodes: &[Pose2],
     key_points: &[Vec<DVec2>],
     i: usize,
     resolution_m: f64,
     cfg: &LoopConfig,
-    response: Option<&ResponseWindow>,
-    visits: usize,
     links: Option<&[(usize, usize)]>,
 ) -> Option<Closure> {
     // The path from each key to key i, only when the reach grows with it.
@@ -137,58 +125,32 @@ pub fn find_closure_among(
         _ => Vec::new(),
     };
     let path = |j: usize| paths.get(j).copied().unwrap_or(0.0);
-    visit_centres(nodes, i, cfg, &paths)
-        .into_iter()
-        .take(visits.max(1))
-        .filter_map(|c| {
-            match_visit(
-                nodes,
-                key_points,
-                i,
-                c,
-                path(c),
-                resolution_m,
-                cfg,
-                response,
-            )
-        })
-        .max_by(|a, b| a.score.total_cmp(&b.score))
+    let centre = nearest_candidate(nodes, i, cfg, &paths)?;
+    match_visit(
+        nodes,
+        key_points,
+        i,
+        centre,
+        path(centre),
+        resolution_m,
+        cfg,
+    )
 }
 
-/// The nearest key of each visit to key `i`'s place (see
-/// [`find_closure_among`]), nearest first. `paths[j]` is the path from key
-/// `j` to key `i` ([`paths_to`]; empty: the reach does not grow).
-pub(super) fn visit_centres(
-    nodes: &[Pose2],
-    i: usize,
-    cfg: &LoopConfig,
-    paths: &[f64],
-) -> Vec<usize> {
-    if i < cfg.min_key_gap {
-        return Vec::new();
-    }
+/// The candidate key nearest key `i`'s estimate, the centre of the
+/// visit a closure is matched against: at least `min_key_gap` keys back,
+/// within `search_radius_m` of it, a radius grown with the path `paths[j]`
+/// from key `j` ([`paths_to`]; empty: the radius does not grow). Of keys
+/// equally near, the earliest.
+fn nearest_candidate(nodes: &[Pose2], i: usize, cfg: &LoopConfig, paths: &[f64]) -> Option<usize> {
+    let newest_old = i.checked_sub(cfg.min_key_gap)?;
     let here = nodes[i].position();
     let widening = |j: usize| paths.get(j).map_or(0.0, |&p| widening_m(cfg, p));
-    let near: Vec<(usize, f64)> = (0..=i - cfg.min_key_gap)
+    (0..=newest_old)
         .map(|j| (j, nodes[j].position().distance(here)))
         .filter(|&(j, d)| d <= cfg.search_radius_m + widening(j))
-        .collect();
-    let mut centres: Vec<(usize, f64)> = Vec::new();
-    let mut last: Option<usize> = None;
-    for &(j, d) in &near {
-        let new_visit = last.is_none_or(|l| j - l > 2 * cfg.submap_half);
-        match centres.last_mut() {
-            Some(c) if !new_visit => {
-                if d < c.1 {
-                    *c = (j, d);
-                }
-            }
-            _ => centres.push((j, d)),
-        }
-        last = Some(j);
-    }
-    centres.sort_by(|a, b| a.1.total_cmp(&b.1));
-    centres.into_iter().map(|c| c.0).collect()
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(j, _)| j)
 }
 
 /// The shortest path (m) from each key `j ≤ i` to key `i` along the chain
@@ -261,33 +223,27 @@ fn widening_m(cfg: &LoopConfig, path_m: f64) -> f64 {
 /// `window_per_m` for every metre of that path, up to `max_window_m`.
 ///
 /// The drift a revisit must undo grows with the path since the place was
-/// last seen: on the logs of `../shared/data` it never passed 0.36 m, but
-/// on a convention centre's hall (the Acapulco log, 812 m of path) it
-/// reached 3–8 m, far outside a fixed 1.5 m window, and the loops stayed
-/// open. Karto sizes its loop search by the covariance accumulated along
-/// the chain; a reach proportional to the path is that bound for drift
-/// that grows with distance. The path is the shortest through the
-/// closures accepted so far: a place already tied to the
-/// newer part of the tour has had its drift taken out, and the search
-/// there stays near the fixed window. Against the path the estimate
-/// travelled, that takes the five shared logs' replays from 4× to about
-/// 1.5× the time with the reach fixed, with the same closures on the
-/// halls; an outdoor campus, with few closures, still takes 9×.
+/// last seen: on the shared logs it stays within a few decimetres, but on
+/// a convention centre's hall (the Acapulco log, 812 m of path) it reaches
+/// metres, far outside a fixed 1.5 m window. Karto sizes its loop search
+/// by the covariance accumulated along the chain; a reach proportional to
+/// the path is that bound for drift that grows with distance. The path is
+/// the shortest through the closures accepted so far: a place already tied
+/// to the newer part of the tour has had its drift taken out, and the
+/// search there stays near the fixed window, which keeps the replays' time
+/// near that of a fixed reach.
 ///
-/// [`match_visit`] searches the fixed window first and the grown one only
-/// where the fixed one finds nothing good enough, and a match found there
-/// must have no rival: no pose more than [`RIVAL_EXCLUDE_M`] from it may
-/// score `unique_ratio` of its score (a corridor's doors repeat, and a
-/// window that reaches several metres along one finds the wrong door as
-/// readily as the right one). `LoopConfig::default` keeps it off (0 per
+/// The search takes the fixed window first and the grown one only where
+/// the fixed one finds nothing good enough, and a match found there must
+/// have no rival: no pose more than [`RIVAL_EXCLUDE_M`] from it may score
+/// `unique_ratio` of its score (a corridor's doors repeat, and a window
+/// that reaches several metres along one finds the wrong door as readily
+/// as the right one). `LoopConfig::default` keeps the growth off (0 per
 /// metre), as the simulated robots' back end does. A replayed log's driver
-/// ([`super::logslam`]) turns it on (0.03 per metre, 16 m at most) and
-/// grows it on one try in four only (`grown_every`; `links: None` to
-/// [`find_closure_among`] on the other tries). Grown on every try it made
-/// one of the tuned logs worse by a centimetre and the replays 4–10×
-/// slower; one try in four keeps most of the halls' gains at a third of
-/// that cost and leaves the five shared logs as they were
-/// (docs/history/issue-21-real-laser-logs.md, rounds 17–19).
+/// ([`super::logs::logslam`]) turns it on (0.03 per metre, 16 m at most)
+/// and grows it on one try in four only (`grown_every`; `links: None` to
+/// [`find_closure_among`] on the other tries): grown on every try, the
+/// replays are several times slower for little more (BENCHMARKS.md).
 pub fn closure_window(cfg: &LoopConfig, path_m: f64) -> Window {
     Window {
         linear_m: cfg.window.linear_m + widening_m(cfg, path_m),
@@ -297,7 +253,7 @@ pub fn closure_window(cfg: &LoopConfig, path_m: f64) -> Window {
 
 /// The keys of the visit around `centre` that key `i` is matched against:
 /// `submap_half` either side, none of the last `min_key_gap` before `i`.
-pub(super) fn visit_keys(i: usize, centre: usize, cfg: &LoopConfig) -> RangeInclusive<usize> {
+fn visit_keys(i: usize, centre: usize, cfg: &LoopConfig) -> RangeInclusive<usize> {
     let lo = centre.saturating_sub(cfg.submap_half);
     let hi = (centre + cfg.submap_half).min(i.saturating_sub(cfg.min_key_gap));
     lo..=hi
@@ -324,8 +280,7 @@ pub(super) fn on_window_edge(
 
 /// Matches key `i` against the key scans around `centre`, `path_m` along
 /// the tour from it ([`closure_window`]).
-#[allow(clippy::too_many_arguments)]
-pub(super) fn match_visit(
+fn match_visit(
     nodes: &[Pose2],
     key_points: &[Vec<DVec2>],
     i: usize,
@@ -333,7 +288,6 @@ pub(super) fn match_visit(
     path_m: f64,
     resolution_m: f64,
     cfg: &LoopConfig,
-    response: Option<&ResponseWindow>,
 ) -> Option<Closure> {
     let mut world = Vec::new();
     for j in visit_keys(i, centre, cfg) {
@@ -346,8 +300,8 @@ pub(super) fn match_visit(
     let points = &key_points[i];
     let field = field_from_points(&world, resolution_m, 8, cfg.window.linear_m + 1.0);
     let found = match_scan(&field, points, &nodes[i], &cfg.window);
-    let (field, m, window) = match found.filter(|m| m.score >= cfg.min_score) {
-        Some(m) => (field, m, cfg.window.clone()),
+    let (m, window) = match found.filter(|m| m.score >= cfg.min_score) {
+        Some(m) => (m, cfg.window.clone()),
         None => {
             let window = closure_window(cfg, path_m);
             if window.linear_m <= cfg.window.linear_m {
@@ -368,7 +322,7 @@ pub(super) fn match_visit(
             if rival > cfg.unique_ratio * m.search_score {
                 return None;
             }
-            (field, m, window)
+            (m, window)
         }
     };
     let mut edge = Edge::new(
@@ -379,12 +333,6 @@ pub(super) fn match_visit(
         cfg.sigma_rad,
     );
     edge.loop_closure = true;
-    if let Some(info) = response
-        .and_then(|w| response_covariance(&field, &key_points[i], &m.pose, w))
-        .and_then(|c| edge_information(&c, m.pose.theta))
-    {
-        edge.information = info;
-    }
     Some(Closure {
         edge,
         score: m.score,
@@ -398,8 +346,7 @@ pub(super) fn match_visit(
 pub const RIVAL_EXCLUDE_M: f64 = 0.5;
 
 /// Neighbourhood of a thinned key scan's point for its normal, and the
-/// association radius and Huber threshold of [`closure_fit`] (m):
-/// those of the closing refinement ([`super::logs::refine`]).
+/// association radius and Huber threshold of [`closure_fit`] (m).
 const PIN_NORMAL_RADIUS_M: f64 = 0.35;
 const PIN_RADIUS_M: f64 = 0.2;
 const PIN_HUBER_M: f64 = 0.02;
@@ -621,7 +568,7 @@ mod tests {
             ..LoopConfig::default()
         };
         let find = |cfg: &LoopConfig, links: Option<&[(usize, usize)]>| {
-            find_closure_among(&nodes, &key_points, i, 0.05, cfg, None, 1, links)
+            find_closure_among(&nodes, &key_points, i, 0.05, cfg, links)
         };
         let grown = find(&cfg, Some(&[])).expect("a closure in the grown window");
         assert_eq!(grown.window.linear_m, 4.0);

@@ -22,7 +22,7 @@
 //! | point-to-line ICP on points, off the raster's grain | [`icp`] | Besl & McKay 1992; Chen & Medioni 1992 |
 //! | pose graph, sparse least squares | [`posegraph`] | Lu & Milios 1997; Grisetti et al. 2010 |
 //! | loop closure by correlative matching | [`loop_closure`] | Konolige et al. 2010; Hess et al. 2016 |
-//! | SLAM for recorded laser logs, and its closing refinement | [`logs`] | Karto / slam_toolbox, Cartographer |
+//! | SLAM for recorded laser logs | [`logs`] | Karto / slam_toolbox, Cartographer |
 //! | its square walls' heading prior | [`manhattan`] | Nguyen et al., IROS 2006 (Orthogonal SLAM) |
 //! | the simulated robots' loop-closing back end | [`robot_graph`] | Konolige et al. 2010; Hess et al. 2016 |
 //! | its key edges' compounded covariance | [`key_chain`] | Smith, Self, Cheeseman 1990; Konolige et al. 2010 |

@@ -37,19 +37,19 @@
 //!    wrong one bends the whole graph. It must pass every one of these:
 //!    - its refinement stands: at least half the new key's points, or
 //!      `refine_min_points` of them, lie on the old keys' surfaces. A match
-//!      of the search alone is dropped, since at a low score it was often
-//!      wrong by 1–3.6° (measured against the truth, below);
+//!      of the search alone is dropped, since at a low score it is often
+//!      wrong by degrees (see below);
 //!    - it is pinned in every direction: the refinement's covariance
 //!      `σ² (JᵀJ)⁻¹` (σ = `closure_residual_m`, the laser's noise) is
 //!      within `closure_max_weak_m` along its weakest direction. Along a
-//!      corridor a match can slide by several centimetres, and that is what
-//!      it had done wherever this was looser;
+//!      corridor a match can slide by several centimetres, and the closures
+//!      looser than this are the ones that slide;
 //!    - it asks the graph for no larger a correction than the front end can
 //!      have drifted along the path between its two keys
 //!      (`max_correction_m` plus `drift_per_metre` of it);
 //!    - a second closure found within `confirm_keys` keys, reaching another
 //!      old key, agrees with it to `confirm_m` and `confirm_rad` (Olson's
-//!      pairwise consistency, as the log SLAM does, [`super::logslam`]): in
+//!      pairwise consistency, as the log SLAM does, [`super::logs::logslam`]): in
 //!      a maze of identical cells a single match can be wrong by a cell;
 //!    - the optimisation that takes the pair leaves both satisfied (χ² at
 //!      most `max_closure_chi2`), or it is undone.
@@ -70,122 +70,63 @@
 //!    scans, so a redraw is never one long task in the page;
 //!    [`RobotGraph::settle`] completes the map at the end of a run.
 //!
-//! 5. **Square walls** ([`super::manhattan`], session 30). A lap's middle
-//!    keeps the front end's slow heading meander: the lap's closures make
-//!    it consistent, not straight, and on the hour the worst robots were a
-//!    lap turned by a quarter of a degree. Each key whose scan's normals
-//!    bundle into one direction modulo 90° is a vote; the building's
-//!    direction is measured from the first `manhattan_anchor_keys` votes,
-//!    near the start, where the heading has not wandered yet (the start
-//!    pose is known), and every later square key within 2° of it gets a
-//!    loose (σ 2°) heading-only edge from the anchored first key. The graph
-//!    is optimised after every `manhattan_every` such edges (and with every
+//! 5. **Square walls** ([`super::manhattan`]). A lap's middle keeps the
+//!    front end's slow heading meander: the lap's closures make it
+//!    consistent, not straight. Each key whose scan's normals bundle into
+//!    one direction modulo 90° is a vote; the building's direction is
+//!    measured from the first `manhattan_anchor_keys` votes, near the
+//!    start, where the heading has not wandered yet (the start pose is
+//!    known), and every later square key within 2° of it gets a loose
+//!    (σ 2°) heading-only edge from the anchored first key. The graph is
+//!    optimised after every `manhattan_every` such edges (and with every
 //!    accepted closure), and the front end moves with it as after a
 //!    closure. A world that is not square gives no votes and nothing
-//!    changes. On the hour's scenario of issue 22 it takes the worst robot
-//!    from 0.194 to 0.091 m natively and every robot under 0.05 m in wasm
-//!    (BENCHMARKS.md, issue 22, session 30).
+//!    changes.
 //!
-//! ## What the numbers say
-//! On the one-hour, 16-robot, 60 × 60 m maze of issue 22
-//! (`examples/sim_drift.rs`), some robots' SLAM drifts: they follow the
-//! maze's outer wall on a left-wall tour of about 550 m, where more than
-//! half the scans pin only the direction across a wall. Without the back
-//! end their ATE is 0.880, 0.485, 0.625, 1.205, 0.149 m (robots 5, 7, 11,
-//! 15, 16). Sessions 15 and 16 measured the back end with stricter gates
-//! (a score of 0.6, a constraint of 20, closures unverified beyond the
-//! pairwise test):
+//! ## Why the gates are what they are
+//! The gates of item 3 come from scoring every closure the search finds
+//! against the truth (`GRAPH_TRIALS=1` with the examples `slam_trace` and
+//! `sim_drift`, [`ClosureTrial`]; the figures are in BENCHMARKS.md). A
+//! wall-follower walks each dead end twice, along either wall, facing the
+//! other way; the scan walking back scores only 0.4–0.6 against the keys
+//! walking in and pins little across, so the closures a first lap needs
+//! are low-scoring ones. Among those, the wrong ones are the matches whose
+//! refinement did not stand, whose answer is the search's (wrong by
+//! degrees in heading), and the ones that slid along a corridor, whose
+//! refinement covariance is loose along it. Refined from
+//! `refine_min_points` points on, a match is right to a few tenths of a
+//! degree, so the pairwise test can be tight (`confirm_m`, `confirm_rad`).
+//! With those gates the score gate matters little; it stays at 0.6, which
+//! keeps two low-scoring closures of an exercise out, and the constraint
+//! gate is 5.
 //!
-//! | key edges; closures | 5 | 7 | 11 | 15 | 16 |
-//! |---|---|---|---|---|---|
-//! | fixed σ (2 cm, 0.5°); search only (session 15) | 0.081 | 0.650 | 0.251 | 0.218 | 0.104 |
-//! | compounded covariance; search only | 0.145 | 0.541 | 0.209 | 0.210 | 0.118 |
-//! | compounded; refined | 0.138 | 0.525 | 0.226 | 0.202 | 0.097 |
-//! | compounded; refined, closures σ 1 cm, 0.1° | 0.126 | 0.660 | 0.156 | 0.188 | 0.100 |
+//! ## What the back end cannot mend
+//! The middle of a first lap. Against the truth (`sim_drift --graph
+//! --probe` with `GRAPH_NO_LOOPS=1`) the front end's relative pose between
+//! keys is off by about a tenth of a degree for neighbours and by a few
+//! tenths of a degree over hundreds of keys, with a mean near zero: not a
+//! bias, and not a random walk of independent key steps either, which
+//! would grow as the square root of the keys. Much of a key's heading
+//! error is jitter that later keys take back; what accumulates is a slow
+//! meander over a lap. A lap's dead ends close within centimetres (the
+//! local shape is right) and its seam closes, but one closure per lap
+//! measures where the lap ended, not its path: least squares bends the lap
+//! between them as the key chain's covariance says (a Brownian bridge),
+//! which leaves the meander's spread mid-lap. Later laps are matched
+//! against the map of the first, so the corrected trajectory repeats the
+//! first lap's error every lap. The square walls' prior (item 5) takes out
+//! what a square building can.
 //!
-//! Session 23's verification (item 3) gives 0.213, 0.448, 0.157, 0.197,
-//! 0.100 m, and each of the 646 closures it accepted in the hour, 16
-//! robots, is within 2.6 cm of the truth; see BENCHMARKS.md, "Session 23",
-//! for all sixteen robots. It is on by default since.
-//!
-//! Why, measured against the truth (`sim_drift --graph --probe` with
-//! `GRAPH_NO_LOOPS=1`, the front end's own key poses, rms over the five
-//! robots' hour): the front end's relative pose between keys `m` apart is
-//! off in heading by
-//!
-//! | keys apart | 1 | 10 | 50 | 150 | 300 | 600 |
-//! |---|---|---|---|---|---|---|
-//! | heading error rms | 0.09–0.10° | 0.19–0.28° | 0.23–0.43° | 0.25–0.45° | 0.23–0.66° | 0.26–0.90° |
-//! | position error rms | 3–4 mm | 0.9–1.4 cm | 3–5 cm | 7–17 cm | 11–28 cm | 18–65 cm |
-//!
-//! with a signed mean near zero: not a bias, and not a random walk of
-//! independent key steps either (that would give √600 × 0.09° ≈ 2.2° over
-//! 600 keys). Much of a key's heading error is jitter that later keys
-//! take back; what accumulates is a slow meander of a few tenths of a
-//! degree over a lap. One closure per lap measures where it ended, not its
-//! path; least squares then bends the lap as the chain's covariance says
-//! (a Brownian bridge), which leaves the meander's spread mid-lap — and for
-//! robot 7, whose error rose early and then stayed, bends the middle of
-//! the lap further off than the filter alone had it (0.75 m at 900 s against
-//! 0.48 m). Later laps are matched against the map of the first, so the
-//! corrected trajectory repeats the first lap's error every lap (robot 5 at
-//! 300 s intervals: 0.03 0.19 0.26 0.16 0.01 | 0.04 0.19 0.27 0.16 0.02).
-//!
-//! ## The first lap's closures (sessions 22 and 23)
-//! Those robots' "loop" is not a 240 m square: robot 7's lap is 1,385 keys
-//! (550 m), a left-wall tour of the outer wall and every wall joined to it,
-//! and with the gates at a score of 0.6 and a constraint of 20 its first
-//! lap, where the error is made, accepted no closure. A wall-follower walks
-//! each dead end twice, along either wall, facing the other way; the scan
-//! walking back scores only 0.4–0.6 against the keys walking in, and pins
-//! little across. Session 22 lowered the gates to 0.4 and 5: the first lap
-//! closed and robot 7 came to 0.068 m, but the 300 s mazes lost precision
-//! (maze 11's robots 0.012 and 0.011 → 0.040 and 0.047 m).
-//!
-//! Scoring every closure found against the truth (`GRAPH_TRIALS=1
-//! slam_trace`, `sim_drift`; [`ClosureTrial`]) showed why. The closures that
-//! cost the mazes their precision were matches whose refinement had not
-//! stood (fewer than half the points on old surfaces, so the search's
-//! answer was kept): wrong by 1.1–3.6° in heading. The closures that had
-//! mended robot 7's first lap were of the same kind, wrong by 0.6–2°: that
-//! it came out well was luck. Refined from 20 points on, the same matches
-//! are right to 0.4°; the rest of the error was sliding along corridors
-//! (2–9 cm), and every such closure had a refinement covariance looser
-//! than 8 mm along the corridor, the good ones 2–7 mm. A tighter pairwise
-//! test (5 cm, 0.5°, made for refined closures where 10 cm and 1.5° were
-//! for the search's) drops the last wrong pair. With item 3 as it is, the
-//! score gate no longer matters to the hour (0.4 and 0.6 give it within
-//! 3 mm), so it stays at 0.6, which keeps two low-scoring closures of an
-//! exercise out (wrong by 0.3–0.4°, found only in the wasm build); the
-//! constraint gate is 5. The presets, exercises and mazes 11, 23, 37 come
-//! out as with the filter alone or better, and the hour's closures are all
-//! right. What the back end cannot
-//! mend is the middle of a first lap: its dead ends close within 2 cm (the
-//! local shape is right), the lap's seam closes, and least squares bends
-//! the lap between them as the key chain's covariance says, which leaves
-//! the front end's slow meander (below) mid-lap: robot 7 is still 0.45 m.
-//!
-//! ## Scan-to-scan key edges: measured, not added
-//! Karto's "chain of recent scans" links each key to the previous keys its
-//! laser still overlaps by matching the scans directly. [`RobotGraph::match_keys`]
-//! refines a key's scan onto the surfaces of an older key's scan alone (or
-//! of a few keys around it) from the front end's relative pose; against the
-//! truth (same run, rms heading error; the front end's in brackets):
-//!
-//! | keys apart (matched onto) | 1 (1) | 2 (1) | 3 (1) | 5 (1) | 10 (1) | 3 (5) | 5 (5) | 10 (7) |
-//! |---|---|---|---|---|---|---|---|---|
-//! | all five robots, hour | 0.11–0.12° (0.08–0.10°) | 0.12–0.13° (0.10–0.13°) | 0.13–0.15° (0.10–0.15°) | 0.15–0.17° (0.11–0.13°) | 0.21–0.22° (0.10–0.15°) | — | — | — |
-//! | robots 7, 15, first 900 s | 0.10° (0.07–0.08°) | 0.11–0.12° (0.07–0.08°) | 0.12–0.13° (0.07–0.08°) | 0.15° (0.08–0.09°) | 0.21–0.22° (0.08–0.11°) | 0.10° (0.08°) | 0.11–0.12° (0.08–0.09°) | 0.14° (0.08–0.09°) |
-//!
-//! and 1–1.4 cm in position against the front end's 2–7 mm. A single scan's
-//! surfaces carry its laser noise (1 cm, a hit or two a cell) where the
-//! front end's map averages hundreds of scans, so the direct match is
-//! *worse* than the chain it would constrain, at every span where the scans
-//! still overlap (beyond 5 keys, 0.4 m apart, fewer than half the pairs
-//! do): such edges cannot straighten the meander, and are not added.
-//! Helping every robot needs information the robot's own scans do not
-//! hold about the first lap's shape (other robots' maps), or a front end
-//! whose later laps are not locked to the first lap's map.
+//! Karto's scan-to-scan links ("chain of recent scans") would not help
+//! either. [`RobotGraph::match_keys`] refines a key's scan onto the
+//! surfaces of an older key's scan alone (or a few keys around it), and
+//! against the truth that match is *worse* than the front end's chain it
+//! would constrain, at every span where the scans still overlap: a single
+//! scan's surfaces carry its laser noise, where the front end's map
+//! averages hundreds of scans. So such edges are not added. Mending the
+//! first lap needs information the robot's own scans do not hold about its
+//! shape (other robots' maps), or a front end whose later laps are not
+//! locked to the first lap's map.
 
 use super::degeneracy::{constraint_of, scan_normals};
 use super::filter::{inverse3, OdometryNoise};
@@ -688,7 +629,6 @@ impl RobotGraph {
             id,
             resolution_m,
             &self.config.loops,
-            None,
         )?;
         self.stats.closures_found += 1;
         let fit = self.refine_closure(&found, &points[id], resolution_m);

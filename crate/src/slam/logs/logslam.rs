@@ -1,129 +1,115 @@
 //! # SLAM for real laser logs: scan-to-map matching, a pose graph, loop closures
 //!
 //! The driver that replays a CARMEN log ([`crate::formats::carmen`]) in file order,
-//! in the manner of Karto / slam_toolbox (Konolige et al., IROS 2010) and
-//! Cartographer (Hess et al., ICRA 2016):
+//! in the manner of Karto / slam_toolbox (Konolige et al., "Efficient sparse
+//! pose adjustment for 2D mapping", IROS 2010) and Cartographer (Hess et al.,
+//! "Real-time loop closure in 2D LIDAR SLAM", ICRA 2016):
 //!
 //! 1. **Predict** each scan's pose from the previous one and the odometry
 //!    increment between them (`x̂_t = x_{t−1} ⊕ (u_{t−1}⁻¹ ⊕ u_t)`).
 //! 2. **Match** the scan against the local map — the points of the last
 //!    `local_keys` key scans at their current estimates — with Olson's
 //!    multi-resolution correlative search and a Gauss–Newton refinement
-//!    ([`crate::slam::multires`]). A narrow window first; if its best pose lies
-//!    on the window's edge or scores poorly, a wide window (real wheel
-//!    odometry slips: the raw MIT CSAIL log's heading jumps by 10–30°).
-//!    The wide window turns far (35°) but reaches only 0.6 m: in a corridor
+//!    ([`crate::slam::multires`]). A narrow window first; if its best pose
+//!    lies on the window's edge or scores poorly, a wide window: real wheel
+//!    odometry slips, and the raw MIT CSAIL log's heading jumps by 10–30°.
+//!    The wide window turns far (35°) but reaches only 0.6 m. In a corridor
 //!    the response is nearly flat along it, and a window that reaches a
 //!    metre lets a stretch further along that happens to score a little
-//!    better win — on ACES with another drift seed (3) two key edges slid
-//!    0.7 and 1.0 m along corridors that way, and the relation error of the
-//!    whole log went from 0.25 to 0.41 m (BENCHMARKS.md, session 18). The
-//!    other logs' figures are the same with either reach (the raw log's
-//!    odometry slips in heading; four drift seeds on the corrected logs).
+//!    better win, so key edges slide along corridors.
+//!
 //!    A scan whose best match still scores poorly keeps the prediction,
 //!    unless the narrow window's match lies inside that window and scores
-//!    at least `weak_match_score` (0.2, against `min_match_score`'s 0.35):
-//!    a poor fit close to where the odometry put the scan — a hall whose
+//!    at least `weak_match_score` (0.2, against `min_match_score`'s 0.35).
+//!    A poor fit close to where the odometry put the scan (a hall whose
 //!    far walls lie beyond the 20 m match range, a turn that shows new
-//!    ground — is still a better pose than the odometry alone, whose error
+//!    ground) is still a better pose than the odometry alone, whose error
 //!    the scans after it would otherwise inherit. Such a scan fits poorly
 //!    for a reason (people around the robot, ground no key has seen), so it
 //!    gives the local map nothing to match the next scans against: once
-//!    the next key follows it, it leaves the local map (it stays a node of
-//!    the graph, with its points for loop closures). Taken into the local
-//!    map, six weak matches on ACES, each within 0.11 m of the prediction,
-//!    made later keys slide along its corridors and cost it a closed loop.
-//!    Over fourteen logs and four drift seeds the mean relation error fell
-//!    0.272 → 0.232 m (a convention centre 0.42 → 0.32 m, a campus
-//!    0.86 → 0.46 m, CSAIL corrected 0.224 → 0.205 m, ACES as before;
-//!    BENCHMARKS.md, session 37).
+//!    the next key follows it, it leaves the local map. It stays a node of
+//!    the graph, with its points for loop closures. Kept in the local map,
+//!    weak matches make the keys after them slide along corridors.
+//!
 //!    Wheel odometry can also arrive late: the raw MIT CSAIL log's odometry
 //!    stands still for a few scans of a fast turn, then jumps by the whole
 //!    turn (85° in one step), which the matcher had already followed. So
-//!    after a scan whose odometry did not change, when
-//!    the motion the matcher saw last (a constant-velocity prediction, as
-//!    Cartographer's pose extrapolator makes) disagrees with the odometry's
-//!    by more than the narrow window, the scan is also matched around that
-//!    prediction, and the better-scoring match is kept.
+//!    after a scan whose odometry did not change, when the motion the
+//!    matcher saw last (a constant-velocity prediction, as Cartographer's
+//!    pose extrapolator makes) disagrees with the odometry's by more than
+//!    the narrow window, the scan is also matched around that prediction,
+//!    and the better-scoring match is kept (`velocity_prior`).
 //! 3. **Key scans** (every `key_distance_m` or `key_angle_rad` of motion)
-//!    become nodes of the pose graph ([`crate::slam::posegraph`]), linked to the
-//!    previous key by the matched relative pose (or, where no match held,
-//!    by odometry with a looser covariance). The matched edge's covariance
-//!    is one σ for all (`key_sigma_m`, `key_sigma_rad`), or with
-//!    `key_covariance` the match's own, from the spread of the matcher's
-//!    response ([`crate::slam::match_covariance`]; measured in BENCHMARKS.md,
-//!    off by default). Other scans are stored relative
-//!    to their key, so they follow it when the graph moves.
-//! 4. **Loop closures** ([`crate::slam::loop_closure`]): every `loop_every` keys
-//!    the new key is matched against older keys near its estimate (with
-//!    `loop_visits` > 1, against the nearest key of each of that many
-//!    earlier passes through the place, the best match kept). A closure
-//!    whose match lies on the edge of its search window is refused
-//!    (`loop_edge_reject`), as the local match widens its window in that
-//!    case: the best pose inside a window is only a peak of the response if
-//!    it lies inside, and a match pressed against the window's border is
-//!    often a wrong place that merely fits better than the right one within
-//!    reach (on the raw MIT CSAIL log the four closures so refused include
-//!    the two that slid 1.8–1.9 m along a corridor; its relation error went
-//!    from 0.43 to 0.22 m, BENCHMARKS.md). With `loop_min_weak` > 0 a
-//!    closure is also refused when the new key's points, laid at the match
-//!    onto the visit's scans, pin it in their weakest direction by fewer
-//!    than that many points' worth ([`crate::slam::loop_closure::closure_fit`]):
-//!    a corridor whose ends are out of sight pins nothing along it. Off by
-//!    default: it removes the corridor slides that make some settings'
-//!    figures jump, but costs the corridor-rich logs right closures too
-//!    (BENCHMARKS.md, session 29). What is kept of that measure: an
-//!    accepted closure's edge is as loose along the match's weakest
-//!    direction as the information there is weaker than across it, up to
-//!    `loop_loosen_ratio` (10) times the variance; a corridor's closure
-//!    then holds the corridor's two walls without pinning where along it
-//!    the key lies (relation errors lower on all five logs on average over
-//!    four drift seeds, BENCHMARKS.md, session 29). The search window
-//!    reaches ±1.5 m, and on one try in `grown_every` (4) further, by
-//!    0.03 m for every metre of the shortest path from the old key through
-//!    the chain and the closures accepted so far, up to 16 m
-//!    ([`crate::slam::loop_closure::closure_window`]): in a convention hall or
-//!    around a campus the drift a revisit must undo reaches metres. (Up
-//!    to 8 m, a 250 m campus left 52 of its 144 revisits out of reach,
-//!    needing 14–21 m; at 16 m, 11. The relations its scans fix between
-//!    revisits ([`crate::slam::eval::verified`]) went from 0.235 to 0.040 m off, an
-//!    MIT corridor's from 0.200 to 0.038 m, every other log as before;
-//!    24 and 32 m gave the same figures. BENCHMARKS.md, session 40.) A
-//!    match found only in the grown reach must score `far_min_score` and
-//!    have no rival near as good; after one, every try searches the grown
-//!    window for `confirm_keys` keys so that a second can confirm it.
-//! 5. **Chain of recent keys** (Karto's scan-to-scan links, off unless
-//!    `chain_keys` > 0): the new key's scan is also matched against each of
-//!    the `chain_keys` keys before the previous one, alone, and every match
-//!    scoring `chain_min_score` becomes a key edge. Those redundant
-//!    stretches stiffen the front end where a closure pulls on it.
-//! 6. **Consistency**: a single match can be wrong (two alike corridors).
+//!    become nodes of the pose graph ([`crate::slam::posegraph`]), linked to
+//!    the previous key by the matched relative pose with one σ for all
+//!    (`key_sigma_m`, `key_sigma_rad`), or, where no match held, by odometry
+//!    with a looser covariance. Other scans are stored relative to their
+//!    key, so they follow it when the graph moves. The spread of the
+//!    matcher's response ([`crate::slam::match_covariance`]) could weigh
+//!    each edge by its own match instead, but on these logs which closures
+//!    are found decides the result, not the key edges' weights
+//!    (BENCHMARKS.md).
+//! 4. **Loop closures** ([`crate::slam::loop_closure`]): every `loop_every`
+//!    keys the new key is matched against the older keys of the nearest
+//!    earlier pass near its estimate.
+//!    - A closure whose match lies on the edge of its search window is
+//!      refused (`loop_edge_reject`), as the local match widens its window
+//!      in that case: the best pose inside a window is only a peak of the
+//!      response if it lies inside, and a match pressed against the
+//!      window's border is often a wrong place that merely fits better than
+//!      the right one within reach (on the raw MIT CSAIL log, closures that
+//!      slid nearly two metres along a corridor).
+//!    - An accepted closure's edge is as loose along the match's weakest
+//!      direction as the point-to-line information there is weaker than
+//!      across it ([`crate::slam::loop_closure::closure_fit`]), up to
+//!      `loop_loosen_ratio` (10) times the variance: a corridor whose ends
+//!      are out of sight pins a closure only across itself, so its closure
+//!      holds the corridor's two walls without pinning where along it the
+//!      key lies. Refusing such closures outright would throw away the
+//!      right half of what they say, and the corridor-rich logs need them.
+//!    - The search window reaches ±1.5 m, and on one try in `grown_every`
+//!      (4) further, by 0.03 m for every metre of the shortest path from the
+//!      old key through the chain and the closures accepted so far, up to
+//!      16 m ([`crate::slam::loop_closure::closure_window`]): in a
+//!      convention hall or around a campus the drift a revisit must undo
+//!      reaches metres, and 16 m covers all but a few revisits of a 250 m
+//!      campus tour. A match found only in the grown reach must score
+//!      `far_min_score` and have no rival near as good; after one, every
+//!      try searches the grown window for `confirm_keys` keys so that a
+//!      second can confirm it. Growing the window on one try in four keeps
+//!      the long revisits in reach without paying the wide search on every
+//!      key.
+//! 5. **Consistency**: a single match can be wrong (two alike corridors).
 //!    Following Olson's pairwise consistency idea ("Recognizing places using
 //!    spectrally clustered local matches", RAS 2009), a closure is only
 //!    accepted once a second closure found within `confirm_keys` keys
 //!    agrees with it: the cycle *old₁ → new₁ → new₂ → old₂ → old₁*, made of
 //!    the two closures and the graph's current relative poses along the two
 //!    stretches (each locally accurate), must compose to nearly the
-//!    identity. Accepted closures go into the graph, which is optimised; an
-//!    optimisation that leaves a closure badly unsatisfied (χ² over
-//!    `max_closure_chi2`) is undone. (Re-checking every accepted closure's
-//!    χ² after later optimisations was tried and finds nothing to drop:
-//!    with key edges of σ 0.1 m the graph absorbs each closure, wrong ones
-//!    included, to χ² < 1.)
+//!    identity. Accepted closures go into the graph, which is optimised by
+//!    plain least squares; an optimisation that leaves a closure badly
+//!    unsatisfied (χ² over `max_closure_chi2`) is undone. Once accepted, a
+//!    closure stays: with key edges of σ 0.1 m the graph absorbs each one
+//!    to χ² < 1, so a later χ² test cannot tell a wrong one, and a robust
+//!    kernel (Dynamic Covariance Scaling) has no outlier to weigh down.
+//! 6. **Square walls** ([`crate::slam::manhattan`]), once the log is
+//!    replayed and the graph optimised: between closures the chain's
+//!    heading wanders by tenths of a degree, and most buildings are built
+//!    square. Each key whose scan's walls run in two directions at right
+//!    angles gets a loose heading prior towards the building's direction,
+//!    measured from the keys themselves, in rounds that let a stretch
+//!    hanging on odometry turn back in; a building that is not square gets
+//!    none.
 //!
-//! 7. **Closing refinement** ([`super::refine`], off unless
-//!    `refine.rounds` > 0): once the log is replayed, every key is linked
-//!    to every earlier visit to its place (Karto's near chains), each link
-//!    refined by point-to-line ICP, and the graph optimised again. It makes
-//!    revisits agree better with their own scans (a pairwise ICP moves them
-//!    6–40 % less) but leaves the relation errors against the reference
-//!    where they were, worse by 1.5 cm on CSAIL corrected (BENCHMARKS.md,
-//!    session 24), so it is not on by default.
+//! Karto's scan-to-scan chain of recent keys, closures against several
+//! earlier passes, each edge weighted by its match's response, and a
+//! closing pass that links every revisit after the replay were all tried
+//! and are not part of the driver: none improved the logs as a whole
+//! (BENCHMARKS.md).
 //!
 //! The poses are in the log's odometry frame: the first scan's pose is its
 //! odometry pose, and the graph's first node stays fixed there.
 
-use super::refine::{refine, RefineConfig};
 use super::scan::LogScan;
 use crate::geom::{wrap_angle, Pose2};
 use crate::slam::grid::{GridConfig, OccupancyGrid, GROW_STEP_CELLS};
@@ -133,7 +119,6 @@ use crate::slam::loop_closure::{
     LoopConfig,
 };
 use crate::slam::manhattan::{scan_direction, settle_priors, ManhattanConfig};
-use crate::slam::match_covariance::{edge_information, response_covariance, ResponseWindow};
 use crate::slam::multires::{field_from_points, match_scan, ScanMatch, Window};
 use crate::slam::posegraph::{Edge, PoseGraph};
 use glam::DVec2;
@@ -173,54 +158,19 @@ pub struct LogSlamConfig {
     /// Standard deviations of a matched key-to-key edge (m, rad). The
     /// matcher pins a heading better than a position (a 20 m beam moves a
     /// cell for a quarter of a degree): its key edges measured against the
-    /// reference poses (example `log_closures`) err by 0.015–0.043 m and
-    /// 0.32–0.64° on average. 0.05 m / 1° made a turn the cheaper way to
-    /// absorb a loop's error, so the graph bent headings.
+    /// reference poses (example `log_closures`) err by a few centimetres
+    /// and about half a degree. A tighter position with a looser heading
+    /// would make a turn the cheaper way to absorb a loop's error, and the
+    /// graph would bend headings.
     pub key_sigma_m: f64,
     pub key_sigma_rad: f64,
     /// Also match around the constant-velocity prediction when it
     /// disagrees with the odometry's (see the module doc).
     pub velocity_prior: bool,
-    /// Dynamic Covariance Scaling of the loop closures (Agarwal et al.
-    /// 2013; [`crate::slam::posegraph`]): Φ, or 0 for plain least squares.
-    pub dcs_phi: f64,
-    /// Whether DCS also weighs the optimisations that accept closures (else
-    /// only the final one, started from the accepted graph).
-    pub dcs_incremental: bool,
-    /// Weigh each matched key edge by its own match's covariance (the
-    /// spread of the matcher's response, [`crate::slam::match_covariance`])
-    /// instead of `key_sigma_m` / `key_sigma_rad`.
-    pub key_covariance: bool,
-    /// The same for loop closures (instead of `loops.sigma_m` /
-    /// `loops.sigma_rad`).
-    pub loop_covariance: bool,
-    /// With `key_covariance`: add `key_sigma_m` / `key_sigma_rad` to the
-    /// match's covariance (independent errors add): the local map the key
-    /// was matched against has its own error, which the response cannot see.
-    pub key_covariance_plus_sigma: bool,
-    /// With `key_covariance`: take only the positional block from the
-    /// response and keep `key_sigma_rad` for the heading.
-    pub key_covariance_position_only: bool,
-    /// Where the response is sampled for those covariances.
-    pub response: ResponseWindow,
-    /// Scan-to-scan edges from each new key to this many keys before the
-    /// previous one (Karto's chain of recent scans; 0: off).
-    pub chain_keys: usize,
-    /// Least score of such a scan-to-scan match.
-    pub chain_min_score: f64,
-    /// Closure candidates: the nearest key of up to this many earlier
-    /// visits to the place ([`crate::slam::loop_closure::find_closure_among`]).
-    pub loop_visits: usize,
     /// Refuse a closure whose match lies on the edge of the closure search
     /// window (the best pose inside the window is then not a peak of the
     /// response: the true one may lie outside, as for the local match).
     pub loop_edge_reject: bool,
-    /// Refuse a closure whose match leaves the new key pinned by fewer than
-    /// this many points' worth of constraint in its weakest direction, as
-    /// a point-to-line fit onto the visit's scans at the matched pose sees
-    /// it ([`crate::slam::loop_closure::closure_fit`]; 0: off). A corridor pins a scan only across
-    /// itself, and a closure there can slide along it by metres.
-    pub loop_min_weak: f64,
     /// With a closure window that grows with the path
     /// (`loops.window_per_m` > 0): the grown window is searched on one try
     /// in this many (tries are `loop_every` keys apart), and on every try
@@ -239,8 +189,6 @@ pub struct LogSlamConfig {
     /// ([`crate::slam::loop_closure::loosened_along_weak`]; 0 or 1: one σ for
     /// all). A corridor's closure is right across it and unsure along it.
     pub loop_loosen_ratio: f64,
-    /// The closing refinement after the replay ([`super::refine`]).
-    pub refine: RefineConfig,
     /// Square walls' heading prior after the replay ([`crate::slam::manhattan`];
     /// `None`: off). On: a building whose walls are not square gets no
     /// prior.
@@ -284,26 +232,10 @@ impl Default for LogSlamConfig {
             key_sigma_m: 0.1,
             key_sigma_rad: 0.5f64.to_radians(),
             velocity_prior: true,
-            dcs_phi: 0.0,
-            dcs_incremental: false,
-            key_covariance: false,
-            loop_covariance: false,
-            key_covariance_plus_sigma: false,
-            key_covariance_position_only: false,
-            response: ResponseWindow {
-                half_m: 0.3,
-                half_rad: 3f64.to_radians(),
-                drop: 0.1,
-            },
-            chain_keys: 0,
-            chain_min_score: 0.5,
-            loop_visits: 1,
             loop_edge_reject: true,
-            loop_min_weak: 0.0,
             grown_every: 4,
             far_min_score: 0.7,
             loop_loosen_ratio: 10.0,
-            refine: RefineConfig::default(),
             manhattan: Some(ManhattanConfig::for_logs()),
         }
     }
@@ -344,17 +276,11 @@ pub struct LogSlamStats {
     pub closures_tried: usize,
     pub closures_found: usize,
     pub closures_rejected: usize,
-    /// Scan-to-scan edges to earlier keys (`chain_keys`).
-    pub chain_edges: usize,
     /// Closures refused for lying on the search window's edge.
     pub closures_on_edge: usize,
     /// Closures refused for moving their key beyond the fixed window with
     /// a score under `far_min_score`.
     pub closures_far_weak: usize,
-    /// Closures refused as not pinned in every direction (`loop_min_weak`).
-    pub closures_degenerate: usize,
-    /// Links the closing refinement added ([`super::refine`]).
-    pub refine_links: usize,
     /// Keys given a square walls' heading prior ([`crate::slam::manhattan`]).
     pub square_keys: usize,
 }
@@ -376,8 +302,6 @@ pub struct LogSlam {
     unmatched_since_key: bool,
     /// Whether each key's scan matched only weakly (`weak_match_score`).
     weak_keys: Vec<bool>,
-    /// The covariance of the match that made the next key (world frame).
-    key_cov: Option<[[f64; 3]; 3]>,
     pending: Vec<Closure>,
     /// The grown closure window is searched on every try up to this key:
     /// a try there found a match beyond the fixed window (`grown_every`).
@@ -454,7 +378,6 @@ impl LogSlam {
             odometry_stale: false,
             unmatched_since_key: false,
             weak_keys: Vec::new(),
-            key_cov: None,
             pending: Vec::new(),
             grow_until: 0,
             closures: Vec::new(),
@@ -491,24 +414,6 @@ impl LogSlam {
         let is_key = rel.position().length() >= self.config.key_distance_m
             || rel.theta.abs() >= self.config.key_angle_rad;
         if is_key {
-            self.key_cov = match (&found, &self.local) {
-                (Some(_), Some(field)) if self.config.key_covariance => {
-                    response_covariance(field, &points, &pose, &self.config.response).map(
-                        |mut c| {
-                            if self.config.key_covariance_plus_sigma {
-                                c[0][0] += self.config.key_sigma_m.powi(2);
-                                c[1][1] += self.config.key_sigma_m.powi(2);
-                                c[2][2] += self.config.key_sigma_rad.powi(2);
-                            }
-                            if self.config.key_covariance_position_only {
-                                c[2][2] = self.config.key_sigma_rad.powi(2);
-                            }
-                            c
-                        },
-                    )
-                }
-                _ => None,
-            };
             let weak = found
                 .as_ref()
                 .is_some_and(|m| m.score < self.config.min_match_score);
@@ -582,18 +487,7 @@ impl LogSlam {
             } else {
                 (self.config.key_sigma_m, self.config.key_sigma_rad)
             };
-            let mut edge = Edge::new(p, id, z, sm, sr);
-            let info = self
-                .key_cov
-                .take()
-                .and_then(|c| edge_information(&c, pose.theta));
-            if let (Some(info), false) = (info, self.unmatched_since_key) {
-                edge.information = info;
-            }
-            self.graph.edges.push(edge);
-            if !self.unmatched_since_key {
-                self.chain_edges(id, &points);
-            }
+            self.graph.edges.push(Edge::new(p, id, z, sm, sr));
         }
         self.unmatched_since_key = false;
         self.key_points.push(points);
@@ -611,31 +505,6 @@ impl LogSlam {
             self.try_close(id);
         }
         self.rebuild_local();
-    }
-
-    /// Scan-to-scan edges from key `id` (its scan `points`) to the
-    /// `chain_keys` keys before the previous one: the new scan matched
-    /// against each old key's scan alone, in the narrow window around the
-    /// new key's estimate.
-    fn chain_edges(&mut self, id: usize, points: &[DVec2]) {
-        let cfg = &self.config;
-        let from = id.saturating_sub(cfg.chain_keys + 1);
-        let pose = self.graph.nodes[id];
-        for j in from..id.saturating_sub(1) {
-            let f = self.graph.nodes[j].frame();
-            let world: Vec<DVec2> = self.key_points[j].iter().map(|&p| f.to_parent(p)).collect();
-            let field = field_from_points(&world, cfg.resolution_m, 4, cfg.narrow.linear_m + 1.0);
-            let Some(m) = match_scan(&field, points, &pose, &cfg.narrow) else {
-                continue;
-            };
-            if m.score < cfg.chain_min_score {
-                continue;
-            }
-            let z = self.graph.nodes[j].between(&m.pose);
-            let edge = Edge::new(j, id, z, cfg.key_sigma_m, cfg.key_sigma_rad);
-            self.graph.edges.push(edge);
-            self.stats.chain_edges += 1;
-        }
     }
 
     /// Rasterises the last `local_keys` key scans into the local map, but
@@ -666,14 +535,12 @@ impl LogSlam {
     fn try_close(&mut self, id: usize) {
         self.stats.closures_tried += 1;
         let links = self.grow_window(id).then(|| self.links());
-        let Some(found) = find_closure_among(
+        let Some(mut found) = find_closure_among(
             &self.graph.nodes,
             &self.key_points,
             id,
             self.config.resolution_m,
             &self.config.loops,
-            Some(&self.config.response).filter(|_| self.config.loop_covariance),
-            self.config.loop_visits,
             links.as_deref(),
         ) else {
             return;
@@ -690,23 +557,10 @@ impl LogSlam {
             self.stats.closures_on_edge += 1;
             return;
         }
-        // How the match pins the new key, when a setting asks (one fit).
-        let loosen = self.config.loop_loosen_ratio > 1.0 && !self.config.loop_covariance;
-        let fit = (loosen || self.config.loop_min_weak > 0.0).then(|| {
-            closure_fit(
-                &self.graph.nodes,
-                &self.key_points,
-                &found,
-                &self.config.loops,
-            )
-        });
-        if fit.is_some_and(|f| f.weak < self.config.loop_min_weak) {
-            self.stats.closures_degenerate += 1;
-            return;
-        }
-        let mut found = found;
-        if let Some(fit) = fit.filter(|_| loosen) {
+        // Loose along the direction the match pins least (a corridor's).
+        if self.config.loop_loosen_ratio > 1.0 {
             let loops = &self.config.loops;
+            let fit = closure_fit(&self.graph.nodes, &self.key_points, &found, loops);
             if let Some(info) = loosened_along_weak(
                 &self.graph.nodes,
                 &found,
@@ -781,11 +635,10 @@ impl LogSlam {
     /// Adds confirmed closures, optimises, and undoes it all if a closure
     /// stays badly unsatisfied.
     fn accept(&mut self, closures: Vec<Closure>) {
-        let phi = self.dcs().filter(|_| self.config.dcs_incremental);
         let edges: Vec<Edge> = closures.iter().map(|c| c.edge.clone()).collect();
         if !self
             .graph
-            .try_closures(&edges, 10, phi, self.config.max_closure_chi2)
+            .try_closures(&edges, 10, None, self.config.max_closure_chi2)
         {
             self.stats.closures_rejected += closures.len();
             return;
@@ -810,15 +663,7 @@ impl LogSlam {
     /// accepted closure; this settles it).
     pub fn finish(&mut self) -> Result<(), String> {
         if !self.closures.is_empty() {
-            self.graph.optimise_robust(20, self.dcs())?;
-            let cfg = &self.config;
-            self.stats.refine_links = refine(
-                &mut self.graph,
-                &self.key_points,
-                cfg.resolution_m,
-                &cfg.loops,
-                &cfg.refine,
-            )?;
+            self.graph.optimise(20)?;
         }
         if let Some(m) = &self.config.manhattan {
             let directions: Vec<Option<f64>> = self
@@ -826,17 +671,11 @@ impl LogSlam {
                 .iter()
                 .map(|p| scan_direction(p, m).map(|(d, _)| d))
                 .collect();
-            let dcs = self.dcs();
             self.stats.square_keys = settle_priors(&mut self.graph, &directions, m, |g| {
-                g.optimise_robust(20, dcs).map(|_| ())
+                g.optimise(20).map(|_| ())
             })?;
         }
         Ok(())
-    }
-
-    /// Φ of Dynamic Covariance Scaling, if on.
-    fn dcs(&self) -> Option<f64> {
-        Some(self.config.dcs_phi).filter(|&p| p > 0.0)
     }
 
     /// The current estimate of scan `k` (position in [`LogSlam::scans`]).

@@ -2,17 +2,14 @@
 //!
 //! A log (a CARMEN file or a ROS bag, read by [`crate::formats`]) is a list
 //! of [`LogScan`]s with the odometry at each; [`logslam`] replays them in
-//! order through scan-to-map matching, a pose graph and loop closures, and
-//! [`refine`] is its optional closing refinement.
+//! order through scan-to-map matching, a pose graph and loop closures.
 //!
 //! | stage | file | follows |
 //! |---|---|---|
 //! | one scan of a log, its beams and poses | [`scan`] | — |
 //! | the replay: matching, key scans, loop closures | [`logslam`] | Karto / slam_toolbox, Cartographer |
-//! | its closing refinement, every revisit linked | [`refine`] | Konolige et al. 2010; Agarwal et al. 2013 |
 
 pub mod logslam;
-pub mod refine;
 pub mod scan;
 
 pub use logslam::{LogSlam, LogSlamConfig};
