@@ -50,8 +50,9 @@
 //! messages, with the byte offset of their record.
 //!
 //! The older format 1.2 (`#ROSRECORD V1.2`, ROS before C Turtle) has no
-//! chunks nor connections, and is refused with a message saying so:
-//! ROS 1's `rosbag fix` rewrites such a bag as 2.0.
+//! chunks nor connections, and is refused with a message saying so. ROS
+//! 1's `rosbag` tools read 1.2 and always write 2.0, so copying the bag
+//! with them (`rosbag filter old.bag new.bag True`) converts it.
 
 use super::stream::{byte_count, shown, u32_at, Extent, Flow, Records, Waiting};
 use super::stream::{HEADER_LIMIT, RECORD_LIMIT};
@@ -274,7 +275,8 @@ fn judge_magic(line: &[u8]) -> Result<(), BagError> {
             "",
             format!(
                 "a ROS 1 bag of the old format 1.{} ({}), which this reader does not read: \
-                 ROS 1's rosbag tools convert it to format 2.0 (`rosbag fix old.bag new.bag`)",
+                 ROS 1's rosbag tools convert it to format 2.0 \
+                 (`rosbag filter old.bag new.bag True` copies it as 2.0)",
                 line.get(14).map_or('?', |&b| b as char),
                 shown(line)
             ),
