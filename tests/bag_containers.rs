@@ -579,6 +579,17 @@ fn ros1_lengths_that_lie_are_errors_or_losses_never_panics() {
         "the record at byte 0 of its data runs past the chunk's end"
     );
 
+    // A record inside a chunk with a header said to be 2 MiB long.
+    let mut huge_inner = magic.clone();
+    huge_inner.extend(ros1w::chunk("lz4", &(2u32 << 20).to_le_bytes()));
+    let e = read_alike(ros1_reader, &huge_inner).unwrap_err();
+    assert_eq!(e.record, "chunk 1 at byte 13");
+    assert_eq!(
+        e.message,
+        "the record at byte 0 of its data: its header is 2,097,152 bytes long, \
+         more than 1 MiB: the file is damaged"
+    );
+
     // A header length running past the end of the file: cut short.
     let mut header_past = magic.clone();
     header_past.extend(500u32.to_le_bytes());

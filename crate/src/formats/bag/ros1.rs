@@ -630,9 +630,9 @@ impl State {
                     ),
                 )
             };
-            let len = match record_extent(records, offset)
-                .map_err(|e| BagError::new(label, format!("{}: {}", e.record, e.message)))?
-            {
+            let len = match record_extent(records, offset).map_err(|e| {
+                BagError::new(label, format!("{} of its data: {}", e.record, e.message))
+            })? {
                 Extent::Whole(len) if len <= records.len() => len,
                 _ => return Err(past_end()),
             };
