@@ -21,9 +21,39 @@
 //! ROS 1 serialisation or ROS 2's CDR — into one set of plain structs, so
 //! what follows never knows which container or encoding a message came in.
 
+pub mod mcap;
 pub mod messages;
+pub mod ros1;
+mod stream;
 
 use std::fmt;
+
+/// The containers [`sniff`] tells apart.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Container {
+    /// A ROS 1 bag (`#ROSBAG V2.0`, or the older `#ROSRECORD V1.2`, which
+    /// [`ros1::Ros1Reader`] refuses with a message saying what it is).
+    Ros1,
+    /// An MCAP file (`\x89MCAP0\r\n`).
+    Mcap,
+    /// An SQLite database (`SQLite format 3\0`): a rosbag2 `.db3`.
+    Sqlite,
+}
+
+/// Which container a file is, from its first bytes (16 are enough), so a
+/// caller picks the reader by content rather than by file name. `None`
+/// when the bytes are none of these, or too few to tell.
+pub fn sniff(first_bytes: &[u8]) -> Option<Container> {
+    if first_bytes.starts_with(b"#ROSBAG V") || first_bytes.starts_with(b"#ROSRECORD V") {
+        Some(Container::Ros1)
+    } else if first_bytes.starts_with(self::mcap::MAGIC) {
+        Some(Container::Mcap)
+    } else if first_bytes.starts_with(b"SQLite format 3\0") {
+        Some(Container::Sqlite)
+    } else {
+        None
+    }
+}
 
 /// How a message's bytes are serialised.
 #[derive(Clone, Debug, PartialEq, Eq)]
