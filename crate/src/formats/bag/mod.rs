@@ -22,6 +22,7 @@
 //! what follows never knows which container or encoding a message came in.
 
 pub mod messages;
+pub mod rosbag2;
 pub mod sqlite;
 
 use std::fmt;
