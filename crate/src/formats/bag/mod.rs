@@ -24,6 +24,8 @@
 pub mod mcap;
 pub mod messages;
 pub mod ros1;
+pub mod rosbag2;
+pub mod sqlite;
 mod stream;
 
 use std::fmt;
