@@ -49,6 +49,12 @@
 //! Timestamps are broken in several logs (all zero, repeated, printed with
 //! six digits so a whole log shares one value): scans are kept in file
 //! order, and the time is only reported, never used to order anything.
+//!
+//! Every scan leaves the reader in the canonical form of
+//! [`crate::slam::logs::LogScan::canonical`] (ranges as `float32`, the beam
+//! step snapped to the laser's `2π / N`, poses to the micrometre), the form
+//! a ROS bag's scans take too: a log written as `FLASER` lines, as
+//! `ROBOTLASER1` lines or as a bag replays the same.
 
 use crate::geom::Pose2;
 use crate::slam::logs::LogScan;
@@ -191,6 +197,15 @@ pub fn parse_str(text: &str) -> Result<CarmenLog, LogError> {
             "no laser records (FLASER, ROBOTLASER1 or RAWLASER1) in the log",
         );
     }
+    // The one form every reader hands the SLAM (LogScan::canonical): the
+    // same scans give the same answer whichever way they were written.
+    log.scans = std::mem::take(&mut log.scans)
+        .into_iter()
+        .map(|s| {
+            let line = s.line;
+            s.canonical().map_err(|message| LogError { line, message })
+        })
+        .collect::<Result<_, _>>()?;
     Ok(log)
 }
 
