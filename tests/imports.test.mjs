@@ -117,14 +117,14 @@ test('the import graph of web/ has no circle', () => {
 });
 
 /** The facades over the wasm build: each parses the JSON its binding returns, and imports nothing. */
-const FACADES = ['lab.js', 'saved-maps.js', 'log-replay.js', 'images.js'].map((f) => path.join(web, f));
+const FACADES = ['lab.js', 'saved-maps.js', 'log-replay.js', 'bag-file.js', 'images.js'].map((f) => path.join(web, f));
 
 /**
  * Raw wasm-bindgen names that answer in JSON text and have a facade: the
- * saved-maps merge, the log replay and SURF on image files. (The raw `Lab`
+ * saved-maps merge, the log replay, ROS bags and SURF on image files. (The raw `Lab`
  * stays open to worker threads, which take only bytes from it.)
  */
-const WRAPPED = /\bwasm\.(MapMerge|LogReplay|mapImagePath|mapMaxCells|surf_features(_rgba)?|surf_match)\b/;
+const WRAPPED = /\bwasm\.(MapMerge|LogReplay|BagFile|bagKind|mapImagePath|mapMaxCells|surf_features(_rgba)?|surf_match)\b/;
 
 test('the layers: the facades import nothing; page and command line stay apart', () => {
   const g = graph();

@@ -13,6 +13,7 @@ import { loadWasm } from '../web/cli/wasm.mjs';
 import { Lab, buildInfo } from '../web/lab.js';
 import { MAX_SAVED_MAPS, SavedMaps, mapImagePath, mapMaxCells } from '../web/saved-maps.js';
 import { LogReplay } from '../web/log-replay.js';
+import { BagFile } from '../web/bag-file.js';
 import * as images from '../web/images.js';
 import { centredFrame, floorPlan, mapImage, mapYaml } from './support/synthetic-maps.mjs';
 import { rayHit } from './support/synthetic-log.mjs';
@@ -139,8 +140,8 @@ function facadeNames(rawClass, renamed = {}) {
     .map((n) => [n, renamed[n] ?? n.replace(/Json$/, '')]);
 }
 
-test('every method of MapMerge and LogReplay has its facade method (parsed ones drop "Json")', () => {
-  for (const [raw, facade, least] of [[wasm.MapMerge, SavedMaps, 10], [wasm.LogReplay, LogReplay, 12]]) {
+test('every method of MapMerge, LogReplay and BagFile has its facade method (parsed ones drop "Json")', () => {
+  for (const [raw, facade, least] of [[wasm.MapMerge, SavedMaps, 11], [wasm.LogReplay, LogReplay, 12], [wasm.BagFile, BagFile, 9]]) {
     const names = facadeNames(raw);
     assert.ok(names.length >= least, `${names.length} methods of ${raw.name}`);
     for (const [name, wrapped] of names) {

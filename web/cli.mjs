@@ -22,6 +22,7 @@ import * as slam from './cli/slam.mjs';
 import * as merge from './cli/merge.mjs';
 import * as savedMaps from './cli/merge-maps.mjs';
 import * as runLog from './cli/run-log.mjs';
+import * as bagInfo from './cli/bag-info.mjs';
 
 export { UsageError, parseArgs };
 
@@ -38,6 +39,7 @@ const MODULES = [
   merge,
   savedMaps,
   runLog,
+  bagInfo,
 ];
 
 const commands = {};

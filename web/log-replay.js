@@ -58,6 +58,16 @@ export class LogReplay {
   }
 
   /**
+   * What was picked from a bag and why — `{scan_topic, scan_reason,
+   * odometry, odometry_reason, truth_topic, truth_reason, laser_frame,
+   * base_frame, laser_offset, offset_reason, scan_topics, odometry_topics,
+   * truth_topics}` — or null for a CARMEN log.
+   */
+  picked() {
+    return JSON.parse(this.raw.pickedJson());
+  }
+
+  /**
    * Replays laser records `from..=to` only (0-based; `to` left out, null or
    * negative: to the end); throws when the stretch holds no record.
    */

@@ -54,6 +54,15 @@ export class SavedMaps {
     return this.raw.addMap(name, yamlText, imageName, image);
   }
 
+  /**
+   * Adds the last map of a bag's `nav_msgs/OccupancyGrid` topic (`bag` a
+   * finished web/bag-file.js `BagFile`; `topic` left out: `/map`, else the
+   * bag's only map topic), named as the bag. Returns its index.
+   */
+  addBagMap(bag, topic = '') {
+    return this.raw.addBagMap(bag.raw, topic);
+  }
+
   /** Map `index`'s `{name, width, height, resolution, origin: [x, y, yaw]}` (cells, metres, radians). */
   mapInfo(index) {
     return JSON.parse(this.raw.mapInfoJson(index));

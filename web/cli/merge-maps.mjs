@@ -6,14 +6,23 @@ import { readFile, writeFile } from 'node:fs/promises';
 import path from 'node:path';
 import { performance } from 'node:perf_hooks';
 import { MAX_SAVED_MAPS, SavedMaps, mapImagePath } from '../saved-maps.js';
+import { isBag, readBag } from './bag-read.mjs';
 import { parseArgs, UsageError, wasmCall } from './args.mjs';
 
 export const usage = `  node web/cli.mjs merge-maps MAP.yaml MAP.yaml [MAP.yaml ...] [--out MERGED.yaml] [--json]
       merge two to sixteen saved ROS map_server maps (YAML + PGM/PNG) offline; with --out,
-      write the merged map as PGM + YAML (+ PNG); nothing is written on no_merge`;
+      write the merged map as PGM + YAML (+ PNG); nothing is written on no_merge. A MAP
+      may also be a ROS bag (.bag, .mcap, .db3 or a rosbag2 folder) with a
+      nav_msgs/OccupancyGrid topic: /map's last message, or the bag's only map topic`;
 
-/** Reads one map's YAML and the image it names into `maps` (a SavedMaps); returns its index. */
+/** Reads one map — a YAML and the image it names, or a bag's map topic — into `maps` (a SavedMaps); returns its index. */
 async function readMap(maps, file, wasm) {
+  if (await isBag(wasm, file)) {
+    const { bag } = await readBag(wasm, file);
+    const index = wasmCall(() => maps.addBagMap(bag));
+    bag.free();
+    return index;
+  }
   let yaml;
   try {
     yaml = await readFile(file, 'utf8');

@@ -15,6 +15,13 @@ pub struct LogReplay {
     inner: log_replay::LogReplay,
 }
 
+impl LogReplay {
+    /// Wraps a session made elsewhere (a bag's replay).
+    pub(super) fn wrap(inner: log_replay::LogReplay) -> LogReplay {
+        LogReplay { inner }
+    }
+}
+
 #[wasm_bindgen]
 impl LogReplay {
     /// Parses the log; throws with the line number on a malformed record.
@@ -29,6 +36,14 @@ impl LogReplay {
     #[wasm_bindgen(js_name = laserRecords)]
     pub fn laser_records(&self) -> u32 {
         self.inner.laser_records() as u32
+    }
+
+    /// What was picked from a bag and why (JSON; `null` for a CARMEN log):
+    /// the scan topic, the odometry, the ground truth, the laser's offset,
+    /// and the other topics there were to pick.
+    #[wasm_bindgen(js_name = pickedJson)]
+    pub fn picked_json(&self) -> Result<String, JsError> {
+        to_json(&self.inner.picked())
     }
 
     /// Replays laser records `from..=to` only (`to` < 0: to the end).

@@ -5,6 +5,7 @@
 //! as PGM, PNG and YAML out. Converts only: every error is a `JsError`
 //! whose message names the file and the field.
 
+use super::bags::BagFile;
 use super::convert::{js_err as err, to_json};
 use crate::lab::saved_maps::{self, SavedMaps};
 use crate::lab::Pose2;
@@ -52,6 +53,16 @@ impl MapMerge {
             .add_map(name, yaml_text, image_name, image)
             .map_err(err)?;
         Ok(i as u32)
+    }
+
+    /// Adds the last map of a bag's `nav_msgs/OccupancyGrid` topic
+    /// (`topic` empty: `/map`, else the bag's only map topic), named as the
+    /// bag. Returns its index.
+    #[wasm_bindgen(js_name = addBagMap)]
+    pub fn add_bag_map(&mut self, bag: &BagFile, topic: &str) -> Result<u32, JsError> {
+        let topic = (!topic.is_empty()).then_some(topic);
+        let map = bag.inner.map(topic).map_err(err)?;
+        Ok(self.inner.add_loaded(map).map_err(err)? as u32)
     }
 
     /// Size, resolution and origin of map `i` (JSON `{name, width, height,

@@ -6,6 +6,7 @@
 //! function returns `Result<_, JsError>` so bad input reaches JavaScript as
 //! an exception with a message, never as a panic or a trap.
 
+mod bags;
 mod logs;
 mod maps;
 mod merge;

@@ -1,24 +1,55 @@
 //! # The log replay session: what the CLI's `run-log` and "Your log…" drive
 //!
-//! Holds a parsed CARMEN log ([`crate::formats::carmen`]), the stretch of its laser
-//! records to replay (`from..=to`, positions among the log's laser records),
-//! and the [`LogSlam`] fed with them in file order, a few at a time (so a
-//! page can animate it and a CLI can time it). While it runs, the page
+//! Holds a recorded log's scans — a CARMEN log's ([`crate::formats::carmen`])
+//! or a ROS bag's ([`super::bag_file`]), in the same canonical form — the
+//! stretch of them to replay (`from..=to`, positions among the log's laser
+//! records), and the [`LogSlam`] fed with them in order, a few at a time (so
+//! a page can animate it and a CLI can time it). A bag may carry a ground
+//! truth: it is kept here, apart from the SLAM, and only scores the result
+//! (the report's `ground_truth` and `ate_m`). While it runs, the page
 //! reads its view ([`LogReplay::view`]: the paths and loop closures so far)
 //! and the live map ([`LogReplay::draw_live`]); at the end it draws the map
 //! at the final poses and writes the report of `docs/interfaces.md`
 //! ("Real laser logs: run-log").
 
-use crate::formats::carmen::{parse_bytes, CarmenLog, LogError};
-use crate::geom::Pose2;
+use crate::formats::bag::recording::{BagLog, Picked};
+use crate::formats::carmen::{parse_bytes, LogError};
+use crate::geom::{wrap_angle, Pose2};
+use crate::slam::eval::scoring::ate_aligned_m;
 use crate::slam::export::{self, MapInfo};
 use crate::slam::grid::OccupancyGrid;
 use crate::slam::logs::logslam::{ClosureInfo, LogSlam, LogSlamConfig, LogSlamStats};
+use crate::slam::logs::LogScan;
 use serde::Serialize;
+
+/// Where a log came from, for its report.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LogSource {
+    Carmen {
+        params: usize,
+        odometry_records: usize,
+        skipped: Vec<(String, usize)>,
+    },
+    Bag(Box<BagSource>),
+}
+
+/// A bag's part of the report: the file, its container, what was lost,
+/// and what was picked from it and why.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BagSource {
+    pub file: String,
+    pub container: String,
+    pub compression: Vec<String>,
+    pub lost: Vec<String>,
+    pub picked: Picked,
+}
 
 /// A replay of one log.
 pub struct LogReplay {
-    pub log: CarmenLog,
+    scans: Vec<LogScan>,
+    source: LogSource,
+    /// Ground truth `(time s, pose)` (a bag's), never given to the SLAM.
+    truth: Vec<(f64, Pose2)>,
     pub slam: LogSlam,
     from: usize,
     to: usize,
@@ -36,7 +67,7 @@ pub struct ReplayView {
     pub done: usize,
     pub total: usize,
     /// Each replayed scan's odometry, flat `[x, y, theta, ...]` (the first
-    /// scan at its odometry pose).
+    /// scan at its odometry pose); empty when the log has none.
     pub odometry: Vec<f64>,
     /// Each replayed scan's current SLAM pose, flat, same frame.
     pub poses: Vec<f64>,
@@ -60,7 +91,15 @@ pub struct ClosureView {
 pub struct ScanReport {
     pub index: usize,
     pub time: f64,
-    pub odometry: [f64; 3],
+    /// `null` when the log has no odometry.
+    pub odometry: Option<[f64; 3]>,
+    pub pose: [f64; 3],
+}
+
+/// One ground-truth pose of the report.
+#[derive(Serialize)]
+pub struct TruthReport {
+    pub time: f64,
     pub pose: [f64; 3],
 }
 
@@ -78,6 +117,18 @@ pub struct LogReport {
     pub params: usize,
     pub odometry_records: usize,
     pub skipped: Vec<(String, usize)>,
+    /// A bag's file, container, what was lost and what was picked.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bag: Option<BagSource>,
+    /// The ground truth read from a bag, and the SLAM's ATE against it
+    /// (RMSE of position after the best rigid fit, the truth interpolated
+    /// at each scan's time; m), over `ate_scans` scans.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ground_truth: Option<Vec<TruthReport>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ate_m: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ate_scans: Option<usize>,
     pub timings_ms: serde_json::Value,
 }
 
@@ -86,24 +137,92 @@ pub const FRAME: &str =
     "log: the log's own odometry frame (the first scan replayed is placed at its odometry pose)";
 
 impl LogReplay {
-    /// Parses a log (plain or gzip-compressed) and prepares to replay all of it.
+    /// Parses a CARMEN log (plain or gzip-compressed) and prepares to
+    /// replay all of it.
     pub fn new(bytes: &[u8]) -> Result<LogReplay, LogError> {
         let log = parse_bytes(bytes)?;
-        let to = log.scans.len() - 1;
-        Ok(LogReplay {
-            log,
-            slam: LogSlam::new(LogSlamConfig::default()),
+        let source = LogSource::Carmen {
+            params: log.params.len(),
+            odometry_records: log.odometry_records,
+            skipped: log.skipped,
+        };
+        Ok(LogReplay::of(log.scans, true, Vec::new(), source))
+    }
+
+    /// A bag's laser log ([`super::bag_file::BagFile::replay`]).
+    pub fn from_bag(log: BagLog, source: BagSource) -> LogReplay {
+        LogReplay::of(
+            log.scans,
+            log.has_odometry,
+            log.truth,
+            LogSource::Bag(Box::new(source)),
+        )
+    }
+
+    fn of(
+        scans: Vec<LogScan>,
+        has_odometry: bool,
+        truth: Vec<(f64, Pose2)>,
+        source: LogSource,
+    ) -> LogReplay {
+        let config = LogSlamConfig {
+            odometry: has_odometry,
+            ..LogSlamConfig::default()
+        };
+        LogReplay {
+            to: scans.len().saturating_sub(1),
+            scans,
+            source,
+            truth,
+            slam: LogSlam::new(config),
             from: 0,
-            to,
             next: 0,
             map: None,
             live: None,
-        })
+        }
+    }
+
+    /// Changes the SLAM's settings (examples and tests measure them);
+    /// before the first step only. Whether the log has odometry is the
+    /// log's, not a setting.
+    pub fn configure(&mut self, change: impl FnOnce(&mut LogSlamConfig)) -> Result<(), String> {
+        if self.next > 0 {
+            return Err("the replay has started: configure it first".into());
+        }
+        let mut config = self.slam.config.clone();
+        change(&mut config);
+        config.odometry = self.slam.config.odometry;
+        self.slam = LogSlam::new(config);
+        Ok(())
     }
 
     /// Number of laser records in the log.
     pub fn laser_records(&self) -> usize {
-        self.log.scans.len()
+        self.scans.len()
+    }
+
+    /// Every scan of the log (canonical).
+    pub fn scans(&self) -> &[LogScan] {
+        &self.scans
+    }
+
+    /// What was picked from a bag, and why (`None` for a CARMEN log).
+    pub fn picked(&self) -> Option<&Picked> {
+        match &self.source {
+            LogSource::Bag(b) => Some(&b.picked),
+            LogSource::Carmen { .. } => None,
+        }
+    }
+
+    /// The ground truth `(time s, pose)` read from a bag (empty without);
+    /// for scoring only.
+    pub fn truth(&self) -> &[(f64, Pose2)] {
+        &self.truth
+    }
+
+    /// Whether the log has odometry.
+    pub fn has_odometry(&self) -> bool {
+        self.slam.config.odometry
     }
 
     /// Replays only laser records `from..=to` (`to` clipped to the last);
@@ -112,7 +231,7 @@ impl LogReplay {
         if self.next > 0 {
             return Err("the replay has started: set the range first".into());
         }
-        let last = self.log.scans.len() - 1;
+        let last = self.scans.len() - 1;
         let to = to.unwrap_or(last).min(last);
         if from > to {
             return Err(format!(
@@ -129,7 +248,7 @@ impl LogReplay {
     pub fn step(&mut self, n: usize) -> usize {
         let mut done = 0;
         while done < n && self.from + self.next <= self.to {
-            let scan = &self.log.scans[self.from + self.next];
+            let scan = &self.scans[self.from + self.next];
             self.slam.add_scan(scan);
             self.next += 1;
             done += 1;
@@ -140,7 +259,7 @@ impl LogReplay {
     /// The laser records replayed so far (a page draws the map as it grows
     /// from them with [`LogSlam::build_map`]).
     pub fn replayed(&self) -> &[crate::slam::logs::LogScan] {
-        &self.log.scans[self.from..self.from + self.next]
+        &self.scans[self.from..self.from + self.next]
     }
 
     pub fn remaining(&self) -> usize {
@@ -151,7 +270,7 @@ impl LogReplay {
     pub fn finish(&mut self) -> Result<(), String> {
         self.step(usize::MAX);
         self.slam.finish()?;
-        let scans = &self.log.scans[self.from..=self.to];
+        let scans = &self.scans[self.from..=self.to];
         self.map = Some(self.slam.build_map(scans));
         Ok(())
     }
@@ -175,24 +294,68 @@ impl LogReplay {
             .map(|(s, p)| ScanReport {
                 index: s.index,
                 time: s.time,
-                odometry: [s.odometry.x, s.odometry.y, s.odometry.theta],
+                odometry: self.has_odometry().then_some([
+                    s.odometry.x,
+                    s.odometry.y,
+                    s.odometry.theta,
+                ]),
                 pose: [p.x, p.y, p.theta],
             })
             .collect();
+        let (params, odometry_records, skipped, bag) = match &self.source {
+            LogSource::Carmen {
+                params,
+                odometry_records,
+                skipped,
+            } => (*params, *odometry_records, skipped.clone(), None),
+            LogSource::Bag(b) => (0, 0, Vec::new(), Some((**b).clone())),
+        };
+        let (ground_truth, ate) = if self.truth.is_empty() {
+            (None, None)
+        } else {
+            let rows = self
+                .truth
+                .iter()
+                .map(|(t, p)| TruthReport {
+                    time: *t,
+                    pose: [p.x, p.y, p.theta],
+                })
+                .collect();
+            (Some(rows), self.ate(&poses))
+        };
         Ok(LogReport {
             frame: FRAME,
-            laser_records: self.log.scans.len(),
+            laser_records: self.scans.len(),
             from: self.from,
             to: self.to,
             scans,
             map: MapInfo::of(grid),
             loop_closures: self.slam.closures.clone(),
             slam: self.slam.stats.clone(),
-            params: self.log.params.len(),
-            odometry_records: self.log.odometry_records,
-            skipped: self.log.skipped.clone(),
+            params,
+            odometry_records,
+            skipped,
+            bag,
+            ground_truth,
+            ate_m: ate.map(|a| a.0),
+            ate_scans: ate.map(|a| a.1),
             timings_ms,
         })
+    }
+
+    /// The SLAM's ATE against the ground truth (m, after the best rigid
+    /// fit) and the number of scans it was taken over: those within the
+    /// truth's time span, the truth interpolated at each.
+    fn ate(&self, poses: &[Pose2]) -> Option<(f64, usize)> {
+        let mut est = Vec::new();
+        let mut truth = Vec::new();
+        for (s, p) in self.slam.scans.iter().zip(poses) {
+            if let Some(t) = truth_at(&self.truth, s.time) {
+                est.push(*p);
+                truth.push(t);
+            }
+        }
+        (!est.is_empty()).then(|| (ate_aligned_m(&Pose2::IDENTITY, &est, &truth), est.len()))
     }
 
     /// The map as a binary PGM (ROS map_server).
@@ -233,7 +396,11 @@ impl LogReplay {
         ReplayView {
             done: self.replayed().len(),
             total: self.replayed().len() + self.remaining(),
-            odometry: flat(&mut slam.scans.iter().map(|s| s.odometry)),
+            odometry: if self.has_odometry() {
+                flat(&mut slam.scans.iter().map(|s| s.odometry))
+            } else {
+                Vec::new()
+            },
             poses: flat(&mut slam.poses().into_iter()),
             closures,
         }
@@ -266,4 +433,21 @@ impl LogReplay {
     pub fn live_pixels(&self) -> Result<Vec<u8>, String> {
         Ok(export::grey_rows_top_first(self.live()?))
     }
+}
+
+/// The truth at time `t`, linear between the samples around it; `None`
+/// outside their span.
+fn truth_at(truth: &[(f64, Pose2)], t: f64) -> Option<Pose2> {
+    let k = truth.partition_point(|(s, _)| *s < t);
+    let (tb, b) = truth.get(k)?;
+    if *tb == t {
+        return Some(*b);
+    }
+    let (ta, a) = truth.get(k.checked_sub(1)?)?;
+    let u = (t - ta) / (tb - ta);
+    Some(Pose2::new(
+        a.x + u * (b.x - a.x),
+        a.y + u * (b.y - a.y),
+        wrap_angle(a.theta + u * wrap_angle(b.theta - a.theta)),
+    ))
 }

@@ -32,6 +32,7 @@
 //! |---|---|
 //! | [`saved_maps`] | saved ROS maps merged (`merge-maps`, "Your maps…") |
 //! | [`log_replay`] | a recorded log replayed through SLAM (`run-log`, "Your log…") |
+//! | [`bag_file`] | a ROS bag read in pieces: its topics, its log, its maps (`bag-info`) |
 //! | [`images`] | SURF on images (`features`, `match`, `bench-surf`) |
 //!
 //! `Lab`'s fields are private to this folder: callers use its methods.
@@ -66,6 +67,7 @@ pub fn robot_colours_json() -> String {
     serde_json::to_string(&crate::palette::ROBOT_COLOURS).unwrap_or_else(|_| "[]".into())
 }
 
+pub mod bag_file;
 pub mod frame_spec;
 pub mod frames;
 pub mod groups;

@@ -23,6 +23,7 @@
 
 pub mod mcap;
 pub mod messages;
+pub mod recording;
 pub mod ros1;
 pub mod rosbag2;
 pub mod sqlite;

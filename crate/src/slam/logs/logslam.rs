@@ -193,6 +193,12 @@ pub struct LogSlamConfig {
     /// `None`: off). On: a building whose walls are not square gets no
     /// prior.
     pub manhattan: Option<ManhattanConfig>,
+    /// Whether the scans carry odometry. Without it (a hand-carried laser,
+    /// a simulator's bag of scans alone) each scan is predicted from the
+    /// last one by the motion the estimate made between the two before
+    /// (a constant velocity, scaled by the scans' time apart), and
+    /// `LogScan::odometry` is not read.
+    pub odometry: bool,
 }
 
 impl Default for LogSlamConfig {
@@ -237,6 +243,7 @@ impl Default for LogSlamConfig {
             far_min_score: 0.7,
             loop_loosen_ratio: 10.0,
             manhattan: Some(ManhattanConfig::for_logs()),
+            odometry: true,
         }
     }
 }
@@ -297,6 +304,9 @@ pub struct LogSlam {
     last: Option<(Pose2, Pose2)>,
     /// The last scan-to-scan motion of the estimate (robot frame).
     last_step: Pose2,
+    /// The time of the last scan, and how long the last step took (s).
+    last_time: f64,
+    last_dt: f64,
     /// Whether the odometry did not change between the last two scans.
     odometry_stale: bool,
     unmatched_since_key: bool,
@@ -375,6 +385,8 @@ impl LogSlam {
             local: None,
             last: None,
             last_step: Pose2::IDENTITY,
+            last_time: 0.0,
+            last_dt: 0.0,
             odometry_stale: false,
             unmatched_since_key: false,
             weak_keys: Vec::new(),
@@ -392,10 +404,23 @@ impl LogSlam {
         let Some((last_pose, last_odom)) = self.last else {
             self.add_key(scan, scan.odometry, points, None, false);
             self.last = Some((scan.odometry, scan.odometry));
+            self.last_time = scan.time;
             return;
         };
-        let predicted = last_pose.compose(&last_odom.between(&scan.odometry));
-        let found = self.match_local(&points, &predicted, &last_pose.compose(&self.last_step));
+        // With odometry, the constant-velocity guess is only a second
+        // opinion after a stale odometry reading (and the last step as it
+        // was); without, it is the prediction.
+        let steady = if self.config.odometry {
+            last_pose.compose(&self.last_step)
+        } else {
+            last_pose.compose(&self.steady_step(scan.time))
+        };
+        let predicted = if self.config.odometry {
+            last_pose.compose(&last_odom.between(&scan.odometry))
+        } else {
+            steady
+        };
+        let found = self.match_local(&points, &predicted, &steady);
         let pose = match &found {
             Some(m) => {
                 self.stats.matched += 1;
@@ -408,7 +433,7 @@ impl LogSlam {
             }
         };
         let step = last_pose.between(&pose);
-        self.odometry_stale = last_odom == scan.odometry;
+        self.odometry_stale = self.config.odometry && last_odom == scan.odometry;
         let key = self.graph.nodes.len() - 1;
         let rel = self.graph.nodes[key].between(&pose);
         let is_key = rel.position().length() >= self.config.key_distance_m
@@ -429,7 +454,26 @@ impl LogSlam {
         }
         let now = self.scan_pose(self.scans.len() - 1);
         self.last_step = step;
+        self.last_dt = scan.time - self.last_time;
+        self.last_time = scan.time;
         self.last = Some((now, scan.odometry));
+    }
+
+    /// The constant-velocity step to a scan at `time`: the last step, scaled
+    /// by the time since the last scan over the time the last step took
+    /// (when both are positive and within a factor of five of each other;
+    /// otherwise the last step as it is — logs with broken timestamps).
+    fn steady_step(&self, time: f64) -> Pose2 {
+        let s = self.last_step;
+        let (dt, before) = (time - self.last_time, self.last_dt);
+        if !(dt > 0.0 && before > 0.0) {
+            return s;
+        }
+        let ratio = dt / before;
+        if !(0.2..=5.0).contains(&ratio) {
+            return s;
+        }
+        Pose2::new(s.x * ratio, s.y * ratio, s.theta * ratio)
     }
 
     /// The local match: narrow window, then wide if needed; after a scan
@@ -716,6 +760,11 @@ impl LogSlam {
             let laser = pose.compose(&scan.laser_offset);
             let from = laser.position();
             for (i, &r) in scan.ranges.iter().enumerate() {
+                if r.is_nan() {
+                    // No reading at all (a ROS range below range_min, or
+                    // NaN): neither a wall nor free space.
+                    continue;
+                }
                 let dir = DVec2::from_angle(wrap_angle(laser.theta + scan.bearing(i)));
                 if scan.no_return(i) || r > self.config.match_range_m {
                     grid.integrate_beam(from, from + dir * self.config.free_range_m, false);

@@ -1,0 +1,132 @@
+//! Replays a ROS bag (a file or a rosbag2 folder) or a CARMEN log through
+//! the log SLAM as `run-log` does, and prints what was picked, the
+//! replay's counts, its time and, with a ground truth, the ATE; with
+//! `--poses`, every scan's final pose at full precision (to diff two
+//! formats of one log).
+//!
+//! `cargo run --release -p slamlab --example bag_replay -- BAG_OR_LOG [--poses] [--png MAP.png]
+//!  [--odom-none] [--odom-topic T] [--scan-topic T] [--truth-topic T]`
+//! (settings to measure: `SLAMLAB_LOG_SLAM=key=value,...`)
+
+#[path = "../../tests/real_support/mod.rs"]
+mod support;
+
+use slamlab::lab::bag_file::{BagFile, Picks};
+use slamlab::lab::log_replay::LogReplay;
+use std::path::Path;
+use std::time::Instant;
+
+fn read_bag(path: &Path) -> Result<BagFile, String> {
+    let name = path.display().to_string();
+    let mut bag = BagFile::new(&name);
+    let mut files: Vec<std::path::PathBuf> = Vec::new();
+    if path.is_dir() {
+        let meta = path.join("metadata.yaml");
+        if meta.exists() {
+            let yaml = std::fs::read_to_string(&meta).map_err(|e| e.to_string())?;
+            bag.set_metadata(&yaml)?;
+            files = bag.metadata_files().iter().map(|f| path.join(f)).collect();
+        }
+        if files.is_empty() {
+            let mut found: Vec<_> = std::fs::read_dir(path)
+                .map_err(|e| e.to_string())?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|x| x == "db3" || x == "mcap"))
+                .collect();
+            found.sort();
+            files = found;
+        }
+    } else {
+        files.push(path.to_path_buf());
+    }
+    for f in files {
+        let bytes = std::fs::read(&f).map_err(|e| format!("{}: {e}", f.display()))?;
+        bag.begin_file(&f.display().to_string())?;
+        for piece in bytes.chunks(8 << 20) {
+            bag.push(piece)?;
+        }
+        bag.end_file()?;
+    }
+    bag.finish()?;
+    Ok(bag)
+}
+
+fn main() -> Result<(), String> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let path = Path::new(
+        args.first()
+            .ok_or("usage: bag_replay BAG_OR_LOG [--poses] [--odom-none]")?,
+    );
+    let poses = args.iter().any(|a| a == "--poses");
+    let t0 = Instant::now();
+    let mut replay = if path.is_dir() || {
+        let head = std::fs::read(path).map_err(|e| e.to_string())?;
+        !slamlab::lab::bag_file::bag_kind(&head[..head.len().min(16)]).is_empty()
+    } {
+        let bag = read_bag(path)?;
+        let info = bag.info();
+        eprintln!(
+            "{}: {} messages, {} topics, read in {:.3} s",
+            info.container,
+            info.messages,
+            info.topics.len(),
+            t0.elapsed().as_secs_f64()
+        );
+        let after = |flag: &str| {
+            args.iter()
+                .position(|a| a == flag)
+                .and_then(|i| args.get(i + 1).cloned())
+        };
+        let picks = Picks {
+            odom_none: args.iter().any(|a| a == "--odom-none"),
+            odom_topic: after("--odom-topic"),
+            truth_topic: after("--truth-topic"),
+            scan_topic: after("--scan-topic"),
+        };
+        bag.replay(&picks)?
+    } else {
+        LogReplay::new(&std::fs::read(path).map_err(|e| e.to_string())?)
+            .map_err(|e| e.to_string())?
+    };
+    // Settings to measure: SLAMLAB_LOG_SLAM="key=value,..." as for the
+    // other log examples.
+    replay.configure(|c| *c = support::config_from_env())?;
+    let t1 = Instant::now();
+    replay.finish()?;
+    let report = replay.report(serde_json::Value::Null)?;
+    if let Some(p) = replay.picked() {
+        eprintln!(
+            "picked: {}",
+            serde_json::to_string(p).map_err(|e| e.to_string())?
+        );
+    }
+    eprintln!(
+        "{} scans, {} keys, {} closures, replayed in {:.2} s; map {} x {}",
+        report.scans.len(),
+        report.slam.keys,
+        report.loop_closures.len(),
+        t1.elapsed().as_secs_f64(),
+        report.map.width,
+        report.map.height
+    );
+    eprintln!(
+        "stats: {}",
+        serde_json::to_string(&report.slam).map_err(|e| e.to_string())?
+    );
+    if let Some(a) = report.ate_m {
+        eprintln!(
+            "ATE against the ground truth: {a:.4} m over {} scans",
+            report.ate_scans.unwrap_or(0)
+        );
+    }
+    if let Some(i) = args.iter().position(|a| a == "--png") {
+        let out = args.get(i + 1).ok_or("--png FILE")?;
+        std::fs::write(out, replay.map_png()?).map_err(|e| e.to_string())?;
+    }
+    if poses {
+        for s in &report.scans {
+            println!("{} {:?} {:?}", s.index, s.time, s.pose);
+        }
+    }
+    Ok(())
+}
