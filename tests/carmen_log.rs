@@ -41,7 +41,7 @@ fn flaser_geometry_poses_and_no_return() {
     assert_eq!((a.index, a.line, a.time), (0, 3, 10.0));
     // Ranges as float32, as a ROS LaserScan stores them (the canonical
     // form every reader hands the SLAM).
-    assert_eq!(a.ranges, vec![1.0, 2.0, 81.91f32 as f64]);
+    assert_eq!(&a.ranges[..], &[1.0, 2.0, 81.91f32]);
     // Odd count: beams at both ends, 90° apart for 3 beams.
     assert!((a.bearing(0) + FRAC_PI_2).abs() < 1e-12);
     assert!((a.bearing(2) - FRAC_PI_2).abs() < 1e-12);
@@ -85,7 +85,7 @@ fn robotlaser1_geometry_and_laser_offset() {
                 1.2 3.0 0.6 1.0 3.0 0.5 0 0 0 0 0 99.5 host 99.5";
     let log = parse_str(line).unwrap();
     let s = &log.scans[0];
-    assert_eq!(s.ranges, vec![1.0, 2.0, 3.0, 30.0, 5.0]);
+    assert_eq!(&s.ranges[..], &[1.0, 2.0, 3.0, 30.0, 5.0]);
     assert_eq!(
         (s.start_angle, s.angle_step, s.max_range),
         (-1.0, 0.5, 30.0)
@@ -272,6 +272,7 @@ fn room_scan(
             }
             r
         })
+        .map(|r: f64| r as f32)
         .collect();
     slamlab::slam::logs::LogScan {
         index,

@@ -98,6 +98,16 @@ export class LogReplay {
     return JSON.parse(this.raw.viewJson());
   }
 
+  /**
+   * The ground truth beside the SLAM path so far, or null when the log
+   * has none: `{poses, errors, ate_m}` — the truth at each replayed scan's
+   * time laid onto the SLAM's frame by the rigid fit the ATE is scored
+   * after (flat `[x, y, theta, ...]`), and `[time, error m, ...]`.
+   */
+  truth() {
+    return JSON.parse(this.raw.truthJson());
+  }
+
   // --- The results (after finish) ----------------------------------------------------
 
   /** The run-log report as an object; `timings` (ms, object or JSON text) becomes its `timings_ms`. */

@@ -53,6 +53,7 @@ pub fn cells_hit(scans: &[LogScan], poses: &[Pose2]) -> usize {
     for (scan, pose) in scans.iter().zip(poses) {
         let laser = pose.compose(&scan.laser_offset);
         for (i, &r) in scan.ranges.iter().enumerate() {
+            let r = r as f64;
             if scan.no_return(i) || r > CRISP_RANGE_M {
                 continue;
             }

@@ -98,6 +98,15 @@ impl LogReplay {
         to_json(&self.inner.view())
     }
 
+    /// The ground truth beside the SLAM path so far (JSON `{poses, errors,
+    /// ate_m}`: the truth laid onto the SLAM's frame by the ATE's rigid fit,
+    /// flat `[x, y, theta, ...]`, and `[time, error m, ...]`), or `null`
+    /// when the log has none.
+    #[wasm_bindgen(js_name = truthJson)]
+    pub fn truth_json(&self) -> Result<String, JsError> {
+        to_json(&self.inner.truth_view())
+    }
+
     /// Draws the map of the scans replayed so far at their current poses
     /// (kept for `liveInfoJson` and `livePixels`); returns false before
     /// the first scan.

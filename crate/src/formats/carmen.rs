@@ -157,7 +157,7 @@ pub fn parse_str(text: &str) -> Result<CarmenLog, LogError> {
         match name {
             "FLASER" => {
                 let scan = flaser(&f, index)?;
-                flaser_max = scan.ranges.iter().fold(flaser_max, |m, &r| m.max(r));
+                flaser_max = scan.ranges.iter().fold(flaser_max, |m, &r| m.max(r as f64));
                 log.scans.push(scan);
             }
             "ROBOTLASER1" => log.scans.push(robotlaser(&f, index, true)?),
@@ -343,7 +343,7 @@ fn flaser(f: &Fields, index: usize) -> Result<LogScan, LogError> {
         start_angle: -half_pi,
         angle_step: step,
         max_range: f64::NAN, // the log's largest range, set at the end
-        ranges,
+        ranges: ranges.iter().map(|&r| r as f32).collect(),
         odometry,
         logged_pose: Some(logged),
         laser_offset: Pose2::IDENTITY,
@@ -402,7 +402,7 @@ fn robotlaser(f: &Fields, index: usize, with_poses: bool) -> Result<LogScan, Log
         start_angle,
         angle_step: step,
         max_range,
-        ranges,
+        ranges: ranges.iter().map(|&r| r as f32).collect(),
         odometry,
         logged_pose,
         laser_offset: offset,

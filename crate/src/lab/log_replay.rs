@@ -15,7 +15,7 @@
 use crate::formats::bag::recording::{BagLog, Picked};
 use crate::formats::carmen::{parse_bytes, LogError};
 use crate::geom::{wrap_angle, Pose2};
-use crate::slam::eval::scoring::ate_aligned_m;
+use crate::slam::eval::scoring::{ate_aligned_m, best_fit};
 use crate::slam::export::{self, MapInfo};
 use crate::slam::grid::OccupancyGrid;
 use crate::slam::logs::logslam::{ClosureInfo, LogSlam, LogSlamConfig, LogSlamStats};
@@ -94,6 +94,20 @@ pub struct ScanReport {
     /// `null` when the log has no odometry.
     pub odometry: Option<[f64; 3]>,
     pub pose: [f64; 3],
+}
+
+/// The ground truth beside the SLAM path, for a page to draw: the truth
+/// at each replayed scan's time laid onto the SLAM's frame by the rigid
+/// fit the ATE is scored after, and each scan's position error.
+#[derive(Serialize)]
+pub struct TruthView {
+    /// `[x, y, theta, ...]` in the SLAM's frame, one per scan the truth
+    /// covers.
+    pub poses: Vec<f64>,
+    /// `[time s, error m, ...]` of those scans.
+    pub errors: Vec<f64>,
+    /// The ATE over them (m).
+    pub ate_m: f64,
 }
 
 /// One ground-truth pose of the report.
@@ -341,6 +355,40 @@ impl LogReplay {
             ate_scans: ate.map(|a| a.1),
             timings_ms,
         })
+    }
+
+    /// The ground truth beside the SLAM path so far (`None` without one,
+    /// or before a scan the truth covers).
+    pub fn truth_view(&self) -> Option<TruthView> {
+        if self.truth.is_empty() {
+            return None;
+        }
+        let poses = self.slam.poses();
+        let mut pairs = Vec::new();
+        for (s, p) in self.slam.scans.iter().zip(&poses) {
+            if let Some(t) = truth_at(&self.truth, s.time) {
+                pairs.push((s.time, *p, t));
+            }
+        }
+        let est: Vec<_> = pairs.iter().map(|(_, p, _)| p.position()).collect();
+        let truth: Vec<_> = pairs.iter().map(|(_, _, t)| t.position()).collect();
+        let fit = best_fit(&est, &truth)?;
+        let back = fit.inverse();
+        let mut view = TruthView {
+            poses: Vec::with_capacity(3 * pairs.len()),
+            errors: Vec::with_capacity(2 * pairs.len()),
+            ate_m: 0.0,
+        };
+        let mut sum = 0.0;
+        for (time, p, t) in &pairs {
+            let laid = back.compose(t);
+            view.poses.extend([laid.x, laid.y, laid.theta]);
+            let e = (fit.transform_point(p.position()) - t.position()).length();
+            view.errors.extend([*time, e]);
+            sum += e * e;
+        }
+        view.ate_m = (sum / pairs.len() as f64).sqrt();
+        Some(view)
     }
 
     /// The SLAM's ATE against the ground truth (m, after the best rigid

@@ -56,6 +56,7 @@ use crate::geom::{wrap_angle, Pose2};
 use crate::slam::logs::LogScan;
 use serde::Serialize;
 use std::collections::{BTreeMap, HashMap};
+use std::sync::Arc;
 
 /// One topic as `bag-info` lists it.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -79,9 +80,9 @@ struct ScanSample {
     frame_id: String,
     angle_min: f32,
     angle_increment: f32,
-    range_min: f32,
     range_max: f32,
-    ranges: Vec<f32>,
+    /// Ranges as the SLAM reads them ([`ranges_of`]).
+    ranges: Arc<[f32]>,
 }
 
 /// A stamped 2-D pose.
@@ -186,9 +187,8 @@ impl BagContents {
                     frame_id: frame(&m.header.frame_id),
                     angle_min: m.angle_min,
                     angle_increment: m.angle_increment,
-                    range_min: m.range_min,
                     range_max: m.range_max,
-                    ranges: m.ranges,
+                    ranges: ranges_of(&m),
                 });
             }
             "tf2_msgs/TFMessage" | "tf/tfMessage" => {
@@ -701,24 +701,27 @@ impl BagContents {
     }
 }
 
-/// Scan `k` of a topic as the SLAM's scan (before its canonical
-/// rounding): ranges below `range_min`, NaN or −∞ become NaN (no reading:
-/// neither a wall nor free space), ranges above `range_max` or +∞ become
-/// +∞ (nothing within range).
-fn log_scan(k: usize, s: &ScanSample, odometry: Pose2, offset: Pose2) -> LogScan {
-    let ranges = s
-        .ranges
+/// A scan's ranges as the SLAM reads them: below `range_min`, NaN or −∞
+/// become NaN (no reading: neither a wall nor free space); above
+/// `range_max` or +∞ become +∞ (nothing within range).
+fn ranges_of(m: &LaserScanMsg) -> Arc<[f32]> {
+    m.ranges
         .iter()
         .map(|&r| {
-            if r.is_nan() || r < s.range_min || r == f32::NEG_INFINITY {
-                f64::NAN
-            } else if r > s.range_max {
-                f64::INFINITY
+            if r.is_nan() || r < m.range_min || r == f32::NEG_INFINITY {
+                f32::NAN
+            } else if r > m.range_max {
+                f32::INFINITY
             } else {
-                r as f64
+                r
             }
         })
-        .collect();
+        .collect()
+}
+
+/// Scan `k` of a topic as the SLAM's scan, before its canonical rounding
+/// (its ranges shared with the bag's contents).
+fn log_scan(k: usize, s: &ScanSample, odometry: Pose2, offset: Pose2) -> LogScan {
     LogScan {
         index: k,
         line: k + 1,
@@ -726,7 +729,7 @@ fn log_scan(k: usize, s: &ScanSample, odometry: Pose2, offset: Pose2) -> LogScan
         start_angle: s.angle_min as f64,
         angle_step: s.angle_increment as f64,
         max_range: s.range_max as f64,
-        ranges,
+        ranges: Arc::clone(&s.ranges),
         odometry,
         logged_pose: None,
         laser_offset: offset,

@@ -78,6 +78,27 @@ pub fn ate_aligned_m(start: &Pose2, estimates: &[Pose2], truth: &[Pose2]) -> f64
     (sum / n as f64).sqrt()
 }
 
+/// The rigid transform that best lays the points `p` onto `q` (least
+/// squares over the pairs, Horn's closed form in 2-D): `q[i] ≈ fit ⊕ p[i]`,
+/// the alignment [`ate_aligned_m`] scores after. `None` without pairs.
+pub fn best_fit(p: &[DVec2], q: &[DVec2]) -> Option<Pose2> {
+    let n = p.len().min(q.len());
+    if n == 0 {
+        return None;
+    }
+    let pc = p[..n].iter().copied().sum::<DVec2>() / n as f64;
+    let qc = q[..n].iter().copied().sum::<DVec2>() / n as f64;
+    let (mut cross, mut dot) = (0.0, 0.0);
+    for (a, b) in p.iter().zip(q) {
+        let (a, b) = (*a - pc, *b - qc);
+        cross += a.perp_dot(b);
+        dot += a.dot(b);
+    }
+    let theta = cross.atan2(dot);
+    let t = qc - DVec2::from_angle(theta).rotate(pc);
+    Some(Pose2::new(t.x, t.y, theta))
+}
+
 /// Position error per step (m), same alignment as [`ate_m`].
 pub fn position_errors_m(start: &Pose2, estimates: &[Pose2], truth: &[Pose2]) -> Vec<f64> {
     estimates

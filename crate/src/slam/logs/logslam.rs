@@ -359,6 +359,7 @@ pub fn scan_points(scan: &LogScan, cfg: &LogSlamConfig) -> Vec<DVec2> {
     let mut out: Vec<DVec2> = Vec::with_capacity(scan.ranges.len());
     let offset = scan.laser_offset.frame();
     for (i, &r) in scan.ranges.iter().enumerate() {
+        let r = r as f64;
         if scan.no_return(i) || r > cfg.match_range_m {
             continue;
         }
@@ -760,6 +761,7 @@ impl LogSlam {
             let laser = pose.compose(&scan.laser_offset);
             let from = laser.position();
             for (i, &r) in scan.ranges.iter().enumerate() {
+                let r = r as f64;
                 if r.is_nan() {
                     // No reading at all (a ROS range below range_min, or
                     // NaN): neither a wall nor free space.

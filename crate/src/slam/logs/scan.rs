@@ -20,8 +20,9 @@
 //! [`LogScan::canonical`], which rounds each number to a precision the
 //! sensors never reach, the same way whatever it was written as:
 //!
-//! * ranges to the nearest `float32` (what ROS stores; a laser's own
-//!   resolution is a millimetre or coarser), the maximum range too;
+//! * ranges as `float32` (the type of [`LogScan::ranges`]: what ROS stores;
+//!   a laser's own resolution is a millimetre or coarser), the maximum
+//!   range rounded to the nearest `float32` too;
 //! * the beam step to `2π / N` for the nearest whole `N` when it lies
 //!   within 10⁻⁴ of it (a scanning laser's encoder divides the turn into
 //!   `N` steps: 720 for a SICK at 0.5°, 1024 for a Hokuyo URG), else to the
@@ -36,6 +37,7 @@
 
 use crate::geom::{wrap_angle, Pose2};
 use std::f64::consts::TAU;
+use std::sync::Arc;
 
 /// One laser scan of the log, in file order.
 #[derive(Clone, Debug, PartialEq)]
@@ -53,10 +55,12 @@ pub struct LogScan {
     pub angle_step: f64,
     /// The laser's maximum range: a range at or beyond it is no return.
     pub max_range: f64,
-    /// Ranges (m), beam 0 first: +∞ where the laser saw nothing within
+    /// Ranges (m), beam 0 first, as `float32` (what ROS stores; far finer
+    /// than any laser resolves): +∞ where the laser saw nothing within
     /// range, NaN where it gave no reading (a ROS range below `range_min`,
-    /// or NaN).
-    pub ranges: Vec<f64>,
+    /// or NaN). Shared, not copied, between a bag's contents and the scans
+    /// replayed from it.
+    pub ranges: Arc<[f32]>,
     /// The robot's odometry pose at the scan.
     pub odometry: Pose2,
     /// The pose the log gives for the robot (corrected logs: the corrected
@@ -74,7 +78,7 @@ impl LogScan {
 
     /// True when beam `i` saw nothing within range.
     pub fn no_return(&self, i: usize) -> bool {
-        let r = self.ranges[i];
+        let r = self.ranges[i] as f64;
         !(r > 0.0 && r < self.max_range - 1e-3)
     }
 
@@ -116,11 +120,6 @@ impl LogScan {
         let (start, step) = canonical_beams(self.start_angle, self.angle_step);
         self.start_angle = start;
         self.angle_step = step;
-        for r in &mut self.ranges {
-            if r.is_finite() {
-                *r = *r as f32 as f64;
-            }
-        }
         self.max_range = self.max_range as f32 as f64;
         self.odometry = micro(self.odometry);
         self.logged_pose = self.logged_pose.map(micro);
@@ -167,6 +166,7 @@ mod tests {
     use std::f64::consts::PI;
 
     fn scan(start: f64, step: f64, ranges: Vec<f64>) -> LogScan {
+        let ranges: Arc<[f32]> = ranges.iter().map(|&r| r as f32).collect();
         LogScan {
             index: 0,
             line: 1,
@@ -221,7 +221,7 @@ mod tests {
         b.time = 1134864629895181894i64 as f64 * 1e-9;
         let b = b.canonical().expect("valid");
         assert_eq!(a, b);
-        assert_eq!(a.ranges[0], 1.23f32 as f64);
+        assert_eq!(a.ranges[0], 1.23f32);
         assert_eq!(a.time, 1134864629.895182);
         // A heading past π comes back wrapped.
         let mut c = scan(0.0, PI / 180.0, vec![1.0]);
