@@ -108,6 +108,24 @@ export class LogReplay {
     return JSON.parse(this.raw.truthJson());
   }
 
+  /**
+   * Sets the relations of a benchmark file (text of `t1 t2 x y z roll
+   * pitch yaw` lines, Kümmerle et al. 2009) to score against; returns how
+   * many. The report then carries `relations`.
+   */
+  setRelations(text) {
+    return this.raw.setRelations(text);
+  }
+
+  /**
+   * The replay so far scored against the relations: `{count, matched,
+   * trans_m: {mean, sd, max}, rot_deg: {mean, sd, max}, worst, errors}`,
+   * each error `{t1, t2, scan1, scan2, trans_m, rot_deg}`.
+   */
+  relationScore() {
+    return JSON.parse(this.raw.relationScoreJson());
+  }
+
   // --- The results (after finish) ----------------------------------------------------
 
   /** The run-log report as an object; `timings` (ms, object or JSON text) becomes its `timings_ms`. */

@@ -5,7 +5,7 @@
 //! formats of one log).
 //!
 //! `cargo run --release -p slamlab --example bag_replay -- BAG_OR_LOG [--poses] [--png MAP.png]
-//!  [--odom-none] [--odom-topic T] [--scan-topic T] [--truth-topic T]`
+//!  [--odom-none] [--odom-topic T] [--scan-topic T] [--truth-topic T] [--relations FILE]`
 //! (settings to measure: `SLAMLAB_LOG_SLAM=key=value,...`)
 
 #[path = "../../tests/real_support/mod.rs"]
@@ -91,6 +91,10 @@ fn main() -> Result<(), String> {
     // Settings to measure: SLAMLAB_LOG_SLAM="key=value,..." as for the
     // other log examples.
     replay.configure(|c| *c = support::config_from_env())?;
+    if let Some(i) = args.iter().position(|a| a == "--relations") {
+        let file = args.get(i + 1).ok_or("--relations FILE")?;
+        replay.set_relations(&std::fs::read_to_string(file).map_err(|e| e.to_string())?)?;
+    }
     let t1 = Instant::now();
     replay.finish()?;
     let report = replay.report(serde_json::Value::Null)?;
@@ -113,6 +117,12 @@ fn main() -> Result<(), String> {
         "stats: {}",
         serde_json::to_string(&report.slam).map_err(|e| e.to_string())?
     );
+    if let Some(q) = &report.relations {
+        eprintln!(
+            "relations: {} of {} matched; translation {:.4} ± {:.4} m (max {:.3}), rotation {:.3} ± {:.3} deg (max {:.2})",
+            q.matched, q.count, q.trans_m.mean, q.trans_m.sd, q.trans_m.max, q.rot_deg.mean, q.rot_deg.sd, q.rot_deg.max
+        );
+    }
     if let Some(a) = report.ate_m {
         eprintln!(
             "ATE against the ground truth: {a:.4} m over {} scans",

@@ -12,7 +12,7 @@ import { LogReplay } from '../log-replay.js';
 import { isBag, readBag } from './bag-read.mjs';
 import { parseArgs, UsageError, wasmCall } from './args.mjs';
 
-export const usage = `  node web/cli.mjs run-log LOG [--json] [--out MAP.yaml] [--from N] [--to M] [--trajectory OUT.tum]
+export const usage = `  node web/cli.mjs run-log LOG [--json] [--out MAP.yaml] [--from N] [--to M] [--trajectory OUT.tum] [--relations FILE]
                           [--scan-topic T] [--odom-topic T | --odom-frame NONE] [--truth-topic T]
       replay a CARMEN laser log (.log/.clf, gzip or not) or a ROS bag (.bag, .mcap,
       .db3, or a rosbag2 folder) through SLAM with loop closures; --from/--to pick
@@ -20,7 +20,9 @@ export const usage = `  node web/cli.mjs run-log LOG [--json] [--out MAP.yaml] [
       and a PNG; --trajectory writes the SLAM poses in TUM format (for evo). For a
       bag: --scan-topic picks the LaserScan topic, --odom-topic the odometry,
       --odom-frame NONE maps by scan matching alone, --truth-topic the ground truth
-      (by default a pose topic named as ground truth or from motion capture)`;
+      (by default a pose topic named as ground truth or from motion capture); --relations
+      scores the replay against a benchmark's relation file (Kümmerle et al. 2009: t1 t2 x y
+      z roll pitch yaw per line): the report's relations, mean, sd and max of the errors`;
 
 /** The SLAM poses as a TUM trajectory: `time x y z qx qy qz qw` per scan. */
 function tum(report) {
@@ -78,7 +80,7 @@ function wholeNumber(name, v) {
 
 async function runLog(argv, wasm) {
   const { positional, options } = parseArgs(argv, {
-    json: 'flag', out: 'value', from: 'value', to: 'value', trajectory: 'value',
+    json: 'flag', out: 'value', from: 'value', to: 'value', trajectory: 'value', relations: 'value',
     'scan-topic': 'value', 'odom-topic': 'value', 'odom-frame': 'value', 'truth-topic': 'value',
   });
   if (positional.length !== 1) throw new UsageError('run-log: expected exactly one LOG file');
@@ -90,6 +92,15 @@ async function runLog(argv, wasm) {
   const file = positional[0];
   const t0 = performance.now();
   const replay = await openLog(wasm, file, options);
+  if (options.relations !== undefined) {
+    let text;
+    try {
+      text = await readFile(options.relations, 'utf8');
+    } catch (e) {
+      throw new UsageError(`--relations: cannot read '${options.relations}': ${e.code ?? e.message}`);
+    }
+    wasmCall(() => replay.setRelations(text));
+  }
   const tParsed = performance.now();
   wasmCall(() => replay.setRange(from, to));
   let left = Infinity;
@@ -136,6 +147,11 @@ async function runLog(argv, wasm) {
       for (const l of r.bag.lost) console.log(`  lost: ${l}`);
     }
     if (r.ate_m !== undefined) console.log(`  ATE against the ground truth: ${r.ate_m.toFixed(3)} m over ${r.ate_scans} scans`);
+    if (r.relations) {
+      const q = r.relations;
+      console.log(`  relations: ${q.matched} of ${q.count} matched; translation ${q.trans_m.mean.toFixed(4)} ± ${q.trans_m.sd.toFixed(4)} m (max ${q.trans_m.max.toFixed(3)}), ` +
+        `rotation ${q.rot_deg.mean.toFixed(3)} ± ${q.rot_deg.sd.toFixed(3)} deg (max ${q.rot_deg.max.toFixed(2)})`);
+    }
     const m = r.map;
     console.log(`${file}: ${r.scans.length} of ${r.laser_records} laser records replayed (${r.from}..${r.to}), ` +
       `${r.slam.keys} key scans, ${r.loop_closures.length} loop closures`);

@@ -107,6 +107,22 @@ impl LogReplay {
         to_json(&self.inner.truth_view())
     }
 
+    /// Sets the relations of a benchmark file (`t1 t2 x y z roll pitch
+    /// yaw` lines) to score against: the report gets `relations`. Returns
+    /// how many; throws naming a malformed line.
+    #[wasm_bindgen(js_name = setRelations)]
+    pub fn set_relations(&mut self, text: &str) -> Result<u32, JsError> {
+        Ok(self.inner.set_relations(text).map_err(err)? as u32)
+    }
+
+    /// The replay so far scored against the relations set (JSON `{count,
+    /// matched, trans_m: {mean, sd, max}, rot_deg: {…}, worst: […],
+    /// errors: […]}`).
+    #[wasm_bindgen(js_name = relationScoreJson)]
+    pub fn relation_score_json(&self) -> Result<String, JsError> {
+        to_json(&self.inner.relation_score())
+    }
+
     /// Draws the map of the scans replayed so far at their current poses
     /// (kept for `liveInfoJson` and `livePixels`); returns false before
     /// the first scan.

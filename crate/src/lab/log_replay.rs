@@ -15,6 +15,9 @@
 use crate::formats::bag::recording::{BagLog, Picked};
 use crate::formats::carmen::{parse_bytes, LogError};
 use crate::geom::{wrap_angle, Pose2};
+use crate::slam::eval::benchmark_relations::{
+    parse_relations, score_relations, Relation, RelationScore,
+};
 use crate::slam::eval::scoring::{ate_aligned_m, best_fit};
 use crate::slam::export::{self, MapInfo};
 use crate::slam::grid::OccupancyGrid;
@@ -50,6 +53,9 @@ pub struct LogReplay {
     source: LogSource,
     /// Ground truth `(time s, pose)` (a bag's), never given to the SLAM.
     truth: Vec<(f64, Pose2)>,
+    /// A benchmark's relations to score against (`run-log --relations`),
+    /// never given to the SLAM.
+    relations: Vec<Relation>,
     pub slam: LogSlam,
     from: usize,
     to: usize,
@@ -143,6 +149,10 @@ pub struct LogReport {
     pub ate_m: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ate_scans: Option<usize>,
+    /// The errors against a benchmark's relations (`--relations`), with
+    /// every relation's error and the worst ones.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub relations: Option<RelationScore>,
     pub timings_ms: serde_json::Value,
 }
 
@@ -188,6 +198,7 @@ impl LogReplay {
             scans,
             source,
             truth,
+            relations: Vec::new(),
             slam: LogSlam::new(config),
             from: 0,
             next: 0,
@@ -353,8 +364,23 @@ impl LogReplay {
             ground_truth,
             ate_m: ate.map(|a| a.0),
             ate_scans: ate.map(|a| a.1),
+            relations: (!self.relations.is_empty()).then(|| self.relation_score()),
             timings_ms,
         })
+    }
+
+    /// The relations of a benchmark file (Kümmerle et al. 2009) to score
+    /// the replay against; a malformed file is an error naming its line.
+    pub fn set_relations(&mut self, text: &str) -> Result<usize, String> {
+        self.relations = parse_relations(text).map_err(|e| format!("relations: {e}"))?;
+        Ok(self.relations.len())
+    }
+
+    /// The replay so far scored against the relations set (empty score
+    /// without).
+    pub fn relation_score(&self) -> RelationScore {
+        let times: Vec<f64> = self.slam.scans.iter().map(|s| s.time).collect();
+        score_relations(&times, &self.slam.poses(), &self.relations)
     }
 
     /// The ground truth beside the SLAM path so far (`None` without one,

@@ -8,7 +8,9 @@
 //! | trajectory and map error against the simulator's truth | [`scoring`] | Sturm et al., IROS 2012 (ATE) |
 //! | relation errors against a reference's relations | [`relations`] | Kümmerle et al., Auton. Robots 2009 |
 //! | relations the scans themselves fix | [`verified`] | Kümmerle et al., Auton. Robots 2009 |
+//! | the benchmark's hand-checked relation files | [`benchmark_relations`] | Kümmerle et al., Auton. Robots 2009 |
 
+pub mod benchmark_relations;
 pub mod relations;
 pub mod scoring;
 pub mod verified;

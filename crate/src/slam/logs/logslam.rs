@@ -119,7 +119,7 @@ use crate::slam::loop_closure::{
     LoopConfig,
 };
 use crate::slam::manhattan::{scan_direction, settle_priors, ManhattanConfig};
-use crate::slam::multires::{field_from_points, match_scan, ScanMatch, Window};
+use crate::slam::multires::{field_from_points, match_scan, surface_points, ScanMatch, Window};
 use crate::slam::posegraph::{Edge, PoseGraph};
 use glam::DVec2;
 
@@ -193,6 +193,12 @@ pub struct LogSlamConfig {
     /// `None`: off). On: a building whose walls are not square gets no
     /// prior.
     pub manhattan: Option<ManhattanConfig>,
+    /// The local map's surfaces filled between a key's neighbouring points
+    /// ([`crate::slam::multires::surface_points`]): neighbours up to this
+    /// many times the gap of a surface facing the laser apart (0: off), and
+    /// at most `fill_max_m`.
+    pub fill_ratio: f64,
+    pub fill_max_m: f64,
     /// Whether the scans carry odometry. Without it (a hand-carried laser,
     /// a simulator's bag of scans alone) each scan is predicted from the
     /// last one by the motion the estimate made between the two before
@@ -243,6 +249,8 @@ impl Default for LogSlamConfig {
             far_min_score: 0.7,
             loop_loosen_ratio: 10.0,
             manhattan: Some(ManhattanConfig::for_logs()),
+            fill_ratio: 0.0,
+            fill_max_m: 1.0,
             odometry: true,
         }
     }
@@ -298,6 +306,8 @@ pub struct LogSlam {
     pub config: LogSlamConfig,
     pub graph: PoseGraph,
     key_points: Vec<Vec<DVec2>>,
+    /// Each key's points with its surfaces filled (for the local map).
+    key_surfaces: Vec<Vec<DVec2>>,
     key_scan: Vec<usize>,
     pub scans: Vec<ScanEntry>,
     local: Option<LikelihoodField>,
@@ -381,6 +391,7 @@ impl LogSlam {
             config,
             graph: PoseGraph::default(),
             key_points: Vec::new(),
+            key_surfaces: Vec::new(),
             key_scan: Vec::new(),
             scans: Vec::new(),
             local: None,
@@ -535,6 +546,17 @@ impl LogSlam {
             self.graph.edges.push(Edge::new(p, id, z, sm, sr));
         }
         self.unmatched_since_key = false;
+        let surfaces = if self.config.fill_ratio > 0.0 {
+            surface_points(
+                &points,
+                self.config.resolution_m / 2.0,
+                self.config.fill_ratio,
+                self.config.fill_max_m,
+            )
+        } else {
+            Vec::new()
+        };
+        self.key_surfaces.push(surfaces);
         self.key_points.push(points);
         self.weak_keys.push(weak);
         self.key_scan.push(scan.index);
@@ -565,7 +587,12 @@ impl LogSlam {
                 continue;
             }
             let f = self.graph.nodes[k].frame();
-            world.extend(self.key_points[k].iter().map(|&p| f.to_parent(p)));
+            let points = if self.config.fill_ratio > 0.0 {
+                &self.key_surfaces[k]
+            } else {
+                &self.key_points[k]
+            };
+            world.extend(points.iter().map(|&p| f.to_parent(p)));
         }
         self.local = Some(field_from_points(
             &world,

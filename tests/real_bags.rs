@@ -1,0 +1,225 @@
+//! Real-data suite: ROS bags replayed through the log SLAM
+//! (`crate/src/lab/bag_file.rs`, `crate/src/formats/bag/`).
+//!
+//! * Same scans, same result: the raw MIT CSAIL log as a CARMEN file, as a
+//!   ROS 1 bag, as two MCAPs and as a rosbag2 `.db3` gives the same poses
+//!   for every scan and the same map; so does the CARMEN log written as
+//!   `ROBOTLASER1` lines that state the same geometry to six decimals.
+//! * Every shared bag opens, picks what it should, and replays; the bags
+//!   without odometry replay by scan matching alone.
+//!
+//! Reads `../shared/data` (or `$SLAMLAB_DATA`); fails when it is missing.
+#![cfg(not(target_arch = "wasm32"))]
+
+#[path = "real_support/mod.rs"]
+mod support;
+
+use slamlab::lab::bag_file::{BagFile, Picks};
+use slamlab::lab::log_replay::{LogReplay, LogReport};
+use std::path::{Path, PathBuf};
+
+fn bags() -> PathBuf {
+    support::data_dir().join("bags")
+}
+
+/// Reads a bag (a file or a rosbag2 folder) in 1 MiB pieces, as the CLI
+/// and the page do.
+fn read_bag(path: &Path) -> BagFile {
+    let name = path.display().to_string();
+    let mut bag = BagFile::new(&name);
+    let files: Vec<PathBuf> = if path.is_dir() {
+        let yaml = std::fs::read_to_string(path.join("metadata.yaml")).expect("metadata.yaml");
+        bag.set_metadata(&yaml).expect("metadata parses");
+        bag.metadata_files().iter().map(|f| path.join(f)).collect()
+    } else {
+        vec![path.to_path_buf()]
+    };
+    for f in files {
+        let bytes = std::fs::read(&f).unwrap_or_else(|e| panic!("{}: {e}", f.display()));
+        bag.begin_file(&f.display().to_string()).expect("begins");
+        for piece in bytes.chunks(1 << 20) {
+            bag.push(piece).unwrap_or_else(|e| panic!("{e}"));
+        }
+        bag.end_file().unwrap_or_else(|e| panic!("{e}"));
+    }
+    bag.finish().unwrap_or_else(|e| panic!("{e}"));
+    bag
+}
+
+/// Replays to the end; the report and the map's PGM.
+fn replayed(mut replay: LogReplay) -> (LogReport, Vec<u8>) {
+    replay.finish().expect("replays");
+    let report = replay.report(serde_json::Value::Null).expect("a report");
+    (report, replay.map_pgm().expect("a map"))
+}
+
+fn bag_replay(path: &Path, picks: &Picks) -> (LogReport, Vec<u8>) {
+    replayed(
+        read_bag(path)
+            .replay(picks)
+            .unwrap_or_else(|e| panic!("{e}")),
+    )
+}
+
+/// Poses within 1 mm and 0.01° of each other, scan by scan, and the same
+/// map, byte for byte.
+fn assert_same(name: &str, a: &(LogReport, Vec<u8>), b: &(LogReport, Vec<u8>)) {
+    assert_eq!(a.0.scans.len(), b.0.scans.len(), "{name}: scans");
+    for (x, y) in a.0.scans.iter().zip(&b.0.scans) {
+        let d = ((x.pose[0] - y.pose[0]).powi(2) + (x.pose[1] - y.pose[1]).powi(2)).sqrt();
+        let t = (x.pose[2] - y.pose[2]).abs().to_degrees();
+        assert!(
+            d <= 1e-3 && t <= 0.01,
+            "{name}: scan {} at {} is {d} m and {t}° from the reference",
+            x.index,
+            x.time
+        );
+        assert!(
+            (x.time - y.time).abs() <= 1e-6,
+            "{name}: scan {} time",
+            x.index
+        );
+    }
+    assert_eq!(
+        a.0.loop_closures.len(),
+        b.0.loop_closures.len(),
+        "{name}: loop closures"
+    );
+    assert!(a.1 == b.1, "{name}: the maps differ");
+}
+
+#[test]
+fn the_mit_csail_log_in_five_formats_replays_the_same() {
+    let carmen = std::fs::read(support::data_dir().join("carmen/mit-csail.clf.gz")).expect("log");
+    let reference = replayed(LogReplay::new(&carmen).expect("parses"));
+    assert_eq!(reference.0.scans.len(), 1988);
+    for bag in [
+        "freiburg/mit-csail.bag",
+        "ros2/mit-csail-zstd.mcap",
+        "ros2/mit-csail-lz4.mcap",
+        "ros2/mit-csail-db3",
+    ] {
+        let got = bag_replay(&bags().join(bag), &Picks::default());
+        let picked = &got.0.bag.as_ref().expect("a bag's report").picked;
+        assert_eq!(picked.scan_topic, "/scan");
+        assert_eq!(picked.odometry.as_deref(), Some("/odom"));
+        assert_same(bag, &got, &reference);
+    }
+}
+
+/// The CARMEN log's FLASER records rewritten as ROBOTLASER1 records that
+/// state their geometry as a logger prints it (six decimals: a step of
+/// 0.008727 rad, a field of view of 3.141593).
+fn as_robotlaser1(text: &str) -> String {
+    let mut out = String::new();
+    for line in text.lines() {
+        let f: Vec<&str> = line.split_whitespace().collect();
+        if f.first() != Some(&"FLASER") {
+            out.push_str(line);
+            out.push('\n');
+            continue;
+        }
+        let n: usize = f[1].parse().expect("a beam count");
+        let ranges = &f[2..2 + n];
+        let rest = &f[2 + n..];
+        let (pose, odom, tail) = (&rest[0..3], &rest[3..6], &rest[6..]);
+        let fov = std::f64::consts::PI;
+        let step = fov / (n - 1) as f64;
+        out.push_str(&format!(
+            "ROBOTLASER1 0 {:.6} {:.6} {:.6} 81.9 0.01 0 {n} {} 0 {} {} 0 0 0.55 0.375 1000000 {}\n",
+            -fov / 2.0,
+            fov,
+            step,
+            ranges.join(" "),
+            odom.join(" "),
+            odom.join(" "),
+            tail.join(" ")
+        ));
+        let _ = pose;
+    }
+    out
+}
+
+#[test]
+fn flaser_and_robotlaser1_lines_of_the_same_scans_replay_the_same() {
+    use std::io::Read;
+    let gz = std::fs::read(support::data_dir().join("carmen/mit-csail.clf.gz")).expect("log");
+    let mut text = String::new();
+    flate2::read::GzDecoder::new(&gz[..])
+        .read_to_string(&mut text)
+        .expect("gzip");
+    let flaser = replayed(LogReplay::new(text.as_bytes()).expect("parses"));
+    let robot = as_robotlaser1(&text);
+    assert!(robot.contains("ROBOTLASER1 0 -1.570796 3.141593 0.008727 81.9"));
+    let robotlaser = replayed(LogReplay::new(robot.as_bytes()).expect("parses"));
+    assert_same("ROBOTLASER1", &robotlaser, &flaser);
+}
+
+#[test]
+fn every_shared_bag_opens_and_picks_what_it_holds() {
+    // (bag, scans, odometry picked, ground truth picked)
+    let cases: [(&str, usize, Option<&str>, Option<&str>); 6] = [
+        ("freiburg/aces.bag", 7374, Some("/odom"), None),
+        ("freiburg/intel.bag", 13631, Some("/odom"), None),
+        ("freiburg/fr079.bag", 4934, Some("/odom"), None),
+        (
+            "other/cupoch-Mapping1.bag",
+            1727,
+            None,
+            Some("/base_pose_ground_truth"),
+        ),
+        ("other/scan_tools-demo.bag", 360, None, None),
+        ("other/mumble-hallway_room_loop", 896, None, None),
+    ];
+    for (name, scans, odometry, truth) in cases {
+        let bag = read_bag(&bags().join(name));
+        let info = bag.info();
+        assert!(info.lost.is_empty(), "{name}: {:?}", info.lost);
+        let replay = bag.replay(&Picks::default()).expect("replays");
+        let picked = replay.picked().expect("a bag's picks").clone();
+        assert_eq!(replay.laser_records(), scans, "{name}");
+        assert_eq!(picked.odometry.as_deref(), odometry, "{name}");
+        assert_eq!(picked.truth_topic.as_deref(), truth, "{name}");
+        assert_eq!(replay.has_odometry(), odometry.is_some(), "{name}");
+    }
+    // FR079's laser sits 4 cm ahead of the robot's base (/tf_static).
+    let bag = read_bag(&bags().join("freiburg/fr079.bag"));
+    let replay = bag.replay(&Picks::default()).expect("replays");
+    let offset = replay.picked().expect("picks").laser_offset;
+    assert!(
+        (offset[0] - 0.04).abs() < 1e-9 && offset[1].abs() < 1e-9,
+        "{offset:?}"
+    );
+    assert!(replay
+        .scans()
+        .iter()
+        .all(|s| (s.laser_offset.x - 0.04).abs() < 1e-9));
+}
+
+#[test]
+fn a_log_without_odometry_replays_by_scan_matching_alone() {
+    // The MIT CSAIL bag with its odometry ignored: scan matching from a
+    // constant-velocity prediction still follows the tour, and its report
+    // says there was no odometry.
+    let picks = Picks {
+        odom_none: true,
+        ..Picks::default()
+    };
+    let (report, _) = bag_replay(&bags().join("freiburg/mit-csail.bag"), &picks);
+    assert!(report.scans.iter().all(|s| s.odometry.is_none()));
+    assert_eq!(report.slam.unmatched, 0, "every scan matched");
+    let relations =
+        std::fs::read_to_string(bags().join("freiburg/mit-csail.relations")).expect("relations");
+    let mut replay = read_bag(&bags().join("freiburg/mit-csail.bag"))
+        .replay(&picks)
+        .expect("replays");
+    replay.set_relations(&relations).expect("parses");
+    replay.finish().expect("replays");
+    let score = replay.relation_score();
+    assert_eq!(score.matched, 1172);
+    assert!(
+        score.trans_m.mean < 0.15,
+        "without odometry: {:.3} m",
+        score.trans_m.mean
+    );
+}
