@@ -118,6 +118,17 @@ fn main() -> Result<(), String> {
         serde_json::to_string(&report.slam).map_err(|e| e.to_string())?
     );
     if let Some(q) = &report.relations {
+        // Local relations (the two scans under 5 s apart) and revisits
+        // (over 60 s apart) apart: the front end's precision and the
+        // loops' consistency.
+        let part = |keep: &dyn Fn(f64) -> bool| {
+            let e: Vec<_> = q.errors.iter().filter(|e| keep(e.t2 - e.t1)).collect();
+            let n = e.len().max(1) as f64;
+            (e.len(), e.iter().map(|e| e.trans_m).sum::<f64>() / n)
+        };
+        let (nl, local) = part(&|dt| dt < 5.0);
+        let (nr, revisit) = part(&|dt| dt > 60.0);
+        eprintln!("relations by gap: {nl} local {local:.4} m, {nr} revisits {revisit:.4} m");
         eprintln!(
             "relations: {} of {} matched; translation {:.4} ± {:.4} m (max {:.3}), rotation {:.3} ± {:.3} deg (max {:.2})",
             q.matched, q.count, q.trans_m.mean, q.trans_m.sd, q.trans_m.max, q.rot_deg.mean, q.rot_deg.sd, q.rot_deg.max

@@ -377,10 +377,19 @@ impl LogReplay {
     }
 
     /// The replay so far scored against the relations set (empty score
-    /// without).
+    /// without). A relation relates two scans, so a scan's pose is the
+    /// laser's when it took the scan: the robot's pose composed with the
+    /// laser's offset on the robot.
     pub fn relation_score(&self) -> RelationScore {
         let times: Vec<f64> = self.slam.scans.iter().map(|s| s.time).collect();
-        score_relations(&times, &self.slam.poses(), &self.relations)
+        let lasers: Vec<Pose2> = self
+            .slam
+            .poses()
+            .iter()
+            .zip(&self.scans[self.from..])
+            .map(|(p, s)| p.compose(&s.laser_offset))
+            .collect();
+        score_relations(&times, &lasers, &self.relations)
     }
 
     /// The ground truth beside the SLAM path so far (`None` without one,

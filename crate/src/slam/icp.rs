@@ -27,6 +27,7 @@ use std::collections::HashMap;
 
 /// The points a scan is aligned to, with their normals, bucketed for the
 /// nearest-point search.
+#[derive(Clone, Debug)]
 pub struct IcpTarget {
     points: Vec<DVec2>,
     normals: Vec<DVec2>,

@@ -13,7 +13,11 @@
 //!
 //! the pose `r` of the scan stamped `t2` in the frame of the scan stamped
 //! `t1` (metres, radians; z, roll and pitch are 0 for these 2-D logs). A
-//! trajectory `p` is scored by each relation's error
+//! scan's pose is the laser's when it took the scan (the robot's pose
+//! composed with the laser's offset on it): on FR079, whose laser sits
+//! 4 cm ahead of the robot's base, scoring the base instead of the laser
+//! adds up to 8 cm to every relation between scans taken facing opposite
+//! ways. A trajectory `p` of scans is scored by each relation's error
 //!
 //! ```text
 //! δ = (p_t1⁻¹ ⊕ p_t2)⁻¹ ⊕ r,    translational |δ.xy|,  rotational |δ.θ|
