@@ -504,6 +504,9 @@ test('your log: a 200 MB bag opens with a progress bar that moves, the tab stayi
   })();
   const t0 = Date.now();
   await page.setInputFiles('#log-file', big);
+  // A picture of the bar while it moves (what it showed is checked below, frame by frame).
+  await page.waitForSelector('#log-reading:not([hidden])', { timeout: 60000 });
+  await page.screenshot({ path: path.join(ARTIFACTS, 'page-bags-reading.png') });
   await page.waitForFunction(() => document.querySelector('#log-bags .bag-card select'), null, { timeout: 300000, polling: 100 });
   const opened = (Date.now() - t0) / 1000;
   await page.getByRole('button', { name: 'Step', exact: true }).click();
