@@ -4,7 +4,7 @@
 // loads a second wasm.
 
 export class WorkerClient {
-  /** `url`: the module worker; `onProgress(text)`: its progress lines. */
+  /** `url`: the module worker; `onProgress(text, message)`: its progress lines (and the whole message). */
   constructor(url, onProgress = () => {}) {
     this.url = url;
     this.onProgress = onProgress;
@@ -18,7 +18,7 @@ export class WorkerClient {
     this.worker = new Worker(this.url, { type: 'module' });
     this.worker.onmessage = ({ data }) => {
       if (data.type === 'progress') {
-        this.onProgress(data.text);
+        this.onProgress(data.text, data);
         return;
       }
       const w = this.waiting.get(data.id);

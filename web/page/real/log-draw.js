@@ -1,11 +1,13 @@
 // Drawing log replays in the log worker (log-worker.js), one tile a robot:
 // the map of the scans so far (walls dark, free space white, unknown left
 // grey), the path the odometry believes (dashed grey) beside the path SLAM
-// gives (in the robot's colour, moved by every loop closure), each loop
-// closure as an orange line between the two scans it joined, and the
-// robot's current pose. A robot's poses and map share one frame (the log's
-// odometry frame, the first scan at its odometry pose); its tile fits the
-// map's known cells and both paths.
+// gives (in the robot's colour, moved by every loop closure), a bag's
+// ground truth (dotted black: the true poses laid onto SLAM's frame by the
+// rigid fit its ATE is taken after), each loop closure as an orange line
+// between the two scans it joined, and the robot's current pose. A robot's
+// poses and map share one frame (the log's odometry frame, the first scan
+// at its odometry pose); its tile fits the map's known cells and the
+// paths.
 
 import { clearCanvas, fitBox } from './fit.js';
 import { outline } from './overlay.js';
@@ -38,10 +40,10 @@ function path(ctx, flat) {
   ctx.stroke();
 }
 
-/** The world box [x0, y0, x1, y1] to fit: the map's known cells and both paths. */
-function bounds(picture, view) {
+/** The world box [x0, y0, x1, y1] to fit: the map's known cells and the paths. */
+function bounds(picture, view, truth) {
   const b = picture?.box ? [...picture.box] : [Infinity, Infinity, -Infinity, -Infinity];
-  for (const flat of [view.odometry, view.poses]) {
+  for (const flat of [view.odometry, view.poses, truth?.poses ?? []]) {
     for (let i = 0; i < flat.length; i += 3) {
       b[0] = Math.min(b[0], flat[i] - 1);
       b[1] = Math.min(b[1], flat[i + 1] - 1);
@@ -58,10 +60,13 @@ function bounds(picture, view) {
  * SLAM path in `robot.colour`, its name when `label`.
  */
 function drawRobot(ctx, rect, dpr, robot, label) {
-  const { picture, view } = robot;
-  if (!view) return;
-  const box = bounds(picture, view);
-  if (!(box[2] > box[0])) return;
+  const { picture, view, truth } = robot;
+  const box = view ? bounds(picture, view, truth) : [0, 0, 0, 0];
+  if (!(box[2] > box[0])) {
+    // Nothing replayed yet: the tile's name only.
+    if (label) drawName(ctx, rect, dpr, robot);
+    return;
+  }
   ctx.save();
   ctx.beginPath();
   ctx.rect(...rect);
@@ -81,6 +86,14 @@ function drawRobot(ctx, rect, dpr, robot, label) {
   ctx.setLineDash([(6 * dpr) / k, (4 * dpr) / k]);
   ctx.strokeStyle = '#7a7a7a';
   path(ctx, view.odometry);
+  if (truth?.poses.length) {
+    ctx.setLineDash([0.1 / k, (5 * dpr) / k]);
+    ctx.lineCap = 'round';
+    ctx.lineWidth = (3 * dpr) / k;
+    ctx.strokeStyle = '#111';
+    path(ctx, truth.poses);
+    ctx.lineCap = 'butt';
+  }
   ctx.setLineDash([]);
   ctx.lineWidth = (2 * dpr) / k;
   ctx.strokeStyle = robot.colour;
@@ -93,12 +106,17 @@ function drawRobot(ctx, rect, dpr, robot, label) {
     ctx.fillStyle = '#c81414';
     ctx.fill();
   }
-  if (label) {
-    ctx.setTransform(1, 0, 0, 1, 0, 0);
-    ctx.font = `bold ${13 * dpr}px sans-serif`;
-    ctx.fillStyle = robot.colour;
-    ctx.fillText(robot.name, rect[0] + 6 * dpr, rect[1] + 16 * dpr);
-  }
+  ctx.restore();
+  if (label) drawName(ctx, rect, dpr, robot);
+}
+
+/** A robot's name in the top left corner of its tile, in its colour. */
+function drawName(ctx, rect, dpr, robot) {
+  ctx.save();
+  ctx.setTransform(1, 0, 0, 1, 0, 0);
+  ctx.font = `bold ${13 * dpr}px sans-serif`;
+  ctx.fillStyle = robot.colour;
+  ctx.fillText(robot.name, rect[0] + 6 * dpr, rect[1] + 16 * dpr);
   ctx.restore();
 }
 

@@ -1,37 +1,50 @@
-// "Your log": replay a CARMEN laser log in the page (issue 21, item 3).
+// "Your log": replay a CARMEN laser log or a ROS bag in the page (issue 21,
+// item 3; issue 53, item 4).
 //
 // A view over the lab, like "Your maps": the user opens a log (.log, .clf,
-// gzip or not; picker or drop) and replays it through the lab's log SLAM
+// gzip or not) or a ROS bag (a ROS 1 .bag, an .mcap, a rosbag2 .db3 or
+// folder), by the picker or a drop, and replays it through the lab's log SLAM
 // (scan matching, pose graph, loop closures) with Play, Pause, Step and a
 // speed (scans per step), watching the map grow, the odometry's path
 // beside SLAM's and the loop closures drawn as they are found; at the end
 // the map is offered as ROS map_server PGM + YAML and PNG. The replay and
 // all drawing run in a Web Worker (log-worker.js, log-draw.js): the page
-// only sends requests and shows the counts, so it stays responsive.
+// only sends requests and shows the counts, so it stays responsive. A bag
+// is read in the worker in pieces (bag-read.js), with a progress bar here;
+// then its card (bag-picks.js) lists its topics and what the replay picked
+// and why, with selects to pick others, and a bag's ground truth is drawn
+// beside SLAM's path with the position error over time under the map
+// (truth-plot.js).
 //
 // Several logs, or one log cut into N stretches of its laser records, are
 // several robots (issue 21, item 3): each replayed on its own, in its own
 // colour and tile, then **Merge maps** joins their finished maps with the
 // saved-maps merge of `merge-maps` (log-merge.js, log-merge-view.js).
 
+import { BagPicks } from './bag-picks.js';
 import { WorkerClient } from './client.js';
+import { droppedFiles, picked } from './dropped.js';
 import { LogMergeView, MERGE_HTML } from './log-merge-view.js';
 import { MAP_COLOURS } from './panel.js';
+import { ErrorPlot } from './truth-plot.js';
 
 const HTML = `
   <div class="real-head">
-    <h1 id="log-title">Your log: replay a CARMEN laser log</h1>
+    <h1 id="log-title">Your log: replay a CARMEN laser log or a ROS bag</h1>
     <button type="button" class="real-close" aria-label="Close your log and go back to the lab">Close</button>
   </div>
   <p class="real-note">Open a CARMEN log (<code>.log</code>, <code>.clf</code>, gzip-compressed or not: FLASER,
-    ROBOTLASER1, ODOM records) and replay it through the lab's SLAM, as <code>node web/cli.mjs run-log</code> does.
-    Dashed grey: the path the odometry believes; in the robot's colour: SLAM's; orange: loop closures as they are found.
-    Two or more logs, or one log cut into stretches, are as many robots: each replays on its own, then
+    ROBOTLASER1, ODOM records) or a ROS bag (ROS 1 <code>.bag</code>, ROS 2 <code>.mcap</code> or <code>.db3</code>;
+    a rosbag2 folder: drop the folder, or pick its <code>metadata.yaml</code> with its data files) and replay it
+    through the lab's SLAM, as <code>node web/cli.mjs run-log</code> does. A bag's card lists its topics and what the
+    replay uses and why; pick others there. Dashed grey: the path the odometry believes; in the robot's colour:
+    SLAM's; dotted black: a bag's ground truth; orange: loop closures as they are found.
+    Two or more logs or bags, or one cut into stretches, are as many robots: each replays on its own, then
     <b>Merge maps</b> joins their maps by the maps' own evidence, as <code>merge-maps</code> does.</p>
-  <div class="real-drop" tabindex="0" aria-label="Drop a log file here">
-    <span>Drop a log here, or</span>
-    <label class="button" for="log-file">Open log…</label>
-    <input id="log-file" type="file" multiple accept=".log,.clf,.gz,.txt" hidden>
+  <div class="real-drop" tabindex="0" aria-label="Drop logs, bags or a rosbag2 folder here">
+    <span>Drop logs, bags or a rosbag2 folder here, or</span>
+    <label class="button" for="log-file">Open log or bag…</label>
+    <input id="log-file" type="file" multiple accept=".log,.clf,.gz,.txt,.bag,.mcap,.db3,.db3-wal,.yaml,.yml" hidden>
     <label for="log-cut" title="Each stretch of a log is replayed as a robot of its own">Cut each log into</label>
     <input id="log-cut" type="number" min="1" max="16" step="1" value="1" class="num"><span class="unit">stretches</span>
     <button type="button" id="log-clear">Clear logs</button>
@@ -39,6 +52,12 @@ const HTML = `
   </div>
   <p id="log-robots" class="real-legend" aria-label="The robots"></p>
   <div id="log-message" class="real-message" role="alert" hidden></div>
+  <div id="log-reading" class="bag-reading" role="status" hidden>
+    <label for="log-reading-bar" id="log-reading-name"></label>
+    <progress id="log-reading-bar" max="1" value="0"></progress>
+    <span id="log-reading-bytes" class="real-stage"></span>
+  </div>
+  <div id="log-bags" class="bag-cards" hidden></div>
   <div class="real-merge-row log-controls" role="group" aria-label="Replay">
     <button type="button" id="log-play" class="primary">Play</button>
     <button type="button" id="log-pause">Pause</button>
@@ -49,9 +68,20 @@ const HTML = `
     <span id="log-progress" class="real-stage" aria-live="polite"></span>
   </div>
   <canvas id="log-canvas" class="real-overlay" aria-label="The map as it grows, the odometry and SLAM paths, and the loop closures"></canvas>
-  <p class="real-legend"><span class="real-swatch" style="--c:#7a7a7a">odometry</span>
+  <p class="real-legend"><span id="log-odom-key" class="real-swatch" style="--c:#7a7a7a">odometry</span>
     <span class="real-swatch" style="--c:#1f77b4">SLAM (in the robot's colour)</span>
-    <span class="real-swatch" style="--c:#e07b00">loop closure</span></p>
+    <span class="real-swatch" style="--c:#e07b00">loop closure</span>
+    <span id="log-truth-key" class="real-swatch" style="--c:#111" hidden>ground truth (dotted), laid onto SLAM's frame</span></p>
+  <div id="log-truth" class="truth-plot" hidden>
+    <h2>Position error against the ground truth</h2>
+    <p class="real-stage">At each scan replayed: the distance from SLAM's pose to the true pose at the scan's time,
+      the truth laid onto SLAM's path by the one rigid motion that fits them best. The ATE (absolute trajectory
+      error) is its root mean square.</p>
+    <div class="truth-row">
+      <canvas id="log-error" aria-label="Each robot's position error against its bag's ground truth over time"></canvas>
+      <ul id="log-ate" class="truth-ate" aria-label="Each robot's ATE"></ul>
+    </div>
+  </div>
   <div id="log-map-downloads" class="real-downloads">
     <label for="log-map-of" hidden>Map of</label>
     <select id="log-map-of" hidden></select>
@@ -64,7 +94,9 @@ export class LogView {
   /** `root`, `opener`: the view and its toolbar button; `download`; `covers` (cover.js). */
   constructor(root, opener, { download, covers }) {
     Object.assign(this, { root, opener, download, covers });
-    this.client = new WorkerClient(new URL('./log-worker.js', import.meta.url), (text) => this.merged.stage(text));
+    this.client = new WorkerClient(new URL('./log-worker.js', import.meta.url), (text, m) =>
+      m.reading ? this.showReading(m.reading) : this.merged.stage(text),
+    );
     this.merged = new LogMergeView(root, this.client, download);
     this.state = emptyState();
     this.playing = false;
@@ -83,15 +115,17 @@ export class LogView {
       e.stopPropagation(); // the lab's shortcuts stay with the lab
     });
     q('#log-file').addEventListener('change', (e) => {
-      const files = [...e.target.files];
+      const files = [...e.target.files].map(picked);
       e.target.value = '';
       this.open(files);
     });
     this.root.addEventListener('dragover', (e) => e.preventDefault());
     this.root.addEventListener('drop', (e) => {
       e.preventDefault();
-      this.open([...(e.dataTransfer?.files ?? [])]);
+      this.open(droppedFiles(e.dataTransfer));
     });
+    this.picks = new BagPicks(q('#log-bags'), (id, picks, truthHidden) => this.enqueue(() => this.repick(id, picks, truthHidden)));
+    this.plot = new ErrorPlot(q('#log-truth'), q('#log-error'), q('#log-ate'));
     q('#log-cut').addEventListener('change', () => this.enqueue(() => this.recut()));
     q('#log-clear').addEventListener('click', () => this.enqueue(() => this.clear()));
     q('#log-play').addEventListener('click', () => this.play());
@@ -103,6 +137,7 @@ export class LogView {
       b.addEventListener('click', () => this.save(b.dataset.file));
     }
     new ResizeObserver(() => this.redraw()).observe(q('#log-canvas'));
+    new ResizeObserver(() => this.plot.show(this.state.robots ?? [])).observe(q('#log-error'));
     this.merged.wire();
     this.showSpeed();
     this.refresh();
@@ -115,6 +150,7 @@ export class LogView {
     if (open) {
       this.root.querySelector('.real-close').focus();
       this.merged.draw();
+      this.refresh();
     } else {
       this.pause();
       this.opener.focus();
@@ -171,32 +207,60 @@ export class LogView {
     };
   }
 
-  /** Opens picked or dropped logs; each is one robot, or as many as the cut says. */
-  open(files) {
-    if (!files.length) return this.queue;
+  /**
+   * Opens picked or dropped files (`[{file, path}]`, or a promise of them:
+   * dropped.js); each log or bag is one robot, or as many as the cut says.
+   * The worker reads them (the files themselves go to it, not their bytes).
+   */
+  open(entries) {
     this.pause();
     return this.enqueue(async () => {
+      const files = await entries;
+      if (!files.length) return;
       await this.idle();
       this.say('', 'info');
-      const read = await Promise.all(files.map(async (f) => ({ name: f.name, bytes: await f.arrayBuffer() })));
       const size = this.size();
-      const out = await this.client.request(
-        { type: 'open', files: read, cut: this.cut(), colours: MAP_COLOURS },
-        read.map((f) => f.bytes),
-      );
-      if (out.added) this.restart(out, read.filter((f) => !out.errors.some((e) => e.startsWith(`${f.name}: `))));
+      let out;
+      try {
+        out = await this.client.request({ type: 'open', files, cut: this.cut(), colours: MAP_COLOURS });
+      } finally {
+        this.showReading(null);
+      }
+      if (out.added) this.restart(out, out.opened);
       if (out.errors.length) this.say(`Not opened: ${out.errors.join(' · ')}`, 'error');
       this.refresh();
       if (out.added) await this.client.request({ type: 'step', n: 0, size });
     });
   }
 
-  /** New robots (`out`: the worker's answer to open or cut); a replay under way goes on. */
+  /** The progress bar while a bag is read: `r` `{name, read, total, bag, of}` (bytes), or null to hide it. */
+  showReading(r) {
+    const q = (s) => this.root.querySelector(s);
+    q('#log-reading').hidden = !r;
+    if (!r) return;
+    const mb = (b) => (b / 1e6).toFixed(1);
+    q('#log-reading-name').textContent = `Reading ${r.name}${r.of > 1 ? ` (bag ${r.bag} of ${r.of})` : ''}`;
+    const bar = q('#log-reading-bar');
+    bar.max = Math.max(1, r.total);
+    bar.value = r.read;
+    q('#log-reading-bytes').textContent = `${mb(r.read)} of ${mb(r.total)} MB`;
+  }
+
+  /** Bag `id`'s replays made anew with `picks` (bag-picks.js): its robots start again, the others go on. */
+  async repick(id, picks, truthHidden) {
+    await this.idle();
+    const out = await this.client.request({ type: 'pick', log: id, picks, truthHidden });
+    this.restart(out);
+    this.refresh();
+    await this.client.request({ type: 'step', n: 0, size: this.size() });
+  }
+
+  /** New robots (`out`: the worker's answer to open, cut or pick; `opened`: the names opened); a replay under way goes on. */
   restart(out, opened = []) {
-    this.names = [...(this.names ?? []), ...opened.map((f) => f.name)];
+    this.names = [...(this.names ?? []), ...opened];
     const sum = (k) => out.robots.reduce((s, r) => s + r[k], 0);
     const [done, total] = [sum('done'), sum('total')];
-    this.state = { ...emptyState(), name: this.names.join(', '), records: out.records, done, total, left: total - done, closures: sum('closures'), robots: out.robots };
+    this.state = { ...emptyState(), name: this.names.join(', '), records: out.records, done, total, left: total - done, closures: sum('closures'), robots: out.robots, bags: out.bags };
     this.files = null;
     this.summary = null;
     this.merged.drop();
@@ -338,6 +402,12 @@ export class LogView {
         ? `done: ${s.done} scans${many}, ${closures}; ${many ? 'a map each' : `map ${this.summary.map.width} × ${this.summary.map.height} cells`}`
         : `scan ${s.done} of ${s.total}${many} · ${closures}`;
     this.listRobots(robots);
+    this.picks.show(s.bags, robots);
+    this.plot.show(robots);
+    q('#log-truth-key').hidden = !robots.some((r) => r.truth);
+    // Bags replayed by scan matching alone draw no odometry.
+    const bagOf = (r) => (s.bags ?? []).find((b) => b.id === r.logId);
+    q('#log-odom-key').hidden = robots.length > 0 && robots.every((r) => bagOf(r)?.picked.odometry === null);
     for (const b of this.root.querySelectorAll('#log-map-downloads button')) b.disabled = !this.files;
   }
 
@@ -392,5 +462,5 @@ export class LogView {
 }
 
 function emptyState() {
-  return { name: '', records: 0, done: 0, total: 0, closures: 0, left: 0, finished: false, robots: [] };
+  return { name: '', records: 0, done: 0, total: 0, closures: 0, left: 0, finished: false, robots: [], bags: [] };
 }

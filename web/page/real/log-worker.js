@@ -1,10 +1,20 @@
-// CARMEN logs replayed off the page's main thread (issue 21, the page).
+// CARMEN logs and ROS bags replayed off the page's main thread (issues 21
+// and 53, the page).
 //
 // A module Web Worker that loads the same wasm build as the page and holds
-// one log replay (web/log-replay.js) per robot: each log opened
+// one log replay (web/log-replay.js) per robot: each log or bag opened
 // is one robot, or N robots when the page cuts it into N stretches of its
 // laser records (each stretch replayed on its own, as if another robot had
-// driven it). The page asks for a few scans at a time (its play, step and
+// driven it). The page posts the picked or dropped `File`s themselves: a
+// CARMEN log is read here whole (it is small), a bag in 8 MiB pieces
+// (bag-read.js) into a `BagFile` (web/bag-file.js) kept here, never its
+// bytes, with `{type: 'progress', reading: {name, read, total}}` after
+// each piece; its replays are made from that `BagFile` with the picks
+// (scan topic, odometry, ground truth) the page asks for, and made anew,
+// without reading the file again, when the user picks others. A bag's
+// ground truth (laid onto the SLAM's frame) is drawn beside the SLAM path
+// and its position error goes back to the page with each step.
+// The page asks for a few scans at a time (its play, step and
 // speed) and gets back how far the replays are and how many loops they
 // have closed; the worker draws them (log-draw.js) into the page's canvas,
 // handed over once with transferControlToOffscreen: each robot in a tile
@@ -15,13 +25,15 @@
 // maps (log-merge.js: the saved-maps merge of `merge-maps`, each map in its
 // robot's own frame) and draws the joined maps into a second canvas.
 // Messages in: `{id, type: 'canvas' | 'mergeCanvas' | 'open' | 'cut' |
-// 'step' | 'redraw' | 'finish' | 'merge' | 'drawMerge' | 'clear', ...}`;
-// out: `{id, ok, ...}` or `{id, ok: false, error}`, and
-// `{type: 'progress', text}` while merging.
+// 'pick' | 'step' | 'redraw' | 'finish' | 'merge' | 'drawMerge' | 'clear',
+// ...}`; out: `{id, ok, ...}` or `{id, ok: false, error}`, and
+// `{type: 'progress', text}` while merging, `{type: 'progress', reading}`
+// while a bag is read.
 
 import init, * as wasm from '../../pkg/slamlab.js';
 import { LogReplay } from '../../log-replay.js';
 import { MAX_SAVED_MAPS } from '../../saved-maps.js';
+import { readBag, sortFiles } from './bag-read.js';
 import { drawMergedPaths, drawReplays, mapPicture } from './log-draw.js';
 import { mergedPaths, mergeRobots, placedMaps, stretches } from './log-merge.js';
 import { drawPlaced } from './overlay.js';
@@ -30,9 +42,17 @@ const ready = init();
 const MAP_EVERY_MS = 400;
 /** The most robots at once (the merge's limit). */
 const MAX_ROBOTS = MAX_SAVED_MAPS;
-/** The logs opened: `{name, bytes: Uint8Array, records}`. */
+/**
+ * The logs opened, each `{id, name, records}` and either a CARMEN log's
+ * `bytes` (Uint8Array) or a bag's `bag` (BagFile), `info` (what it holds),
+ * `lost` (what could not be read), `picks` (as the page asked), `auto`
+ * and `picked` (what was picked with no picks and with them, and why),
+ * `truthHidden` (the page picked no ground truth) and `spare` (a replay
+ * made and not yet given to a robot).
+ */
 let logs = [];
-/** `{name, log, from, to, colour, replay, picture, view, mapAt, finished, summary}`. */
+let nextLog = 1;
+/** `{name, log, logId, from, to, colour, replay, picture, view, truth, showTruth, mapAt, finished, summary}`. */
 let robots = [];
 let canvas = null;
 let mergeCanvas = null;
@@ -45,6 +65,26 @@ function message(e) {
 /** A log's name without folder, `.gz` and extension. */
 function stem(name) {
   return (String(name).split(/[\\/]/).pop().replace(/(\.gz)?$/i, '').replace(/\.[^.]*$/, '') || 'log').replace(/[^\w.-]+/g, '_');
+}
+
+/** A message that names `name`, unless it does already. */
+function named(name, e) {
+  const text = message(e);
+  return text.startsWith(name) ? text : `${name}: ${text}`;
+}
+
+/** A new replay of `log` (its spare, the first time). */
+function replayOf(log) {
+  const spare = log.spare;
+  log.spare = null;
+  if (spare) return spare;
+  return log.bag ? log.bag.replay(LogReplay, log.picks) : LogReplay.open(wasm, log.bytes);
+}
+
+/** Frees what a log holds in wasm memory. */
+function dropLog(log) {
+  log.spare?.free();
+  log.bag?.free();
 }
 
 /** Makes the robots anew from the logs: each log cut into `cut` stretches. */
@@ -73,54 +113,123 @@ function addRobots(some, cut, colours) {
       let name = parts.length > 1 ? `${stem(log.name)}-${k + 1}` : stem(log.name);
       while (names.has(name)) name += '_';
       names.add(name);
-      const replay = LogReplay.open(wasm, log.bytes);
-      replay.setRange(from, to);
       const colour = colours[robots.length % colours.length];
-      robots.push({ name, log: log.name, from, to, colour, replay, picture: null, view: null, mapAt: -Infinity, finished: false });
+      robots.push(robotOf(log, name, colour, from, to));
     }
   }
+}
+
+/** A robot replaying laser records `from..=to` of `log`. */
+function robotOf(log, name, colour, from, to) {
+  const replay = replayOf(log);
+  try {
+    replay.setRange(from, to);
+  } catch (e) {
+    replay.free();
+    throw e;
+  }
+  const showTruth = !!log.bag && !log.truthHidden;
+  return { name, log: log.name, logId: log.id, from, to, colour, replay, showTruth, truth: null, picture: null, view: null, mapAt: -Infinity, finished: false };
 }
 
 /** What the page shows of each robot. */
 function describe() {
   return {
     records: logs.reduce((s, l) => s + l.records, 0),
-    robots: robots.map(({ name, log, from, to, colour, finished, summary, view }) => ({
-      name, log, from, to, colour, finished, summary: summary ?? null,
+    robots: robots.map(({ name, log, logId, from, to, colour, finished, summary, view, truth }) => ({
+      name, log, logId, from, to, colour, finished, summary: summary ?? null,
       done: view?.done ?? 0, total: to - from + 1, closures: view?.closures.length ?? 0,
+      truth: truth ? { ate_m: truth.ate_m, errors: truth.errors } : null,
+    })),
+    bags: logs.filter((l) => l.bag).map(({ id, name, records, info, lost, picks, auto, picked, truthHidden }) => ({
+      id, name, records, info, lost, picks, auto, picked, truthHidden,
     })),
   };
 }
 
 /**
- * Opens logs (each read here, so a bad one is named with its line): the
- * good ones are robots added to those there are, whose replays go on.
+ * Opens picked or dropped files (`[{file, path}]`, bag-read.js sorts them
+ * into logs and bags, each read here, so a bad one is named with its line
+ * or record): the good ones are robots added to those there are, whose
+ * replays go on.
  */
-function open({ files, cut, colours }) {
-  const errors = [];
+async function open({ files, cut, colours }, id) {
   const before = logs.length;
-  let added = 0;
-  for (const f of files) {
-    const bytes = new Uint8Array(f.bytes);
+  const { items, errors } = await sortFiles(wasm, files);
+  const opened = [];
+  const bags = items.filter((i) => i.bag).length;
+  let bagAt = 0;
+  for (const item of items) {
+    const name = item.log ? item.log.name : item.name;
     try {
-      const probe = LogReplay.open(wasm, bytes);
-      const records = probe.laserRecords();
-      probe.free();
-      logs.push({ name: f.name, bytes, records });
-      added++;
+      if (item.log) {
+        const bytes = new Uint8Array(await item.log.arrayBuffer());
+        const probe = LogReplay.open(wasm, bytes);
+        const records = probe.laserRecords();
+        probe.free();
+        logs.push({ id: nextLog++, name, bytes, records });
+      } else {
+        bagAt++;
+        const reading = (read, total) => postMessage({ type: 'progress', id, reading: { name, read, total, bag: bagAt, of: bags } });
+        logs.push(await openBag(item, reading));
+      }
+      opened.push(name);
     } catch (e) {
-      errors.push(`${f.name}: ${message(e)}`);
+      item.bag?.free();
+      errors.push(named(name, e));
     }
   }
-  if (added) {
+  if (opened.length) {
     try {
       addRobots(logs.slice(before), cut, colours);
     } catch (e) {
-      logs.length = before;
+      for (const log of logs.splice(before)) dropLog(log);
       throw e;
     }
   }
-  return { ...describe(), added, errors };
+  return { ...describe(), added: opened.length, opened, errors };
+}
+
+/** Reads a bag (`item` from sortFiles) and makes its first replay with no picks: what it picks and why. */
+async function openBag(item, progress) {
+  const info = await readBag(item.bag, item.files, progress);
+  const spare = item.bag.replay(LogReplay, {});
+  const auto = spare.picked();
+  const lost = [...info.lost, ...item.missing.map((n) => `${n}: listed in metadata.yaml but not picked or dropped with it`)];
+  return { id: nextLog++, name: item.name, bag: item.bag, info, lost, picks: {}, auto, picked: auto, truthHidden: false, records: spare.laserRecords(), spare };
+}
+
+/**
+ * Makes the replays of bag `log` (an id) anew from its BagFile with
+ * `picks` (`{scan_topic, odom_topic, odom_none, truth_topic}`; and
+ * `truthHidden`: no ground truth drawn), as many stretches as it had:
+ * its robots start again; the others go on. A pick the bag refuses
+ * throws, and nothing changes.
+ */
+function pick({ log: id, picks, truthHidden }) {
+  const log = logs.find((l) => l.id === id && l.bag);
+  if (!log) throw new Error('that bag is no longer open');
+  const probe = log.bag.replay(LogReplay, picks);
+  const next = { ...log, picks, truthHidden: !!truthHidden, spare: probe, picked: probe.picked(), records: probe.laserRecords() };
+  const mine = robots.filter((r) => r.logId === id);
+  const made = [];
+  try {
+    for (const [k, [from, to]] of stretches(next.records, Math.max(1, mine.length)).entries()) {
+      const like = mine[k] ?? mine[0];
+      made.push(robotOf(next, mine[k]?.name ?? `${like.name}_${k + 1}`, like.colour, from, to));
+    }
+  } catch (e) {
+    for (const r of made) r.replay.free();
+    next.spare?.free();
+    throw e;
+  }
+  log.spare?.free();
+  Object.assign(log, next);
+  const at = robots.indexOf(mine[0]);
+  for (const r of mine) r.replay.free();
+  robots.splice(at < 0 ? robots.length : at, mine.length, ...made);
+  merged = null;
+  return describe();
 }
 
 /** Redraws a robot's map from the scans so far, if it is time (or `force`). */
@@ -145,6 +254,7 @@ async function step({ n, size }) {
     const rest = r.replay.step(n);
     left += rest;
     r.view = r.replay.view();
+    r.truth = r.showTruth ? r.replay.truth() : null;
     await refreshMap(r, rest === 0);
   }
   draw(size);
@@ -164,6 +274,7 @@ function finish() {
       r.report = r.replay.report({ finish: performance.now() - t0 });
       r.summary = { scans: r.report.scans.length, closures: r.report.loop_closures.length, map: r.report.map };
       r.view = r.replay.view();
+      r.truth = r.showTruth ? r.replay.truth() : null;
       r.drawnDone = -1; // the settled poses draw a new map
       r.finished = true;
     }
@@ -196,8 +307,8 @@ const handlers = {
     mergeCanvas = data.canvas;
     return {};
   },
-  open: (data) => open(data),
   cut: (data) => (logs.length ? layout(data.cut, data.colours) : describe()),
+  pick: (data) => pick(data),
   step: async (data) => step(data),
   redraw: (data) => {
     draw(data.size);
@@ -212,6 +323,7 @@ const handlers = {
   },
   clear: () => {
     for (const r of robots) r.replay.free();
+    for (const log of logs) dropLog(log);
     merged?.savedMaps.free();
     [logs, robots, merged] = [[], [], null];
     return describe();
@@ -227,6 +339,7 @@ async function answer({ data }) {
     let out;
     if (type === 'finish') out = finish();
     else if (type === 'merge') out = await merge(id);
+    else if (type === 'open') out = { result: await open(data, id), transfer: [] };
     else {
       const handler = handlers[type];
       if (!handler) throw new Error(`unknown request '${type}'`);
