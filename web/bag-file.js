@@ -9,7 +9,8 @@
 // slices — and pushes them in order: the bag is never held whole. Then
 // `finish()` says what the bag holds (as `bag-info --json`), and
 // `replay(picks)` makes a web/log-replay.js `LogReplay` of the scans picked
-// (`{scan_topic, odom_topic, odom_none, truth_topic}`, each optional).
+// (`{scan_topic, odom_topic, odom_none, truth_topic, truth_none}`, each
+// optional; `odom_topic: 'tf'` takes the moving transform of /tf).
 //
 // As web/lab.js does for `Lab`, this module parses every JSON text the
 // binding returns once, here. Errors are thrown as `Error`s whose message

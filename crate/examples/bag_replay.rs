@@ -81,6 +81,7 @@ fn main() -> Result<(), String> {
             odom_none: args.iter().any(|a| a == "--odom-none"),
             odom_topic: after("--odom-topic"),
             truth_topic: after("--truth-topic"),
+            truth_none: args.iter().any(|a| a == "--truth-none"),
             scan_topic: after("--scan-topic"),
         };
         bag.replay(&picks)?

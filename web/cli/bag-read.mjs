@@ -87,7 +87,12 @@ async function folderFiles(bag, dir) {
  * called after each piece.
  */
 export async function readBag(wasm, file, onProgress = () => {}) {
-  const s = await stat(file);
+  let s;
+  try {
+    s = await stat(file);
+  } catch (e) {
+    throw new UsageError(`cannot read '${file}': ${e.code ?? e.message}`);
+  }
   const bag = BagFile.open(wasm, file);
   const files = s.isDirectory() ? await folderFiles(bag, file) : [null];
   const paths = files.map((f) => (f === null ? file : path.join(file, f)));

@@ -18,9 +18,10 @@ export const usage = `  node web/cli.mjs run-log LOG [--json] [--out MAP.yaml] [
       .db3, or a rosbag2 folder) through SLAM with loop closures; --from/--to pick
       laser records N..M (0-based); --out writes the map as ROS map_server PGM + YAML
       and a PNG; --trajectory writes the SLAM poses in TUM format (for evo). For a
-      bag: --scan-topic picks the LaserScan topic, --odom-topic the odometry,
-      --odom-frame NONE maps by scan matching alone, --truth-topic the ground truth
-      (by default a pose topic named as ground truth or from motion capture); --relations
+      bag: --scan-topic picks the LaserScan topic, --odom-topic the odometry (tf: the
+      moving transform of /tf), --odom-frame NONE maps by scan matching alone,
+      --truth-topic the ground truth (NONE: none; by default a pose topic named as
+      ground truth or from motion capture); --relations
       scores the replay against a benchmark's relation file (Kümmerle et al. 2009: t1 t2 x y
       z roll pitch yaw per line): the report's relations, mean, sd and max of the errors`;
 
@@ -50,11 +51,13 @@ async function openLog(wasm, file, options) {
         lastNote = performance.now();
       }
     });
+    const noTruth = options['truth-topic']?.toUpperCase() === 'NONE';
     const picks = {
       scan_topic: options['scan-topic'],
       odom_topic: options['odom-topic'],
       odom_none: options['odom-frame'] !== undefined,
-      truth_topic: options['truth-topic'],
+      truth_topic: noTruth ? undefined : options['truth-topic'],
+      truth_none: noTruth,
     };
     const replay = wasmCall(() => bag.replay(LogReplay, picks));
     bag.free();

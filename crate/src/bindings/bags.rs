@@ -17,7 +17,8 @@ pub struct BagFile {
 }
 
 /// What the page and the CLI may ask of a bag's log (JSON): `scan_topic`,
-/// `odom_topic`, `odom_none`, `truth_topic`, each optional.
+/// `odom_topic` (`"tf"`: the moving transform of `/tf`), `odom_none`,
+/// `truth_topic`, `truth_none`, each optional.
 #[derive(serde::Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 struct PicksJson {
@@ -26,6 +27,8 @@ struct PicksJson {
     #[serde(default)]
     odom_none: bool,
     truth_topic: Option<String>,
+    #[serde(default)]
+    truth_none: bool,
 }
 
 /// Which container a file is from its first bytes (16 are enough):
@@ -97,6 +100,7 @@ impl BagFile {
             odom_topic: p.odom_topic,
             odom_none: p.odom_none,
             truth_topic: p.truth_topic,
+            truth_none: p.truth_none,
         };
         Ok(LogReplay::wrap(self.inner.replay(&picks).map_err(err)?))
     }

@@ -55,7 +55,9 @@ function picksOf(card, auto) {
   if (odom.startsWith('topic:') && odom !== topicValue(auto.odometry)) picks.odom_topic = odom.slice(6);
   const truth = v('truth');
   if (truth.startsWith('topic:') && truth !== topicValue(auto.truth_topic)) picks.truth_topic = truth.slice(6);
-  return { picks, truthHidden: truth === 'none' && !!auto.truth_topic };
+  const truthHidden = truth === 'none' && !!auto.truth_topic;
+  if (truthHidden) picks.truth_none = true;
+  return { picks, truthHidden };
 }
 
 function select(key, label, { options, value }) {

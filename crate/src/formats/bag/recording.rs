@@ -356,12 +356,15 @@ impl MessageSink for BagContents {
 pub struct Picks {
     /// The `LaserScan` topic to map.
     pub scan_topic: Option<String>,
-    /// The `Odometry` (or other pose) topic to take as odometry.
+    /// The `Odometry` (or other pose) topic to take as odometry; `tf`: the
+    /// moving transform to the laser's base in `/tf`.
     pub odom_topic: Option<String>,
     /// No odometry at all: scan matching alone.
     pub odom_none: bool,
     /// The topic holding the ground truth.
     pub truth_topic: Option<String>,
+    /// No ground truth, even where a topic is named as one.
+    pub truth_none: bool,
 }
 
 /// What was picked, and why.
@@ -600,6 +603,18 @@ impl BagContents {
             picked.odometry_reason = "--odom-frame NONE: scan matching alone".into();
             return Ok(None);
         }
+        if picks.odom_topic.as_deref() == Some("tf") {
+            let Some((parent, child)) = self.moving_parent(base) else {
+                return Err(format!(
+                    "--odom-topic tf: no moving transform in /tf ends at the laser's base {base}"
+                ));
+            };
+            picked.odometry = Some(format!("tf {parent} → {child}"));
+            picked.odometry_reason = "given: the moving transform of /tf".into();
+            return Ok(Some(sorted(
+                self.tf[&(parent.clone(), child.clone())].clone(),
+            )));
+        }
         if let Some(t) = &picks.odom_topic {
             if !self.poses.contains_key(t) {
                 return Err(format!(
@@ -662,6 +677,10 @@ impl BagContents {
     /// The ground truth `(time s, pose)`: the topic given, else the first
     /// pose topic named as ground truth, else none.
     fn pick_truth(&self, picks: &Picks, picked: &mut Picked) -> Result<Vec<(f64, Pose2)>, String> {
+        if picks.truth_none {
+            picked.truth_reason = "none, as asked".into();
+            return Ok(Vec::new());
+        }
         let topic = match &picks.truth_topic {
             Some(t) if self.poses.contains_key(t) => {
                 picked.truth_reason = "given".into();
