@@ -622,6 +622,28 @@ fn ros1_lengths_that_lie_are_errors_or_losses_never_panics() {
         )
     );
 
+    // A record inside a chunk whose header field runs past its header.
+    let mut bad_field = ros1w::connection(0, "/scan", "sensor_msgs/LaserScan");
+    bad_field.extend(4u32.to_le_bytes());
+    bad_field.extend(200u32.to_le_bytes());
+    bad_field.extend(0u32.to_le_bytes());
+    let mut field_in_chunk = magic.clone();
+    field_in_chunk.extend(ros1w::chunk("none", &bad_field));
+    let at = ros1w::connection(0, "/scan", "sensor_msgs/LaserScan").len();
+    let (got, end) = read_alike(ros1_reader, &field_in_chunk).unwrap();
+    assert!(
+        got.topics.is_empty(),
+        "nothing of a skipped chunk is handed over"
+    );
+    assert_eq!(
+        end.lost,
+        Some(format!(
+            "chunk 1 at byte 13 is skipped, its messages lost: the record at byte {} \
+             of its data: a header field of 200 bytes runs past the header's end",
+            commas(at)
+        ))
+    );
+
     // A header length running past the end of the file: cut short.
     let mut header_past = magic.clone();
     header_past.extend(500u32.to_le_bytes());

@@ -664,9 +664,13 @@ fn chunk_records(mut records: &[u8]) -> Result<Vec<(Header<'_>, &[u8])>, String>
         };
         let (record, rest) = records.split_at(len);
         let (header_bytes, data) = split_record(record);
-        let label = format!("the record at byte {} of its data", byte_count(offset));
-        let header = parse_header(header_bytes, &label)
-            .map_err(|e| format!("{}: {}", e.record, e.message))?;
+        let header = parse_header(header_bytes, "").map_err(|e| {
+            format!(
+                "the record at byte {} of its data: {}",
+                byte_count(offset),
+                e.message
+            )
+        })?;
         out.push((header, data));
         records = rest;
         offset += len as u64;
