@@ -3,9 +3,11 @@
 //! in pieces of 1 byte, 7 bytes and whole, must give the same topics,
 //! messages, times and payload bytes; messages before their connection or
 //! channel wait for it; a file cut inside a chunk keeps exactly the chunks
-//! before it and says what was lost; unknown compressions, foreign and
-//! legacy files, and lengths that lie are refused with errors naming the
-//! record, never a panic. Runs natively and in node (no file system).
+//! before it and says what was lost; a chunk whose size or CRC lies, or
+//! whose data is damaged, is skipped and said lost, the chunks after it
+//! read; unknown compressions, foreign and legacy files, and record
+//! lengths that lie are refused with errors naming the record, never a
+//! panic. Runs natively and in node (no file system).
 
 use slamlab::formats::bag::mcap::McapReader;
 use slamlab::formats::bag::ros1::Ros1Reader;
@@ -459,14 +461,19 @@ fn ros1_bag_cut_inside_a_chunk_keeps_exactly_the_chunks_before() {
 }
 
 #[wasm_bindgen_test(unsupported = test)]
-fn ros1_unknown_compression_and_a_lying_size_name_the_chunk() {
+fn ros1_unknown_compression_is_refused_and_a_lying_size_skips_the_chunk() {
     let records = [
         ros1w::connection(0, "/scan", "sensor_msgs/LaserScan"),
         ros1w::message(0, time_ns(0), &payload(0, 0)),
     ]
     .concat();
+    let next = [
+        ros1w::connection(0, "/scan", "sensor_msgs/LaserScan"),
+        ros1w::message(0, time_ns(1), &payload(0, 1)),
+    ]
+    .concat();
     let mut start = ros1w::MAGIC.to_vec();
-    start.extend(ros1w::bag_header(0, 1, 1));
+    start.extend(ros1w::bag_header(0, 1, 2));
     let chunk_at = commas(start.len());
 
     let zip = [
@@ -482,28 +489,46 @@ fn ros1_unknown_compression_and_a_lying_size_name_the_chunk() {
         e.message
     );
 
+    // The chunk whose size field lies is skipped and said lost; the chunk
+    // after it is read.
     for compression in ["none", "bz2", "lz4"] {
         let lying = [
             start.clone(),
             ros1w::chunk_sized(compression, records.len() + 1, &records),
+            ros1w::chunk(compression, &next),
         ]
         .concat();
-        let e = read_alike(ros1_reader, &lying).unwrap_err();
+        let (got, end) = read_alike(ros1_reader, &lying).unwrap();
+        assert_eq!(got.messages.len(), 1, "{compression}");
+        assert_eq!(got.messages[0].time_ns, time_ns(1), "{compression}");
+        assert_eq!(got.messages[0].data, payload(0, 1), "{compression}");
+        assert_eq!(end.chunks, 1, "{compression}");
         assert_eq!(
-            e.record,
-            format!("chunk 1 at byte {chunk_at}"),
-            "{compression}"
-        );
-        assert_eq!(
-            e.message,
-            format!(
-                "its size field says {} bytes uncompressed, its data holds {}",
+            end.lost,
+            Some(format!(
+                "chunk 1 at byte {chunk_at} is skipped, its messages lost: \
+                 its size field says {} bytes uncompressed, its data holds {}",
                 records.len() + 1,
                 records.len()
-            ),
+            )),
             "{compression}"
         );
     }
+
+    // Damaged bz2 data: skipped, said so.
+    let mut bad_bz2 = ros1w::chunk("bz2", &records);
+    let n = bad_bz2.len();
+    bad_bz2[n - 20..n - 10].fill(0x55);
+    let damaged = [start.clone(), bad_bz2, ros1w::chunk("none", &next)].concat();
+    let (got, end) = read_alike(ros1_reader, &damaged).unwrap();
+    assert_eq!(got.messages.len(), 1);
+    assert_eq!(
+        end.lost,
+        Some(format!(
+            "chunk 1 at byte {chunk_at} is skipped, its messages lost: \
+             its bz2 data cannot be decompressed: bzip2: invalid data"
+        ))
+    );
 }
 
 #[wasm_bindgen_test(unsupported = test)]
@@ -566,28 +591,57 @@ fn ros1_lengths_that_lie_are_errors_or_losses_never_panics() {
     let e = read_alike(ros1_reader, &huge_data).unwrap_err();
     assert!(e.message.contains("more than 1 GiB"), "{}", e.message);
 
-    // A record inside a chunk runs past the chunk's end.
+    // A record inside a chunk runs past the chunk's end: the chunk is
+    // skipped, said lost.
     let mut inner = ros1w::message(0, 0, &payload(0, 0));
     let n = inner.len();
     inner.truncate(n - 5);
     let mut past_chunk = magic.clone();
     past_chunk.extend(ros1w::chunk("bz2", &inner));
-    let e = read_alike(ros1_reader, &past_chunk).unwrap_err();
-    assert_eq!(e.record, "chunk 1 at byte 13");
+    let (got, end) = read_alike(ros1_reader, &past_chunk).unwrap();
+    assert!(got.messages.is_empty());
     assert_eq!(
-        e.message,
-        "the record at byte 0 of its data runs past the chunk's end"
+        end.lost.as_deref(),
+        Some(
+            "chunk 1 at byte 13 is skipped, its messages lost: \
+             the record at byte 0 of its data runs past the chunk's end"
+        )
     );
 
     // A record inside a chunk with a header said to be 2 MiB long.
     let mut huge_inner = magic.clone();
     huge_inner.extend(ros1w::chunk("lz4", &(2u32 << 20).to_le_bytes()));
-    let e = read_alike(ros1_reader, &huge_inner).unwrap_err();
-    assert_eq!(e.record, "chunk 1 at byte 13");
+    let (got, end) = read_alike(ros1_reader, &huge_inner).unwrap();
+    assert!(got.messages.is_empty());
     assert_eq!(
-        e.message,
-        "the record at byte 0 of its data: its header is 2,097,152 bytes long, \
-         more than 1 MiB: the file is damaged"
+        end.lost.as_deref(),
+        Some(
+            "chunk 1 at byte 13 is skipped, its messages lost: \
+             the record at byte 0 of its data: its header is 2,097,152 bytes long, \
+             more than 1 MiB: the file is damaged"
+        )
+    );
+
+    // A record inside a chunk whose header field runs past its header.
+    let mut bad_field = ros1w::connection(0, "/scan", "sensor_msgs/LaserScan");
+    bad_field.extend(4u32.to_le_bytes());
+    bad_field.extend(200u32.to_le_bytes());
+    bad_field.extend(0u32.to_le_bytes());
+    let mut field_in_chunk = magic.clone();
+    field_in_chunk.extend(ros1w::chunk("none", &bad_field));
+    let at = ros1w::connection(0, "/scan", "sensor_msgs/LaserScan").len();
+    let (got, end) = read_alike(ros1_reader, &field_in_chunk).unwrap();
+    assert!(
+        got.topics.is_empty(),
+        "nothing of a skipped chunk is handed over"
+    );
+    assert_eq!(
+        end.lost,
+        Some(format!(
+            "chunk 1 at byte 13 is skipped, its messages lost: the record at byte {} \
+             of its data: a header field of 200 bytes runs past the header's end",
+            commas(at)
+        ))
     );
 
     // A header length running past the end of the file: cut short.

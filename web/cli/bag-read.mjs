@@ -4,7 +4,8 @@
 // data files it lists, or, without one, every `.db3` / `.mcap` in it by
 // name). Each file is read 8 MiB at a time and pushed as it comes, so a bag
 // is never held whole in node's memory; a `.db3-wal` file goes before its
-// `.db3`. Whether a file is a bag at all is told from its first bytes.
+// `.db3`. Whether a file is a bag at all is told from its name or its
+// first bytes.
 import { open, readFile, readdir, stat } from 'node:fs/promises';
 import path from 'node:path';
 import { BagFile, bagKind } from '../bag-file.js';
@@ -24,7 +25,12 @@ async function head(file) {
   }
 }
 
-/** True when `file` is a bag: a folder, or a file whose first bytes say ROS 1, MCAP or SQLite. */
+/**
+ * True when `file` is a bag: a folder, a file named as one (`.bag`,
+ * `.mcap`, `.db3`: read as a bag even when its bytes are not one, so the
+ * message says what is wrong with it as a bag), or a file whose first
+ * bytes say ROS 1, MCAP or SQLite.
+ */
 export async function isBag(wasm, file) {
   let s;
   try {
@@ -32,7 +38,7 @@ export async function isBag(wasm, file) {
   } catch (e) {
     throw new UsageError(`cannot read '${file}': ${e.code ?? e.message}`);
   }
-  if (s.isDirectory()) return true;
+  if (s.isDirectory() || /\.(bag|mcap|db3)$/i.test(file)) return true;
   return bagKind(wasm, await head(file)) !== '';
 }
 

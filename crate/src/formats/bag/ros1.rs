@@ -44,10 +44,25 @@
 //! file. A file cut short keeps every message of the chunks before the
 //! cut, and [`ReadEnd::lost`] says where it ends. Lengths are checked
 //! against their record before they are used: a header longer than 1 MiB,
-//! a record longer than 1 GiB, a field running past its header or a
-//! record past its chunk are errors naming the record, never an
-//! allocation or a panic. Chunks are numbered from 1 in file order in
-//! messages, with the byte offset of their record.
+//! a record longer than 1 GiB or a field running past its header are
+//! errors naming the record, never an allocation or a panic. Chunks are
+//! numbered from 1 in file order in messages, with the byte offset of
+//! their record.
+//!
+//! ## A damaged chunk is skipped, not fatal
+//!
+//! A chunk's own record (`header_len`, `data_len`) frames the file; what
+//! it holds is checked when it is opened: its data must decompress, give
+//! exactly the bytes its `size` field says, and split into whole records
+//! with readable headers, all before any of its messages is handed over.
+//! A chunk that fails (its `size` lies, its bz2 or lz4 data is damaged, a
+//! record inside it runs past its end) is skipped whole, as the MCAP
+//! reader skips one, and [`ReadEnd::lost`] names it and says why; the
+//! chunks after it are read as usual. A chunk whose *record* length lies
+//! throws the framing off instead, and the next "record" is refused with
+//! an error naming its offset. A chunk compressed with something other
+//! than none, bz2 or lz4 is an error naming the chunk and the
+//! compression, since every later chunk is likely the same.
 //!
 //! The older format 1.2 (`#ROSRECORD V1.2`, ROS before C Turtle) has no
 //! chunks nor connections, and is refused with a message saying so. ROS
@@ -57,6 +72,7 @@
 use super::stream::{byte_count, shown, u32_at, Extent, Flow, Records, Waiting};
 use super::stream::{HEADER_LIMIT, RECORD_LIMIT};
 use super::{BagError, BagReader, Encoding, MessageSink, RawMessage, ReadEnd, Topic};
+use std::borrow::Cow;
 use std::collections::HashSet;
 use std::io::Read;
 
@@ -108,6 +124,8 @@ struct State {
     bag_header: Option<BagHeader>,
     /// Chunks met (the number of the last one, counting from 1).
     chunks_met: usize,
+    /// The chunks skipped, and why.
+    skipped: Vec<String>,
     end: ReadEnd,
 }
 
@@ -193,7 +211,7 @@ impl BagReader for Ros1Reader {
                 not_a_bag(&self.magic)
             });
         }
-        let mut lost = Vec::new();
+        let mut lost = self.state.skipped.clone();
         if let Some(cut) = self.cut_short() {
             lost.push(cut);
         }
@@ -535,7 +553,8 @@ impl State {
         self.waiting.release(id, sink)
     }
 
-    /// A chunk record at file offset `at`: opened, its records read.
+    /// A chunk record at file offset `at`: opened, checked, its records
+    /// read; or skipped, and the reason kept for [`ReadEnd::lost`].
     fn chunk(
         &mut self,
         header: &Header<'_>,
@@ -546,60 +565,13 @@ impl State {
         self.chunks_met += 1;
         let label = format!("chunk {} at byte {}", self.chunks_met, byte_count(at));
         let compression = header.compression.unwrap_or(b"none");
-        let size = match (header.size, compression) {
-            (Some(size), _) => size as usize,
-            (None, b"none") => data.len(),
-            (None, _) => {
-                return Err(BagError::new(
-                    &label,
-                    "a compressed chunk without its `size` field",
-                ))
-            }
-        };
-        if size as u64 > RECORD_LIMIT {
+        if !matches!(compression, b"none" | b"bz2" | b"lz4") {
             return Err(BagError::new(
                 &label,
                 format!(
-                    "its size field says {} bytes, more than {} GiB: the file is damaged",
-                    byte_count(size as u64),
-                    RECORD_LIMIT >> 30
-                ),
-            ));
-        }
-        let opened;
-        let records: &[u8] = match compression {
-            b"none" => data,
-            b"bz2" => {
-                opened = inflate(bzip2::bufread::BzDecoder::new(data), size, &label, "bz2")?;
-                &opened
-            }
-            b"lz4" => {
-                opened = inflate(
-                    lz4_flex::frame::FrameDecoder::new(data),
-                    size,
-                    &label,
-                    "lz4",
-                )?;
-                &opened
-            }
-            other => {
-                return Err(BagError::new(
-                    &label,
-                    format!(
-                        "its compression is {}, which this reader does not know \
-                         (format 2.0 writes none, bz2 or lz4)",
-                        shown(other)
-                    ),
-                ))
-            }
-        };
-        if records.len() != size {
-            return Err(BagError::new(
-                &label,
-                format!(
-                    "its size field says {} bytes uncompressed, its data holds {}",
-                    byte_count(size as u64),
-                    byte_count(records.len() as u64)
+                    "its compression is {}, which this reader does not know \
+                     (format 2.0 writes none, bz2 or lz4)",
+                    shown(compression)
                 ),
             ));
         }
@@ -607,58 +579,113 @@ impl State {
         if !self.end.compression.contains(&name) {
             self.end.compression.push(name);
         }
-        self.chunk_records(records, &label, sink)?;
+        let opened = match open_chunk(header.size, compression, data) {
+            Ok(opened) => opened,
+            Err(why) => {
+                self.skip(&label, why);
+                return Ok(());
+            }
+        };
+        let records = match chunk_records(&opened) {
+            Ok(records) => records,
+            Err(why) => {
+                self.skip(&label, why);
+                return Ok(());
+            }
+        };
+        for (header, data) in records {
+            self.inner_record(&header, data, &label, Place::Chunk(&label), sink)?;
+        }
         self.end.chunks += 1;
         Ok(())
     }
 
-    /// The records of an opened chunk.
-    fn chunk_records(
-        &mut self,
-        mut records: &[u8],
-        label: &str,
-        sink: &mut dyn MessageSink,
-    ) -> Result<(), BagError> {
-        let mut offset = 0u64;
-        while !records.is_empty() {
-            let past_end = || {
-                BagError::new(
-                    label,
-                    format!(
-                        "the record at byte {} of its data runs past the chunk's end",
-                        byte_count(offset)
-                    ),
-                )
-            };
-            let len = match record_extent(records, offset).map_err(|e| {
-                BagError::new(label, format!("{} of its data: {}", e.record, e.message))
-            })? {
-                Extent::Whole(len) if len <= records.len() => len,
-                _ => return Err(past_end()),
-            };
-            let (header_bytes, data) = split_record(&records[..len]);
-            let header = parse_header(header_bytes, label)?;
-            self.inner_record(&header, data, label, Place::Chunk(label), sink)?;
-            records = &records[len..];
-            offset += len as u64;
-        }
-        Ok(())
+    fn skip(&mut self, label: &str, why: String) {
+        self.skipped
+            .push(format!("{label} is skipped, its messages lost: {why}"));
     }
+}
+
+/// Decompresses a chunk's data (`compression` one of `none`, `bz2`,
+/// `lz4`) and checks it against its `size` field.
+fn open_chunk<'a>(
+    size: Option<u32>,
+    compression: &[u8],
+    data: &'a [u8],
+) -> Result<Cow<'a, [u8]>, String> {
+    let size = match (size, compression) {
+        (Some(size), _) => size as usize,
+        (None, b"none") => data.len(),
+        (None, _) => return Err("a compressed chunk without its `size` field".into()),
+    };
+    if size as u64 > RECORD_LIMIT {
+        return Err(format!(
+            "its size field says {} bytes, more than {} GiB",
+            byte_count(size as u64),
+            RECORD_LIMIT >> 30
+        ));
+    }
+    let opened = match compression {
+        b"bz2" => Cow::Owned(inflate(bzip2::bufread::BzDecoder::new(data), size, "bz2")?),
+        b"lz4" => Cow::Owned(inflate(
+            lz4_flex::frame::FrameDecoder::new(data),
+            size,
+            "lz4",
+        )?),
+        _ => Cow::Borrowed(data),
+    };
+    if opened.len() != size {
+        return Err(format!(
+            "its size field says {} bytes uncompressed, its data holds {}",
+            byte_count(size as u64),
+            byte_count(opened.len() as u64)
+        ));
+    }
+    Ok(opened)
+}
+
+/// Frames every record of an opened chunk and reads its header, or says
+/// why it cannot.
+fn chunk_records(mut records: &[u8]) -> Result<Vec<(Header<'_>, &[u8])>, String> {
+    let mut out = Vec::new();
+    let mut offset = 0u64;
+    while !records.is_empty() {
+        let past_end = || {
+            format!(
+                "the record at byte {} of its data runs past the chunk's end",
+                byte_count(offset)
+            )
+        };
+        let len = match record_extent(records, offset)
+            .map_err(|e| format!("{} of its data: {}", e.record, e.message))?
+        {
+            Extent::Whole(len) if len <= records.len() => len,
+            _ => return Err(past_end()),
+        };
+        let (record, rest) = records.split_at(len);
+        let (header_bytes, data) = split_record(record);
+        let header = parse_header(header_bytes, "").map_err(|e| {
+            format!(
+                "the record at byte {} of its data: {}",
+                byte_count(offset),
+                e.message
+            )
+        })?;
+        out.push((header, data));
+        records = rest;
+        offset += len as u64;
+    }
+    Ok(out)
 }
 
 /// Decompresses a chunk expected to give `size` bytes; reads at most one
 /// byte more, so a chunk that would give far more is caught without
 /// holding it.
-fn inflate(reader: impl Read, size: usize, label: &str, name: &str) -> Result<Vec<u8>, BagError> {
+fn inflate(reader: impl Read, size: usize, name: &str) -> Result<Vec<u8>, String> {
     let mut out = Vec::with_capacity(size.min(64 << 20));
     reader
         .take(size as u64 + 1)
         .read_to_end(&mut out)
-        .map_err(|e| {
-            BagError::new(
-                label,
-                format!("its {name} data cannot be decompressed: {e}"),
-            )
-        })?;
+        .map_err(|e| format!("its {name} data cannot be decompressed: {e}"))?;
     Ok(out)
 }
