@@ -5,7 +5,7 @@
 //! formats of one log).
 //!
 //! `cargo run --release -p slamlab --example bag_replay -- BAG_OR_LOG [--poses] [--png MAP.png]
-//!  [--odom-none] [--odom-topic T] [--scan-topic T] [--truth-topic T] [--relations FILE]`
+//!  [--odom-none] [--odom-topic T] [--scan-topic T] [--truth-topic T] [--relations FILE] [--json REPORT.json]`
 //! (settings to measure: `SLAMLAB_LOG_SLAM=key=value,...`)
 
 #[path = "../../tests/real_support/mod.rs"]
@@ -92,6 +92,15 @@ fn main() -> Result<(), String> {
     // Settings to measure: SLAMLAB_LOG_SLAM="key=value,..." as for the
     // other log examples.
     replay.configure(|c| *c = support::config_from_env())?;
+    // --half first|second: that half of the scans on its own.
+    if let Some(i) = args.iter().position(|a| a == "--half") {
+        let n = replay.laser_records();
+        match args.get(i + 1).map(String::as_str) {
+            Some("first") => replay.set_range(0, Some(n / 2 - 1))?,
+            Some("second") => replay.set_range(n / 2, None)?,
+            _ => return Err("--half first|second".into()),
+        }
+    }
     if let Some(i) = args.iter().position(|a| a == "--relations") {
         let file = args.get(i + 1).ok_or("--relations FILE")?;
         replay.set_relations(&std::fs::read_to_string(file).map_err(|e| e.to_string())?)?;
@@ -144,6 +153,14 @@ fn main() -> Result<(), String> {
     if let Some(i) = args.iter().position(|a| a == "--png") {
         let out = args.get(i + 1).ok_or("--png FILE")?;
         std::fs::write(out, replay.map_png()?).map_err(|e| e.to_string())?;
+    }
+    if let Some(i) = args.iter().position(|a| a == "--json") {
+        let out = args.get(i + 1).ok_or("--json FILE")?;
+        std::fs::write(
+            out,
+            serde_json::to_string(&report).map_err(|e| e.to_string())?,
+        )
+        .map_err(|e| e.to_string())?;
     }
     if poses {
         for s in &report.scans {

@@ -309,6 +309,8 @@ pub fn config_from_env() -> LogSlamConfig {
             "match_range_m" => cfg.match_range_m = v,
             "fill_ratio" => cfg.fill_ratio = v,
             "icp_iterations" => cfg.icp_iterations = v as usize,
+            "loop_icp_iterations" => cfg.loop_icp_iterations = v as usize,
+            "icp_prior" => cfg.icp_prior = v,
             "icp_huber_m" => cfg.icp_huber_m = v,
             "icp_radius_m" => cfg.icp_radius_m = v,
             "icp_max_move_m" => cfg.icp_max_move_m = v,

@@ -31,12 +31,12 @@ async function head(file) {
  * message says what is wrong with it as a bag), or a file whose first
  * bytes say ROS 1, MCAP or SQLite.
  */
-export async function isBag(wasm, file) {
+export async function isBag(wasm, file, what = 'file') {
   let s;
   try {
     s = await stat(file);
   } catch (e) {
-    throw new UsageError(`cannot read '${file}': ${e.code ?? e.message}`);
+    throw new UsageError(`cannot read ${what} '${file}': ${e.code ?? e.message}`);
   }
   if (s.isDirectory() || /\.(bag|mcap|db3)$/i.test(file)) return true;
   return bagKind(wasm, await head(file)) !== '';

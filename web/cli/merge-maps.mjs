@@ -17,7 +17,7 @@ export const usage = `  node web/cli.mjs merge-maps MAP.yaml MAP.yaml [MAP.yaml 
 
 /** Reads one map — a YAML and the image it names, or a bag's map topic — into `maps` (a SavedMaps); returns its index. */
 async function readMap(maps, file, wasm) {
-  if (await isBag(wasm, file)) {
+  if (await isBag(wasm, file, 'map')) {
     const { bag } = await readBag(wasm, file);
     const index = wasmCall(() => maps.addBagMap(bag));
     bag.free();

@@ -43,7 +43,7 @@ async function openLog(wasm, file, options) {
   if (options['odom-frame'] !== undefined && options['odom-topic'] !== undefined) {
     throw new UsageError('--odom-topic and --odom-frame NONE contradict each other');
   }
-  if (await isBag(wasm, file)) {
+  if (await isBag(wasm, file, 'log')) {
     let lastNote = performance.now();
     const { bag } = await readBag(wasm, file, (done, total) => {
       if (!options.json && performance.now() - lastNote > 2000) {

@@ -209,6 +209,12 @@ pub struct LogSlamConfig {
     pub icp_radius_m: f64,
     pub icp_max_move_m: f64,
     pub icp_max_turn_rad: f64,
+    /// The refinement is held near the match by a prior worth this many
+    /// points ([`crate::slam::icp::IcpTarget::align_near`]).
+    pub icp_prior: f64,
+    /// The same refinement of each loop closure's match on the visit's
+    /// points (0: off).
+    pub loop_icp_iterations: usize,
     /// Whether the scans carry odometry. Without it (a hand-carried laser,
     /// a simulator's bag of scans alone) each scan is predicted from the
     /// last one by the motion the estimate made between the two before
@@ -264,6 +270,8 @@ impl Default for LogSlamConfig {
             icp_radius_m: 0.2,
             icp_max_move_m: 0.1,
             icp_max_turn_rad: 2f64.to_radians(),
+            icp_prior: 0.0,
+            loop_icp_iterations: 0,
             fill_ratio: 0.0,
             fill_max_m: 1.0,
             odometry: true,
@@ -502,7 +510,13 @@ impl LogSlam {
         let Some(target) = self.local_icp.as_ref().filter(|_| cfg.icp_iterations > 0) else {
             return pose;
         };
-        let fit = target.align(points, &pose, cfg.icp_huber_m, cfg.icp_iterations);
+        let fit = target.align_near(
+            points,
+            &pose,
+            cfg.icp_huber_m,
+            cfg.icp_iterations,
+            cfg.icp_prior,
+        );
         let d = pose.between(&fit.pose);
         if fit.associated * 2 < points.len()
             || d.position().length() > cfg.icp_max_move_m
@@ -685,14 +699,14 @@ impl LogSlam {
             return;
         }
         // The closure's pose off the raster's grain (as each scan's).
-        if self.config.icp_iterations > 0 {
+        if self.config.loop_icp_iterations > 0 {
             let loops = &self.config.loops;
             let fit = closure_icp(
                 &self.graph.nodes,
                 &self.key_points,
                 &found,
                 loops,
-                self.config.icp_iterations,
+                self.config.loop_icp_iterations,
             );
             let at = self.graph.nodes[found.edge.from].compose(&found.edge.measurement);
             let d = at.between(&fit.pose);
