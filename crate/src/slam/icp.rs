@@ -27,7 +27,6 @@ use std::collections::HashMap;
 
 /// The points a scan is aligned to, with their normals, bucketed for the
 /// nearest-point search.
-#[derive(Clone, Debug)]
 pub struct IcpTarget {
     points: Vec<DVec2>,
     normals: Vec<DVec2>,
@@ -119,22 +118,6 @@ impl IcpTarget {
         huber_m: f64,
         iterations: usize,
     ) -> IcpFit {
-        self.align_near(points, start, huber_m, iterations, 0.0)
-    }
-
-    /// [`IcpTarget::align`] held near `start` by a prior worth `prior`
-    /// points on each axis (in metres; the heading's in metre-radians, as
-    /// for a point a metre away): where the points pin the pose weakly (a
-    /// corridor's long axis), the answer stays where it started instead of
-    /// sliding.
-    pub fn align_near(
-        &self,
-        points: &[DVec2],
-        start: &Pose2,
-        huber_m: f64,
-        iterations: usize,
-        prior: f64,
-    ) -> IcpFit {
         let mut pose = *start;
         let (mut weak, mut associated) = (0.0, 0);
         let (mut strong, mut weak_direction) = (0.0, DVec2::X);
@@ -158,14 +141,8 @@ impl IcpTarget {
             }
             let (l1, l2, along) = symmetric_eigen2(h[0][0], h[0][1], h[1][1]);
             (strong, weak, weak_direction) = (l1, l2, along);
-            let off = [
-                pose.x - start.x,
-                pose.y - start.y,
-                wrap_angle(pose.theta - start.theta),
-            ];
             for (a, row) in h.iter_mut().enumerate() {
-                row[a] += 1e-6 + prior;
-                g[a] += prior * off[a];
+                row[a] += 1e-6;
             }
             let Some(d) = solve3(h, [-g[0], -g[1], -g[2]]) else {
                 break;

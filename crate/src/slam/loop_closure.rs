@@ -364,19 +364,6 @@ pub fn closure_fit(
     c: &Closure,
     cfg: &LoopConfig,
 ) -> IcpFit {
-    closure_icp(nodes, key_points, c, cfg, 1)
-}
-
-/// Closure `c`'s match refined by `iterations` steps of point-to-line ICP
-/// on the visit's scans ([`closure_fit`]'s alignment, iterated): the new
-/// key's pose off the raster's grain, with the information there.
-pub fn closure_icp(
-    nodes: &[Pose2],
-    key_points: &[Vec<DVec2>],
-    c: &Closure,
-    cfg: &LoopConfig,
-    iterations: usize,
-) -> IcpFit {
     let (i, centre) = (c.edge.to, c.edge.from);
     let (mut points, mut normals) = (Vec::new(), Vec::new());
     for j in visit_keys(i, centre, cfg) {
@@ -389,12 +376,8 @@ pub fn closure_icp(
         );
     }
     let found = nodes[centre].compose(&c.edge.measurement);
-    IcpTarget::new(&points, &normals, PIN_RADIUS_M).align(
-        &key_points[i],
-        &found,
-        PIN_HUBER_M,
-        iterations,
-    )
+    // One pass: the information at the matched pose, not a refined one.
+    IcpTarget::new(&points, &normals, PIN_RADIUS_M).align(&key_points[i], &found, PIN_HUBER_M, 1)
 }
 
 /// Closure `c`'s edge made loose along its weak direction: the variance

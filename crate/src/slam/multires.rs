@@ -30,40 +30,6 @@ use super::likelihood::LikelihoodField;
 use crate::geom::Pose2;
 use glam::DVec2;
 
-/// A scan's points (in scan order, in the robot's frame) with the gap
-/// between neighbours on one surface filled every `step_m`, for the tables
-/// a later scan is matched against. Two neighbours lie on one surface when
-/// they are no farther apart than `ratio` times the gap a surface facing
-/// the laser would leave between them (their range times the angle
-/// between them as the robot sees them), and than `max_m`.
-///
-/// Why: the tables mark the cells the points fall in, and a laser samples
-/// a wall densely near the robot and sparsely far from it (or seen
-/// obliquely). A later scan, taken further on, samples the same wall at
-/// other places; its points score more where the old marks are dense, so
-/// the match is pulled back towards where the old scan was taken. On the
-/// benchmark's relations the pull is 0.6 to 4 cm per match along the
-/// robot's motion (the example `scan_match_bias`); filled surfaces score
-/// the same wherever along them a point falls.
-pub fn surface_points(points: &[DVec2], step_m: f64, ratio: f64, max_m: f64) -> Vec<DVec2> {
-    let mut out = Vec::with_capacity(points.len() * 2);
-    for w in points.windows(2) {
-        let (p, q) = (w[0], w[1]);
-        out.push(p);
-        let d = p.distance(q);
-        let angle = p.perp_dot(q).atan2(p.dot(q)).abs();
-        let reach = p.length().max(q.length()) * angle * ratio;
-        if d <= reach.min(max_m) && d > step_m {
-            let n = (d / step_m).ceil() as usize;
-            for i in 1..n {
-                out.push(p.lerp(q, i as f64 / n as f64));
-            }
-        }
-    }
-    out.extend(points.last());
-    out
-}
-
 /// Blur weights `exp(−d² / 2)` for d = 0, 1, 2 cells.
 const BLUR: [f32; 3] = [1.0, 0.606_530_66, 0.135_335_28];
 

@@ -112,16 +112,14 @@
 
 use super::scan::LogScan;
 use crate::geom::{wrap_angle, Pose2};
-use crate::slam::degeneracy::scan_normals_within;
 use crate::slam::grid::{GridConfig, OccupancyGrid, GROW_STEP_CELLS};
-use crate::slam::icp::IcpTarget;
 use crate::slam::likelihood::LikelihoodField;
 use crate::slam::loop_closure::{
-    closure_fit, closure_icp, closures_agree, find_closure_among, loosened_along_weak,
-    on_window_edge, Closure, LoopConfig,
+    closure_fit, closures_agree, find_closure_among, loosened_along_weak, on_window_edge, Closure,
+    LoopConfig,
 };
 use crate::slam::manhattan::{scan_direction, settle_priors, ManhattanConfig};
-use crate::slam::multires::{field_from_points, match_scan, surface_points, ScanMatch, Window};
+use crate::slam::multires::{field_from_points, match_scan, ScanMatch, Window};
 use crate::slam::posegraph::{Edge, PoseGraph};
 use glam::DVec2;
 
@@ -195,26 +193,6 @@ pub struct LogSlamConfig {
     /// `None`: off). On: a building whose walls are not square gets no
     /// prior.
     pub manhattan: Option<ManhattanConfig>,
-    /// The local map's surfaces filled between a key's neighbouring points
-    /// ([`crate::slam::multires::surface_points`]): neighbours up to this
-    /// many times the gap of a surface facing the laser apart (0: off), and
-    /// at most `fill_max_m`.
-    pub fill_ratio: f64,
-    pub fill_max_m: f64,
-    /// Each matched scan's pose refined by point-to-line ICP on the local
-    /// map's points: this many iterations (0: off), Huber threshold, and
-    /// the largest move from the match it may make.
-    pub icp_iterations: usize,
-    pub icp_huber_m: f64,
-    pub icp_radius_m: f64,
-    pub icp_max_move_m: f64,
-    pub icp_max_turn_rad: f64,
-    /// The refinement is held near the match by a prior worth this many
-    /// points ([`crate::slam::icp::IcpTarget::align_near`]).
-    pub icp_prior: f64,
-    /// The same refinement of each loop closure's match on the visit's
-    /// points (0: off).
-    pub loop_icp_iterations: usize,
     /// Whether the scans carry odometry. Without it (a hand-carried laser,
     /// a simulator's bag of scans alone) each scan is predicted from the
     /// last one by the motion the estimate made between the two before
@@ -265,15 +243,6 @@ impl Default for LogSlamConfig {
             far_min_score: 0.7,
             loop_loosen_ratio: 10.0,
             manhattan: Some(ManhattanConfig::for_logs()),
-            icp_iterations: 0,
-            icp_huber_m: 0.02,
-            icp_radius_m: 0.2,
-            icp_max_move_m: 0.1,
-            icp_max_turn_rad: 2f64.to_radians(),
-            icp_prior: 0.0,
-            loop_icp_iterations: 0,
-            fill_ratio: 0.0,
-            fill_max_m: 1.0,
             odometry: true,
         }
     }
@@ -305,8 +274,6 @@ pub struct LogSlamStats {
     pub scans: usize,
     pub keys: usize,
     pub matched: usize,
-    /// Matched scans whose pose point-to-line ICP refined.
-    pub refined: usize,
     pub wide_searches: usize,
     pub unmatched: usize,
     /// Scans also matched around the constant-velocity prediction, and how
@@ -331,12 +298,6 @@ pub struct LogSlam {
     pub config: LogSlamConfig,
     pub graph: PoseGraph,
     key_points: Vec<Vec<DVec2>>,
-    /// Each key's normals (for the local map's ICP target).
-    key_normals: Vec<Vec<Option<DVec2>>>,
-    /// The local map's points with their normals, for ICP.
-    local_icp: Option<IcpTarget>,
-    /// Each key's points with its surfaces filled (for the local map).
-    key_surfaces: Vec<Vec<DVec2>>,
     key_scan: Vec<usize>,
     pub scans: Vec<ScanEntry>,
     local: Option<LikelihoodField>,
@@ -420,9 +381,6 @@ impl LogSlam {
             config,
             graph: PoseGraph::default(),
             key_points: Vec::new(),
-            key_surfaces: Vec::new(),
-            key_normals: Vec::new(),
-            local_icp: None,
             key_scan: Vec::new(),
             scans: Vec::new(),
             local: None,
@@ -467,7 +425,7 @@ impl LogSlam {
         let pose = match &found {
             Some(m) => {
                 self.stats.matched += 1;
-                self.refined(&points, m.pose)
+                m.pose
             }
             None => {
                 self.stats.unmatched += 1;
@@ -500,32 +458,6 @@ impl LogSlam {
         self.last_dt = scan.time - self.last_time;
         self.last_time = scan.time;
         self.last = Some((now, scan.odometry));
-    }
-
-    /// A matched pose refined on the local map's points themselves by
-    /// point-to-line ICP ([`crate::slam::icp`]), off the raster's grain;
-    /// kept only when enough points take part and it stays near the match.
-    fn refined(&mut self, points: &[DVec2], pose: Pose2) -> Pose2 {
-        let cfg = &self.config;
-        let Some(target) = self.local_icp.as_ref().filter(|_| cfg.icp_iterations > 0) else {
-            return pose;
-        };
-        let fit = target.align_near(
-            points,
-            &pose,
-            cfg.icp_huber_m,
-            cfg.icp_iterations,
-            cfg.icp_prior,
-        );
-        let d = pose.between(&fit.pose);
-        if fit.associated * 2 < points.len()
-            || d.position().length() > cfg.icp_max_move_m
-            || d.theta.abs() > cfg.icp_max_turn_rad
-        {
-            return pose;
-        }
-        self.stats.refined += 1;
-        fit.pose
     }
 
     /// The constant-velocity step to a scan at `time`: the last step, scaled
@@ -603,22 +535,6 @@ impl LogSlam {
             self.graph.edges.push(Edge::new(p, id, z, sm, sr));
         }
         self.unmatched_since_key = false;
-        let surfaces = if self.config.fill_ratio > 0.0 {
-            surface_points(
-                &points,
-                self.config.resolution_m / 2.0,
-                self.config.fill_ratio,
-                self.config.fill_max_m,
-            )
-        } else {
-            Vec::new()
-        };
-        self.key_surfaces.push(surfaces);
-        self.key_normals.push(if self.config.icp_iterations > 0 {
-            scan_normals_within(&points, 0.35)
-        } else {
-            Vec::new()
-        });
         self.key_points.push(points);
         self.weak_keys.push(weak);
         self.key_scan.push(scan.index);
@@ -642,7 +558,6 @@ impl LogSlam {
         let n = self.graph.nodes.len();
         let from = n.saturating_sub(self.config.local_keys);
         let mut world = Vec::new();
-        let (mut icp_points, mut icp_normals) = (Vec::new(), Vec::new());
         for k in from..n {
             // A weakly matched key, once another key follows it (see the
             // module doc).
@@ -650,19 +565,8 @@ impl LogSlam {
                 continue;
             }
             let f = self.graph.nodes[k].frame();
-            let points = if self.config.fill_ratio > 0.0 {
-                &self.key_surfaces[k]
-            } else {
-                &self.key_points[k]
-            };
-            world.extend(points.iter().map(|&p| f.to_parent(p)));
-            if self.config.icp_iterations > 0 {
-                icp_points.extend(self.key_points[k].iter().map(|&p| f.to_parent(p)));
-                icp_normals.extend(self.key_normals[k].iter().map(|n| n.map(|n| f.rotate(n))));
-            }
+            world.extend(self.key_points[k].iter().map(|&p| f.to_parent(p)));
         }
-        self.local_icp = (self.config.icp_iterations > 0)
-            .then(|| IcpTarget::new(&icp_points, &icp_normals, self.config.icp_radius_m));
         self.local = Some(field_from_points(
             &world,
             self.config.resolution_m,
@@ -697,25 +601,6 @@ impl LogSlam {
         if self.config.loop_edge_reject && self.on_window_edge(&found) {
             self.stats.closures_on_edge += 1;
             return;
-        }
-        // The closure's pose off the raster's grain (as each scan's).
-        if self.config.loop_icp_iterations > 0 {
-            let loops = &self.config.loops;
-            let fit = closure_icp(
-                &self.graph.nodes,
-                &self.key_points,
-                &found,
-                loops,
-                self.config.loop_icp_iterations,
-            );
-            let at = self.graph.nodes[found.edge.from].compose(&found.edge.measurement);
-            let d = at.between(&fit.pose);
-            if fit.associated * 2 >= self.key_points[id].len()
-                && d.position().length() <= self.config.icp_max_move_m
-                && d.theta.abs() <= self.config.icp_max_turn_rad
-            {
-                found.edge.measurement = self.graph.nodes[found.edge.from].between(&fit.pose);
-            }
         }
         // Loose along the direction the match pins least (a corridor's).
         if self.config.loop_loosen_ratio > 1.0 {
