@@ -1,5 +1,6 @@
 // End-to-end test of ROS bags in "Your log" (web/page/real/: log-panel.js,
-// bag-picks.js, bag-read.js, truth-plot.js; issue 53, item 4) in headless
+// bag-picks.js, bag-read.js, truth-plot.js; issue 53, item 4; and a
+// benchmark's relations: log-relations.js, relations-view.js; issue 54) in headless
 // Chromium, on the real bags of the shared data (../shared/data/README.md,
 // section bags/). Part of the real-data suite: without the data folder
 // (`../shared/data` beside the checkout, or `$SLAMLAB_DATA`) it fails.
@@ -14,6 +15,14 @@
 //   - the Stage bag (no odometry, ground truth): odometry none, truth
 //     /base_pose_ground_truth; the error plot and a finite ATE, the same as
 //     `run-log` reports; the ground truth picked away and back;
+//   - the raw MIT CSAIL bag dropped with its `.relations` file: the
+//     relation errors grow as it replays and end as `run-log --relations`
+//     reports them (1172 of 1172 matched, the same mean, sd and max, the
+//     same worst relations); each relation's error is plotted, and the
+//     worst drawn on the map (none before a scan); a relations file
+//     malformed on its third line is named with it, one named after no
+//     open log is refused, and the one in use stays; cut into two
+//     stretches, each scores what it replays, as `run-log --from --to`;
 //   - a pick switched (odometry → none): the robot's replay starts again;
 //   - a bag cut short opens with what was lost; random bytes named x.bag
 //     are refused by name; a rosbag2 folder's files dropped together are one
@@ -318,6 +327,161 @@ test('your log: the Stage bag has no odometry and a ground truth; the error over
     return r.done > 0 && r.truth?.errors.length === 2 * r.done;
   }, null, { timeout: 60000 });
   assert.equal(await page.locator('#log-truth').isVisible(), true);
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});
+
+/**
+ * How many pixels of a PNG (`png`, a Buffer: a screenshot) are within
+ * `tol` of the colour `hex` (#rrggbb) in each channel; decoded in the page.
+ */
+function colourPixels(page, png, hex, tol = 40) {
+  return page.evaluate(async ({ b64, hex, tol }) => {
+    const bitmap = await createImageBitmap(await (await fetch(`data:image/png;base64,${b64}`)).blob());
+    const c = new OffscreenCanvas(bitmap.width, bitmap.height);
+    const ctx = c.getContext('2d');
+    ctx.drawImage(bitmap, 0, 0);
+    const px = ctx.getImageData(0, 0, c.width, c.height).data;
+    const [r, g, b] = [1, 3, 5].map((i) => parseInt(hex.slice(i, i + 2), 16));
+    let n = 0;
+    for (let i = 0; i < px.length; i += 4) if (Math.abs(px[i] - r) <= tol && Math.abs(px[i + 1] - g) <= tol && Math.abs(px[i + 2] - b) <= tol) n++;
+    return n;
+  }, { b64: png.toString('base64'), hex, tol });
+}
+
+/** The relation figures the page shows, one a robot: its text and data attributes. */
+const relationFigures = (page) =>
+  page.locator('#log-rel-figures li').evaluateAll((lis) => lis.map((li) => ({ text: li.textContent, ...li.dataset })));
+
+test('your log: a bag dropped with its .relations file shows the relation errors run-log reports, plots them and draws the worst on the map; a malformed file is named with its line', { timeout: 600000 }, async () => {
+  const bag = path.join(BAGS, 'freiburg/mit-csail.bag');
+  const relations = path.join(BAGS, 'freiburg/mit-csail.relations');
+  const report = JSON.parse(execFileSync('node', [path.join(ROOT, 'web/cli.mjs'), 'run-log', bag, '--relations', relations, '--json'], { maxBuffer: 1 << 28 }).toString());
+  const cli = report.relations;
+  const t0 = report.scans[0].time; // the bag's first scan: the plot's time starts there
+  assert.deepEqual([cli.matched, cli.count], [1172, 1172]);
+
+  const { context, page, problems } = await newPage(env.browser, { width: 1280, height: 1500 });
+  await openLogView(page);
+  await drop(page, [bag, relations]);
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().robots[0]?.relations, null, { timeout: 120000 });
+  assert.equal(await page.locator('#log-message').isHidden(), true, 'no message');
+  assert.equal(await page.locator('#log-relations').isVisible(), true);
+  assert.match(await page.locator('#log-relations p').innerText(), /^A relation \(Kümmerle et al\. 2009\) is the pose of one scan seen from another, matched by the benchmark's authors and checked by hand\./);
+  let [fig] = await relationFigures(page);
+  assert.equal(fig.text, 'mit-csail: matched 0 of 1,172 relations of mit-csail.relations (so far, on the 0 of 1,988 scans replayed); translation 0.0000 ± 0.0000 m (max 0.0000 m), rotation 0.00 ± 0.00° (max 0.00°)');
+  const magentaOnMap = async () => colourPixels(page, await page.locator('#log-canvas').screenshot(), '#e6007e');
+  assert.equal(await magentaOnMap(), 0, 'no worst relation drawn before a scan is replayed');
+  assert.equal(await page.locator('#log-rel-key').isHidden(), true);
+
+  // Played to the end: the figures grow as the scans are replayed (read every 50 ms).
+  await page.evaluate(() => {
+    window.matchedSeen = [];
+    const tick = () => {
+      const li = document.querySelector('#log-rel-figures li');
+      if (li) window.matchedSeen.push(Number(li.dataset.matched));
+      if (!window.slamlab.logView.snapshot().finished) setTimeout(tick, 50);
+    };
+    tick();
+  });
+  await playToEnd(page);
+  const seen = await page.evaluate(() => window.matchedSeen);
+  const between = [...new Set(seen)].filter((n) => n > 0 && n < 1172);
+  assert.ok(between.length >= 3, `the figures were shown at ${between.length} counts between none and all: ${between}`);
+  assert.deepEqual(seen, [...seen].sort((a, b) => a - b), 'matched only grows');
+
+  // The end: the same figures as run-log, shown to 4 decimals (translation) and 2 (rotation).
+  [fig] = await relationFigures(page);
+  const [t, r] = [cli.trans_m, cli.rot_deg];
+  assert.equal(
+    fig.text,
+    `mit-csail: matched 1,172 of 1,172 relations of mit-csail.relations; translation ${t.mean.toFixed(4)} ± ${t.sd.toFixed(4)} m (max ${t.max.toFixed(4)} m), ` +
+      `rotation ${r.mean.toFixed(2)} ± ${r.sd.toFixed(2)}° (max ${r.max.toFixed(2)}°)`,
+  );
+  assert.equal(Number(fig.transMean).toFixed(4), t.mean.toFixed(4));
+  assert.deepEqual([fig.matched, fig.count], ['1172', '1172']);
+  const page5 = await page.evaluate(() => {
+    const q = window.slamlab.logView.snapshot().robots[0].relations;
+    return { trans: q.trans_m, rot: q.rot_deg, worst: q.worst, errors: [...q.errors] };
+  });
+  console.log(`mit-csail relations: page ${page5.trans.mean} m, ${page5.rot.mean}°; run-log ${t.mean} m, ${r.mean}°`);
+  assert.ok(Math.abs(page5.trans.mean - t.mean) < 1e-9 && Math.abs(page5.rot.mean - r.mean) < 1e-7, 'the page scores as run-log does');
+
+  // The plot: a point a relation (x: the later scan's time since the first scan), in the robot's
+  // colour; the five worst ringed in magenta.
+  assert.equal(await page.locator('#log-rel-plot').getAttribute('data-points'), '1172');
+  assert.equal(page5.errors.length, 2 * 1172);
+  const times = page5.errors.filter((_, i) => i % 2 === 0);
+  assert.ok(Math.min(...times) >= 0 && Math.max(...times) <= 424.1, `times ${Math.min(...times)}..${Math.max(...times)} s within the bag's 424 s`);
+  const last = cli.errors[1171];
+  assert.ok(Math.abs(page5.errors[2 * 1172 - 2] - (Math.max(last.t1, last.t2) - t0)) < 1e-6, 'the last point is at the last relation\'s later scan');
+  assert.ok(Math.abs(page5.errors[2 * 1172 - 1] - last.trans_m) < 1e-9, 'the last point is the last relation\'s error');
+  const plot = await page.locator('#log-rel-plot').screenshot();
+  const colour = (await logSnapshot(page)).robots[0].colour;
+  const dots = await colourPixels(page, plot, colour);
+  assert.ok(dots > 1500, `${dots} pixels of the relations' points`);
+  assert.ok((await colourPixels(page, plot, '#e6007e')) > 100, 'the worst ringed on the plot');
+
+  // The worst relations: the table lists run-log's five worst; the map draws them.
+  const rows = await page.locator('#log-rel-worst tbody tr').evaluateAll((trs) => trs.map((tr) => [...tr.cells].map((c) => c.textContent)));
+  assert.deepEqual(rows, cli.worst.slice(0, 5).map((w, k) => [String(k + 1), 'mit-csail', String(w.t1), String(w.t2), (Math.max(w.t1, w.t2) - t0).toFixed(1), w.trans_m.toFixed(4), w.rot_deg.toFixed(2)]));
+  assert.equal(await page.locator('#log-rel-key').isVisible(), true, 'the legend names the worst relations');
+  const drawn = await magentaOnMap();
+  assert.ok(drawn > 300, `${drawn} pixels of the worst relations on the map`);
+  // Pointing at the first row draws that one stronger and the others fainter.
+  await page.locator('#log-rel-worst tbody tr').first().hover();
+  await page.waitForFunction(() => document.querySelector('#log-rel-worst tbody tr.on'));
+  await page.waitForTimeout(300);
+  const pointed = await magentaOnMap();
+  assert.ok(Math.abs(pointed - drawn) > 50, `pointed at: ${pointed} magenta pixels, not ${drawn}`);
+  await page.locator('#log-canvas').scrollIntoViewIfNeeded();
+  await page.screenshot({ path: path.join(ARTIFACTS, 'page-bags-relations.png'), fullPage: true });
+  await page.mouse.move(5, 5);
+  await page.waitForFunction(() => !document.querySelector('#log-rel-worst tbody tr.on'));
+  // Focused by the keyboard: the same.
+  await page.locator('#log-rel-worst tbody tr').nth(1).focus();
+  await page.waitForFunction(() => document.querySelector('#log-rel-worst tbody tr.on')?.dataset.k === '1');
+
+  // A relations file malformed on its third line: named with it; the one in use stays.
+  const broken = path.join(tmp, 'broken.relations');
+  writeFileSync(broken, `${cli.worst[0].t1} ${cli.worst[0].t2} 1 0 0 0 0 0\n# a comment\n1 2 3\n`);
+  await drop(page, [broken]);
+  await page.waitForFunction(() => !document.querySelector('#log-message').hidden, null, { timeout: 60000 });
+  assert.equal(await page.locator('#log-message').innerText(), 'Relations not used: broken.relations: line 3: expected 8 numbers (t1 t2 x y z roll pitch yaw), found 3');
+  // One named after no open log, with two logs open: refused by name.
+  await drop(page, [path.join(BAGS, 'ros2/mit-csail-zstd.mcap')]);
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().robots.length === 2, null, { timeout: 120000 });
+  const stray = path.join(tmp, 'elsewhere.relations');
+  writeFileSync(stray, readFileSync(relations));
+  await drop(page, [stray]);
+  await page.waitForFunction(() => /elsewhere/.test(document.querySelector('#log-message').textContent), null, { timeout: 60000 });
+  assert.equal(
+    await page.locator('#log-message').innerText(),
+    'Relations not used: elsewhere.relations: no open log or bag is called elsewhere (open: mit-csail.bag, mit-csail-zstd.mcap); name it after its log (aces.relations goes with aces.bag), or pick or drop it together with that one log',
+  );
+  const figs = await relationFigures(page);
+  assert.deepEqual(figs.map((f) => [f.robot, f.matched, f.count]), [['mit-csail', '1172', '1172']], 'the relations in use stay; the new robot has none');
+
+  // Cut into two stretches: each scores the relations both of whose scans it replays, as
+  // run-log --from/--to does; the others are named as outside the stretch.
+  await page.locator('#log-cut').fill('2');
+  await page.locator('#log-cut').dispatchEvent('change');
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().robots.length === 4, null, { timeout: 60000 });
+  await playToEnd(page);
+  const cut = await relationFigures(page);
+  assert.deepEqual(cut.map((f) => f.robot), ['mit-csail-1', 'mit-csail-2']);
+  for (const [k, [from, to]] of [[0, 993], [994, 1987]].entries()) {
+    const c = JSON.parse(execFileSync('node', [path.join(ROOT, 'web/cli.mjs'), 'run-log', bag, '--relations', relations, '--from', String(from), '--to', String(to), '--json'], { maxBuffer: 1 << 28 }).toString()).relations;
+    assert.ok(c.matched > 100 && c.matched < 1172, `${c.matched} relations within records ${from}–${to}`);
+    const m = c.matched.toLocaleString('en');
+    const other = (1172 - c.matched).toLocaleString('en');
+    assert.equal(
+      cut[k].text,
+      `mit-csail-${k + 1}: matched ${m} of 1,172 relations of mit-csail.relations (the other ${other} have a scan outside this stretch (records ${from}–${to}) and are not scored); ` +
+        `translation ${c.trans_m.mean.toFixed(4)} ± ${c.trans_m.sd.toFixed(4)} m (max ${c.trans_m.max.toFixed(4)} m), rotation ${c.rot_deg.mean.toFixed(2)} ± ${c.rot_deg.sd.toFixed(2)}° (max ${c.rot_deg.max.toFixed(2)}°)`,
+    );
+  }
+  assert.equal(await page.locator('#log-rel-worst tbody tr').count(), 10, 'five worst a stretch');
   assert.deepEqual(problems, [], 'no console errors or page errors');
   await context.close();
 });

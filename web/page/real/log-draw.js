@@ -4,13 +4,20 @@
 // gives (in the robot's colour, moved by every loop closure), a bag's
 // ground truth (dotted black: the true poses laid onto SLAM's frame by the
 // rigid fit its ATE is taken after), each loop closure as an orange line
-// between the two scans it joined, and the robot's current pose. A robot's
+// between the two scans it joined, the worst relations of a benchmark's
+// relations file (log-relations.js: both scans' current poses ringed with
+// their headings, joined by a magenta line, numbered as the page's table
+// lists them; the one the user points at drawn stronger, the others
+// fainter), and the robot's current pose. A robot's
 // poses and map share one frame (the log's odometry frame, the first scan
 // at its odometry pose); its tile fits the map's known cells and the
 // paths.
 
 import { clearCanvas, fitBox } from './fit.js';
 import { outline } from './overlay.js';
+
+/** The colour of the worst relations (the page's legend uses it too). */
+export const WORST_COLOUR = '#e6007e';
 
 /** The live map as a picture: `grey` PGM shades top row first, `info` its MapInfo. */
 export async function mapPicture(grey, info) {
@@ -99,6 +106,7 @@ function drawRobot(ctx, rect, dpr, robot, label) {
   ctx.strokeStyle = robot.colour;
   path(ctx, view.poses);
   drawClosures(ctx, view.closures, k, dpr);
+  if (robot.relations?.worst.length) drawWorst(ctx, view.poses, robot.relations.worst, robot.highlight ?? -1, k, dpr);
   const n = view.poses.length;
   if (n) {
     ctx.beginPath();
@@ -137,6 +145,98 @@ function drawClosures(ctx, closures, k, dpr) {
       ctx.fill();
     }
   }
+}
+
+/**
+ * The worst relations (`worst`: [{scan1, scan2}], worst first) on the SLAM
+ * poses `poses` (flat): each scan's pose a ring with a tick along its
+ * heading, the two joined by a line (a white halo under it, so it shows
+ * over walls and paths), numbered from 1 beside the line's middle;
+ * `highlight` (an index, or -1) drawn stronger, the others fainter.
+ */
+function drawWorst(ctx, poses, worst, highlight, k, dpr) {
+  const at = (i) => (3 * i + 2 < poses.length ? [poses[3 * i], poses[3 * i + 1], poses[3 * i + 2]] : null);
+  const px = (n) => (n * dpr) / k;
+  const order = [...worst.keys()].reverse(); // the worst drawn last, on top
+  if (highlight >= 0) order.push(...order.splice(order.indexOf(highlight), 1));
+  for (const i of order) {
+    const [a, b] = [at(worst[i].scan1), at(worst[i].scan2)];
+    if (!a || !b) continue;
+    const strong = i === highlight;
+    ctx.globalAlpha = highlight >= 0 && !strong ? 0.35 : 1;
+    const [width, ring] = strong ? [3.5, px(11)] : [2.5, px(7)];
+    for (const [colour, w] of [['#fff', width + 3], [WORST_COLOUR, width]]) {
+      ctx.strokeStyle = colour;
+      ctx.lineWidth = px(w);
+      ctx.beginPath();
+      ctx.moveTo(a[0], a[1]);
+      ctx.lineTo(b[0], b[1]);
+      for (const [x, y, th] of [a, b]) {
+        ctx.moveTo(x + ring, y);
+        ctx.arc(x, y, ring, 0, 2 * Math.PI);
+        ctx.moveTo(x, y);
+        ctx.lineTo(x + px(14) * Math.cos(th), y + px(14) * Math.sin(th));
+      }
+      ctx.stroke();
+    }
+  }
+  ctx.globalAlpha = 1;
+  // The numbers, the worst placed first, none over another; the one pointed at on top.
+  const taken = [];
+  const labels = worst.map((w, i) => {
+    const [a, b] = [at(w.scan1), at(w.scan2)];
+    return a && b ? label(ctx, taken, String(i + 1), (a[0] + b[0]) / 2, (a[1] + b[1]) / 2, dpr, i === highlight) : null;
+  });
+  for (const i of order) labels[i]?.();
+}
+
+/**
+ * Where a label `w` × `h` (device pixels) goes beside the point (x, y):
+ * above and right of it, moved up (then right) past the labels `taken`
+ * ([left, top, w, h] each, the new one added).
+ */
+export function placeLabel(taken, x, y, w, h, gap) {
+  let [left, top] = [x + gap, y - h - gap];
+  const hits = (b) => left < b[0] + b[2] + 2 && b[0] < left + w + 2 && top < b[1] + b[3] + 2 && b[1] < top + h + 2;
+  for (let tries = 0; taken.some(hits) && tries < 24; tries++) {
+    if (tries % 4 === 3) [left, top] = [left + w + 4, y - h - gap];
+    else top -= h + 4;
+  }
+  const box = [left, top, w, h];
+  taken.push(box);
+  return box;
+}
+
+/**
+ * Places a number in a magenta box by world point (x, y) (placeLabel,
+ * upright whatever the view's transform); returns the drawing of it, with
+ * a line to the point when it was moved away.
+ */
+function label(ctx, taken, text, x, y, dpr, strong) {
+  const p = ctx.getTransform().transformPoint(new DOMPoint(x, y));
+  ctx.save();
+  ctx.font = `bold ${(strong ? 14 : 12) * dpr}px sans-serif`;
+  const w = ctx.measureText(text).width + 8 * dpr;
+  ctx.restore();
+  const h = (strong ? 18 : 16) * dpr;
+  const [left, top] = placeLabel(taken, p.x, p.y, w, h, 4 * dpr);
+  return () => {
+    ctx.save();
+    ctx.setTransform(1, 0, 0, 1, 0, 0);
+    ctx.strokeStyle = WORST_COLOUR;
+    ctx.lineWidth = dpr;
+    ctx.beginPath();
+    ctx.moveTo(p.x, p.y);
+    ctx.lineTo(left, top + h);
+    ctx.stroke();
+    ctx.fillStyle = WORST_COLOUR;
+    ctx.fillRect(left, top, w, h);
+    ctx.fillStyle = '#fff';
+    ctx.font = `bold ${(strong ? 14 : 12) * dpr}px sans-serif`;
+    ctx.textBaseline = 'middle';
+    ctx.fillText(text, left + 4 * dpr, top + h / 2 + dpr / 2);
+    ctx.restore();
+  };
 }
 
 /**

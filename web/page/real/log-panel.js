@@ -14,7 +14,11 @@
 // then its card (bag-picks.js) lists its topics and what the replay picked
 // and why, with selects to pick others, and a bag's ground truth is drawn
 // beside SLAM's path with the position error over time under the map
-// (truth-plot.js).
+// (truth-plot.js). A benchmark's `.relations` file (Kümmerle et al. 2009)
+// opened with a log or bag, or afterwards, goes with it (by name, or as
+// the one log opened with it): its relation errors are shown as the
+// replay goes, plotted along the run, and the worst drawn on the map
+// (relations-view.js; the worker's side in log-relations.js).
 //
 // Several logs, or one log cut into N stretches of its laser records, are
 // several robots (issue 21, item 3): each replayed on its own, in its own
@@ -25,7 +29,9 @@ import { BagPicks } from './bag-picks.js';
 import { WorkerClient } from './client.js';
 import { droppedFiles, picked } from './dropped.js';
 import { LogMergeView, MERGE_HTML } from './log-merge-view.js';
+import { WORST_COLOUR } from './log-draw.js';
 import { MAP_COLOURS } from './panel.js';
+import { RELATIONS_HTML, RelationsView } from './relations-view.js';
 import { ErrorPlot } from './truth-plot.js';
 
 const HTML = `
@@ -40,11 +46,13 @@ const HTML = `
     replay uses and why; pick others there. Dashed grey: the path the odometry believes; in the robot's colour:
     SLAM's; dotted black: a bag's ground truth; orange: loop closures as they are found.
     Two or more logs or bags, or one cut into stretches, are as many robots: each replays on its own, then
-    <b>Merge maps</b> joins their maps by the maps' own evidence, as <code>merge-maps</code> does.</p>
-  <div class="real-drop" tabindex="0" aria-label="Drop logs, bags or a rosbag2 folder here">
-    <span>Drop logs, bags or a rosbag2 folder here, or</span>
+    <b>Merge maps</b> joins their maps by the maps' own evidence, as <code>merge-maps</code> does.
+    A benchmark's <code>.relations</code> file opened with its log (<code>aces.relations</code> with
+    <code>aces.bag</code>) scores the replay against it, as <code>run-log --relations</code> does.</p>
+  <div class="real-drop" tabindex="0" aria-label="Drop logs, bags, a rosbag2 folder or relations files here">
+    <span>Drop logs, bags (with their <code>.relations</code>) or a rosbag2 folder here, or</span>
     <label class="button" for="log-file">Open log or bag…</label>
-    <input id="log-file" type="file" multiple accept=".log,.clf,.gz,.txt,.bag,.mcap,.db3,.db3-wal,.yaml,.yml" hidden>
+    <input id="log-file" type="file" multiple accept=".log,.clf,.gz,.txt,.bag,.mcap,.db3,.db3-wal,.yaml,.yml,.relations" hidden>
     <label for="log-cut" title="Each stretch of a log is replayed as a robot of its own">Cut each log into</label>
     <input id="log-cut" type="number" min="1" max="16" step="1" value="1" class="num"><span class="unit">stretches</span>
     <button type="button" id="log-clear">Clear logs</button>
@@ -71,7 +79,9 @@ const HTML = `
   <p class="real-legend"><span id="log-odom-key" class="real-swatch" style="--c:#7a7a7a">odometry</span>
     <span class="real-swatch" style="--c:#1f77b4">SLAM (in the robot's colour)</span>
     <span class="real-swatch" style="--c:#e07b00">loop closure</span>
-    <span id="log-truth-key" class="real-swatch" style="--c:#111" hidden>ground truth (dotted), laid onto SLAM's frame</span></p>
+    <span id="log-truth-key" class="real-swatch" style="--c:#111" hidden>ground truth (dotted), laid onto SLAM's frame</span>
+    <span id="log-rel-key" class="real-swatch" style="--c:${WORST_COLOUR}" hidden>worst relations: both scans' poses
+      (rings, with their headings) joined, numbered as in the table below</span></p>
   <div id="log-truth" class="truth-plot" hidden>
     <h2>Position error against the ground truth</h2>
     <p class="real-stage">At each scan replayed: the distance from SLAM's pose to the true pose at the scan's time,
@@ -81,7 +91,7 @@ const HTML = `
       <canvas id="log-error" aria-label="Each robot's position error against its bag's ground truth over time"></canvas>
       <ul id="log-ate" class="truth-ate" aria-label="Each robot's ATE"></ul>
     </div>
-  </div>
+  </div>${RELATIONS_HTML}
   <div id="log-map-downloads" class="real-downloads">
     <label for="log-map-of" hidden>Map of</label>
     <select id="log-map-of" hidden></select>
@@ -126,6 +136,7 @@ export class LogView {
     });
     this.picks = new BagPicks(q('#log-bags'), (id, picks, truthHidden) => this.enqueue(() => this.repick(id, picks, truthHidden)));
     this.plot = new ErrorPlot(q('#log-truth'), q('#log-error'), q('#log-ate'));
+    this.relations = new RelationsView(q('#log-relations'), (name, k) => this.highlight(name, k));
     q('#log-cut').addEventListener('change', () => this.enqueue(() => this.recut()));
     q('#log-clear').addEventListener('click', () => this.enqueue(() => this.clear()));
     q('#log-play').addEventListener('click', () => this.play());
@@ -138,6 +149,7 @@ export class LogView {
     }
     new ResizeObserver(() => this.redraw()).observe(q('#log-canvas'));
     new ResizeObserver(() => this.plot.show(this.state.robots ?? [])).observe(q('#log-error'));
+    new ResizeObserver(() => this.relations.draw()).observe(q('#log-rel-plot'));
     this.merged.wire();
     this.showSpeed();
     this.refresh();
@@ -227,9 +239,14 @@ export class LogView {
         this.showReading(null);
       }
       if (out.added) this.restart(out, out.opened);
-      if (out.errors.length) this.say(`Not opened: ${out.errors.join(' · ')}`, 'error');
+      else if (out.attached.length) this.state.robots = out.robots;
+      const problems = [
+        out.errors.length ? `Not opened: ${out.errors.join(' · ')}` : '',
+        out.relationErrors.length ? `Relations not used: ${out.relationErrors.join(' · ')}` : '',
+      ];
+      if (problems.some(Boolean)) this.say(problems.filter(Boolean).join(' — '), 'error');
       this.refresh();
-      if (out.added) await this.client.request({ type: 'step', n: 0, size });
+      if (out.added || out.attached.length) await this.client.request({ type: 'step', n: 0, size });
     });
   }
 
@@ -371,6 +388,12 @@ export class LogView {
     this.advance();
   }
 
+  /** Draws robot `name`'s worst relation `k` stronger on the map (`name` null: none). */
+  highlight(name, k) {
+    if (!this.state.records || this.root.hidden) return;
+    this.client.request({ type: 'highlight', robot: name, k, size: this.size() }).catch((e) => this.say(e.message, 'error'));
+  }
+
   redraw() {
     if (!this.state.records || this.root.hidden) return;
     this.client.request({ type: 'redraw', size: this.size() }).catch((e) => this.say(e.message, 'error'));
@@ -405,6 +428,8 @@ export class LogView {
     this.picks.show(s.bags, robots);
     this.plot.show(robots);
     q('#log-truth-key').hidden = !robots.some((r) => r.truth);
+    this.relations.show(robots);
+    q('#log-rel-key').hidden = !robots.some((r) => r.relations?.worst.length);
     // Bags replayed by scan matching alone draw no odometry.
     const bagOf = (r) => (s.bags ?? []).find((b) => b.id === r.logId);
     q('#log-odom-key').hidden = robots.length > 0 && robots.every((r) => bagOf(r)?.picked.odometry === null);

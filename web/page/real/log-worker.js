@@ -24,11 +24,16 @@
 // hands back each map as PGM, PNG and YAML; then `merge` joins the robots'
 // maps (log-merge.js: the saved-maps merge of `merge-maps`, each map in its
 // robot's own frame) and draws the joined maps into a second canvas.
+// A benchmark's `.relations` file opened with a log (log-relations.js)
+// is parsed by each of its robots' replays, which score the scans
+// replayed so far against it (at most every RELATIONS_EVERY_MS while
+// playing); the worst relations are drawn on the robot's tile, and
+// `highlight` picks one of them to draw stronger.
 // Messages in: `{id, type: 'canvas' | 'mergeCanvas' | 'open' | 'cut' |
-// 'pick' | 'step' | 'redraw' | 'finish' | 'merge' | 'drawMerge' | 'clear',
-// ...}`; out: `{id, ok, ...}` or `{id, ok: false, error}`, and
-// `{type: 'progress', text}` while merging, `{type: 'progress', reading}`
-// while a bag is read.
+// 'pick' | 'step' | 'redraw' | 'highlight' | 'finish' | 'merge' |
+// 'drawMerge' | 'clear', ...}`; out: `{id, ok, ...}` or `{id, ok: false,
+// error}`, and `{type: 'progress', text}` while merging, `{type:
+// 'progress', reading}` while a bag is read.
 
 import init, * as wasm from '../../pkg/slamlab.js';
 import { LogReplay } from '../../log-replay.js';
@@ -36,10 +41,13 @@ import { MAX_SAVED_MAPS } from '../../saved-maps.js';
 import { readBag, sortFiles } from './bag-read.js';
 import { drawMergedPaths, drawReplays, mapPicture } from './log-draw.js';
 import { mergedPaths, mergeRobots, placedMaps, stretches } from './log-merge.js';
+import { firstScanTime, matchRelations, relationFigures, relationsText, setRelations, splitRelations } from './log-relations.js';
 import { drawPlaced } from './overlay.js';
 
 const ready = init();
 const MAP_EVERY_MS = 400;
+/** How often a playing replay is scored against its relations. */
+const RELATIONS_EVERY_MS = 300;
 /** The most robots at once (the merge's limit). */
 const MAX_ROBOTS = MAX_SAVED_MAPS;
 /**
@@ -48,11 +56,19 @@ const MAX_ROBOTS = MAX_SAVED_MAPS;
  * `lost` (what could not be read), `picks` (as the page asked), `auto`
  * and `picked` (what was picked with no picks and with them, and why),
  * `truthHidden` (the page picked no ground truth) and `spare` (a replay
- * made and not yet given to a robot).
+ * made and not yet given to a robot), and `relations` `{name, text,
+ * count}` when a relations file goes with it, `firstTime` its first scan's
+ * time (log-relations.js).
  */
 let logs = [];
 let nextLog = 1;
-/** `{name, log, logId, from, to, colour, replay, picture, view, truth, showTruth, mapAt, finished, summary}`. */
+/**
+ * `{name, log, logId, from, to, whole, colour, replay, picture, view, truth,
+ * showTruth, mapAt, finished, summary, relations, relationsAt, highlight}`
+ * (`whole`: it replays all of its log; `relations`: log-relations.js's
+ * `relationFigures`; `highlight`: which of its worst relations to draw
+ * stronger, or -1).
+ */
 let robots = [];
 let canvas = null;
 let mergeCanvas = null;
@@ -124,22 +140,27 @@ function robotOf(log, name, colour, from, to) {
   const replay = replayOf(log);
   try {
     replay.setRange(from, to);
+    if (log.relations) replay.setRelations(log.relations.text);
   } catch (e) {
     replay.free();
     throw e;
   }
   const showTruth = !!log.bag && !log.truthHidden;
-  return { name, log: log.name, logId: log.id, from, to, colour, replay, showTruth, truth: null, picture: null, view: null, mapAt: -Infinity, finished: false };
+  return {
+    name, log: log.name, logId: log.id, from, to, colour, replay, showTruth, truth: null, picture: null, view: null, mapAt: -Infinity, finished: false,
+    whole: from === 0 && to >= log.records - 1, relations: null, relationsAt: -Infinity, highlight: -1,
+  };
 }
 
 /** What the page shows of each robot. */
 function describe() {
   return {
     records: logs.reduce((s, l) => s + l.records, 0),
-    robots: robots.map(({ name, log, logId, from, to, colour, finished, summary, view, truth }) => ({
-      name, log, logId, from, to, colour, finished, summary: summary ?? null,
+    robots: robots.map(({ name, log, logId, from, to, whole, colour, finished, summary, view, truth, relations }) => ({
+      name, log, logId, from, to, whole, colour, finished, summary: summary ?? null,
       done: view?.done ?? 0, total: to - from + 1, closures: view?.closures.length ?? 0,
       truth: truth ? { ate_m: truth.ate_m, errors: truth.errors } : null,
+      relations,
     })),
     bags: logs.filter((l) => l.bag).map(({ id, name, records, info, lost, picks, auto, picked, truthHidden }) => ({
       id, name, records, info, lost, picks, auto, picked, truthHidden,
@@ -151,11 +172,13 @@ function describe() {
  * Opens picked or dropped files (`[{file, path}]`, bag-read.js sorts them
  * into logs and bags, each read here, so a bad one is named with its line
  * or record): the good ones are robots added to those there are, whose
- * replays go on.
+ * replays go on. Relations files go with the logs they name, those just
+ * opened or those open (`attached`), or are named in `relationErrors`.
  */
 async function open({ files, cut, colours }, id) {
   const before = logs.length;
-  const { items, errors } = await sortFiles(wasm, files);
+  const { relations, rest } = splitRelations(files);
+  const { items, errors } = await sortFiles(wasm, rest);
   const opened = [];
   const bags = items.filter((i) => i.bag).length;
   let bagAt = 0;
@@ -187,7 +210,52 @@ async function open({ files, cut, colours }, id) {
       throw e;
     }
   }
-  return { ...describe(), added: opened.length, opened, errors };
+  const { attached, relationErrors } = await attach(relations, logs.slice(before));
+  return { ...describe(), added: opened.length, opened, errors, attached, relationErrors };
+}
+
+/**
+ * Gives each relations file (`entries`, [{file, path}]) to the log it goes
+ * with (log-relations.js), `openedNow` the logs opened with them: each of
+ * that log's robots scores against it from now on. A file that goes with
+ * none, or is malformed (named with its line), changes nothing.
+ */
+async function attach(entries, openedNow) {
+  const { pairs, errors } = matchRelations(entries, logs, openedNow, stem);
+  const attached = [];
+  for (const { entry, log } of pairs) {
+    const name = String(entry.path).split(/[\\/]/).pop();
+    try {
+      const text = await relationsText(entry);
+      const mine = robots.filter((r) => r.logId === log.id);
+      const count = setRelations(mine.map((r) => r.replay), name, text);
+      log.relations = { name, text, count };
+      for (const r of mine) scoreRelations(r, true);
+      attached.push({ file: name, log: log.name, count });
+    } catch (e) {
+      errors.push(named(name, e));
+    }
+  }
+  return { attached, relationErrors: errors };
+}
+
+/** Scores `robot`'s replay so far against its log's relations, if it is time (or `force`). */
+function scoreRelations(robot, force) {
+  const log = logs.find((l) => l.id === robot.logId);
+  if (!log?.relations) {
+    robot.relations = null;
+    return;
+  }
+  const now = performance.now();
+  if (!force && now - robot.relationsAt < RELATIONS_EVERY_MS) return;
+  let t0 = null;
+  try {
+    t0 = firstScanTime(wasm, log);
+  } catch {
+    log.firstTime = null; // the plot's time then starts at the earliest relation's stamp
+  }
+  robot.relations = relationFigures(robot.replay, log.relations.name, t0);
+  robot.relationsAt = now;
 }
 
 /** Reads a bag (`item` from sortFiles) and makes its first replay with no picks: what it picks and why. */
@@ -210,7 +278,7 @@ function pick({ log: id, picks, truthHidden }) {
   const log = logs.find((l) => l.id === id && l.bag);
   if (!log) throw new Error('that bag is no longer open');
   const probe = log.bag.replay(LogReplay, picks);
-  const next = { ...log, picks, truthHidden: !!truthHidden, spare: probe, picked: probe.picked(), records: probe.laserRecords() };
+  const next = { ...log, picks, truthHidden: !!truthHidden, spare: probe, picked: probe.picked(), records: probe.laserRecords(), firstTime: undefined };
   const mine = robots.filter((r) => r.logId === id);
   const made = [];
   try {
@@ -255,6 +323,7 @@ async function step({ n, size }) {
     left += rest;
     r.view = r.replay.view();
     r.truth = r.showTruth ? r.replay.truth() : null;
+    scoreRelations(r, n === 0 || rest === 0);
     await refreshMap(r, rest === 0);
   }
   draw(size);
@@ -275,6 +344,7 @@ function finish() {
       r.summary = { scans: r.report.scans.length, closures: r.report.loop_closures.length, map: r.report.map };
       r.view = r.replay.view();
       r.truth = r.showTruth ? r.replay.truth() : null;
+      scoreRelations(r, true);
       r.drawnDone = -1; // the settled poses draw a new map
       r.finished = true;
     }
@@ -311,6 +381,11 @@ const handlers = {
   pick: (data) => pick(data),
   step: async (data) => step(data),
   redraw: (data) => {
+    draw(data.size);
+    return {};
+  },
+  highlight: (data) => {
+    for (const r of robots) r.highlight = r.name === data.robot ? data.k : -1;
     draw(data.size);
     return {};
   },

@@ -6,7 +6,9 @@
 // (the absolute trajectory error: the root mean square of those distances,
 // after the one rigid motion that lays the truth best onto SLAM's path —
 // the log worker takes both from the replay, `LogReplay.truth()`). A
-// dashed line in the robot's colour marks its ATE on the plot.
+// dashed line in the robot's colour marks its ATE on the plot. The plot's
+// frame (`plotFrame`) serves the relation errors' plot too
+// (relations-view.js).
 
 import { el, fmt } from '../dom.js';
 
@@ -15,6 +17,60 @@ function niceStep(span, n) {
   const raw = span / n;
   const p = 10 ** Math.floor(Math.log10(raw));
   return [1, 2, 5, 10].map((m) => m * p).find((s) => s >= raw) ?? 10 * p;
+}
+
+/**
+ * Sizes `canvas` to its box in device pixels, clears it and draws a
+ * plot's frame for x from 0 to about `xMax` and y from 0 to about `yMax`
+ * (both rounded up to a step): grid lines at round steps, their values,
+ * the axes' names. Returns `{ctx, dpr, X, Y, left, right, top, bottom}`,
+ * `X` and `Y` taking a value to device pixels.
+ */
+export function plotFrame(canvas, xMax, yMax, xName, yName) {
+  const c = canvas;
+  const dpr = window.devicePixelRatio || 1;
+  const [w, h] = [Math.max(1, Math.round(c.clientWidth * dpr)), Math.max(1, Math.round(c.clientHeight * dpr))];
+  if (c.width !== w || c.height !== h) [c.width, c.height] = [w, h];
+  const ctx = c.getContext('2d');
+  ctx.setTransform(1, 0, 0, 1, 0, 0);
+  ctx.fillStyle = '#fff';
+  ctx.fillRect(0, 0, w, h);
+  let [tMax, eMax] = [Math.max(xMax, 1e-9), Math.max(yMax, 1e-9)];
+  const [tStep, eStep] = [niceStep(tMax, 6), niceStep(eMax, 3)];
+  [tMax, eMax] = [Math.ceil(tMax / tStep) * tStep, Math.ceil(eMax / eStep) * eStep];
+  const [left, right, top, bottom] = [58 * dpr, w - 12 * dpr, 10 * dpr, h - 34 * dpr];
+  const X = (t) => left + ((right - left) * t) / tMax;
+  const Y = (e) => bottom - ((bottom - top) * e) / eMax;
+  ctx.font = `${11 * dpr}px sans-serif`;
+  ctx.fillStyle = '#555';
+  ctx.strokeStyle = '#ddd';
+  ctx.lineWidth = dpr;
+  ctx.textAlign = 'center';
+  for (let t = 0; t <= tMax + 1e-9; t += tStep) {
+    ctx.beginPath();
+    ctx.moveTo(X(t), top);
+    ctx.lineTo(X(t), bottom);
+    ctx.stroke();
+    ctx.fillText(String(Number(t.toPrecision(6))), X(t), bottom + 13 * dpr);
+  }
+  ctx.fillText(xName, (left + right) / 2, h - 4 * dpr);
+  ctx.textAlign = 'right';
+  for (let e = 0; e <= eMax + 1e-12; e += eStep) {
+    ctx.beginPath();
+    ctx.moveTo(left, Y(e));
+    ctx.lineTo(right, Y(e));
+    ctx.stroke();
+    ctx.fillText(String(Number(e.toPrecision(6))), left - 5 * dpr, Y(e) + 4 * dpr);
+  }
+  ctx.save();
+  ctx.translate(13 * dpr, (top + bottom) / 2);
+  ctx.rotate(-Math.PI / 2);
+  ctx.textAlign = 'center';
+  ctx.fillText(yName, 0, 0);
+  ctx.restore();
+  ctx.strokeStyle = '#888';
+  ctx.strokeRect(left, top, right - left, bottom - top);
+  return { ctx, dpr, X, Y, left, right, top, bottom };
 }
 
 export class ErrorPlot {
@@ -43,14 +99,6 @@ export class ErrorPlot {
   }
 
   draw(robots) {
-    const c = this.canvas;
-    const dpr = window.devicePixelRatio || 1;
-    const [w, h] = [Math.max(1, Math.round(c.clientWidth * dpr)), Math.max(1, Math.round(c.clientHeight * dpr))];
-    if (c.width !== w || c.height !== h) [c.width, c.height] = [w, h];
-    const ctx = c.getContext('2d');
-    ctx.setTransform(1, 0, 0, 1, 0, 0);
-    ctx.fillStyle = '#fff';
-    ctx.fillRect(0, 0, w, h);
     // Time from each bag's first scan: the stretches of one bag share it.
     const start = new Map();
     for (const r of robots) start.set(r.log, Math.min(start.get(r.log) ?? Infinity, r.truth.errors[0]));
@@ -62,40 +110,7 @@ export class ErrorPlot {
         eMax = Math.max(eMax, e[i + 1]);
       }
     }
-    const [tStep, eStep] = [niceStep(tMax, 6), niceStep(eMax, 3)];
-    [tMax, eMax] = [Math.ceil(tMax / tStep) * tStep, Math.ceil(eMax / eStep) * eStep];
-    const [left, right, top, bottom] = [58 * dpr, w - 12 * dpr, 10 * dpr, h - 34 * dpr];
-    const X = (t) => left + ((right - left) * t) / tMax;
-    const Y = (e) => bottom - ((bottom - top) * e) / eMax;
-    ctx.font = `${11 * dpr}px sans-serif`;
-    ctx.fillStyle = '#555';
-    ctx.strokeStyle = '#ddd';
-    ctx.lineWidth = dpr;
-    ctx.textAlign = 'center';
-    for (let t = 0; t <= tMax + 1e-9; t += tStep) {
-      ctx.beginPath();
-      ctx.moveTo(X(t), top);
-      ctx.lineTo(X(t), bottom);
-      ctx.stroke();
-      ctx.fillText(String(Number(t.toPrecision(6))), X(t), bottom + 13 * dpr);
-    }
-    ctx.fillText('time since the bag’s first scan (s)', (left + right) / 2, h - 4 * dpr);
-    ctx.textAlign = 'right';
-    for (let e = 0; e <= eMax + 1e-12; e += eStep) {
-      ctx.beginPath();
-      ctx.moveTo(left, Y(e));
-      ctx.lineTo(right, Y(e));
-      ctx.stroke();
-      ctx.fillText(String(Number(e.toPrecision(6))), left - 5 * dpr, Y(e) + 4 * dpr);
-    }
-    ctx.save();
-    ctx.translate(13 * dpr, (top + bottom) / 2);
-    ctx.rotate(-Math.PI / 2);
-    ctx.textAlign = 'center';
-    ctx.fillText('position error (m)', 0, 0);
-    ctx.restore();
-    ctx.strokeStyle = '#888';
-    ctx.strokeRect(left, top, right - left, bottom - top);
+    const { ctx, dpr, X, Y, left, right } = plotFrame(this.canvas, tMax, eMax, 'time since the bag’s first scan (s)', 'position error (m)');
     for (const r of robots) {
       const e = r.truth.errors, t0 = start.get(r.log);
       ctx.strokeStyle = r.colour;
