@@ -408,19 +408,23 @@ impl LogSlam {
             self.last_time = scan.time;
             return;
         };
-        // With odometry, the constant-velocity guess is only a second
-        // opinion after a stale odometry reading (and the last step as it
-        // was); without, it is the prediction.
-        let steady = if self.config.odometry {
-            last_pose.compose(&self.last_step)
+        // With odometry, the constant-velocity guess is a second opinion
+        // after a stale odometry reading (the last step as it was).
+        // Without, it is the prediction, and standing still the second
+        // opinion: a constant velocity carries a wrong match's turn into
+        // the next scan, and a robot that stops must be found where it
+        // stopped.
+        let (predicted, steady) = if self.config.odometry {
+            (
+                last_pose.compose(&last_odom.between(&scan.odometry)),
+                last_pose.compose(&self.last_step),
+            )
         } else {
-            last_pose.compose(&self.steady_step(scan.time))
+            (last_pose.compose(&self.steady_step(scan.time)), last_pose)
         };
-        let predicted = if self.config.odometry {
-            last_pose.compose(&last_odom.between(&scan.odometry))
-        } else {
-            steady
-        };
+        if !self.config.odometry {
+            self.odometry_stale = true;
+        }
         let found = self.match_local(&points, &predicted, &steady);
         let pose = match &found {
             Some(m) => {
@@ -434,7 +438,7 @@ impl LogSlam {
             }
         };
         let step = last_pose.between(&pose);
-        self.odometry_stale = self.config.odometry && last_odom == scan.odometry;
+        self.odometry_stale = !self.config.odometry || last_odom == scan.odometry;
         let key = self.graph.nodes.len() - 1;
         let rel = self.graph.nodes[key].between(&pose);
         let is_key = rel.position().length() >= self.config.key_distance_m
