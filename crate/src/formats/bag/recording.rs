@@ -267,7 +267,11 @@ impl BagContents {
             name,
             m.width as usize,
             m.height as usize,
-            m.resolution as f64,
+            // The float32 as it was written (0.05, not 0.0500000007).
+            m.resolution
+                .to_string()
+                .parse::<f64>()
+                .unwrap_or(m.resolution as f64),
             pose2_of(&m.origin),
             data,
         )
