@@ -77,7 +77,7 @@ async function folderFiles(bag, dir) {
     if (e.code !== 'ENOENT') throw new UsageError(`${dir}/metadata.yaml: ${e.code ?? e.message}`);
   }
   const names = await readdir(dir);
-  if (listed.length === 0) listed = names.filter((n) => /\.(db3|mcap)$/i.test(n)).sort();
+  if (listed.length === 0) listed = names.filter((n) => /\.(db3|mcap)(\.zstd)?$/i.test(n)).sort();
   if (listed.length === 0) throw new UsageError(`${dir}: no .db3 or .mcap file in the folder`);
   const out = [];
   for (const f of listed) {

@@ -175,21 +175,28 @@ impl BagFile {
         match sniff(head) {
             Some(Container::Ros1) => Ok(Box::new(Ros1Reader::new())),
             Some(Container::Mcap) => Ok(Box::new(McapReader::new())),
-            Some(Container::Sqlite) => {
-                let mut reader = Db3Reader::new();
-                if let Some(m) = &self.metadata {
-                    reader = reader.with_metadata(m).map_err(|e| format!("{name}: {e}"))?;
-                }
-                if let Some(wal) = self.wal.take() {
-                    reader.push_wal(&wal);
-                }
-                Ok(Box::new(reader))
-            }
+            // A zstd frame: a rosbag2 `.db3.zstd` (compression mode FILE),
+            // which the SQLite reader decompresses.
+            None if head.starts_with(&ZSTD_MAGIC) => self.db3_reader(&name),
+            Some(Container::Sqlite) => self.db3_reader(&name),
             None => Err(format!(
                 "{name}: not a ROS bag: neither a ROS 1 bag (#ROSBAG V2.0), an MCAP file nor a rosbag2 SQLite file; it starts with {}",
                 printable(head)
             )),
         }
+    }
+
+    fn db3_reader(&mut self, name: &str) -> Result<Box<dyn BagReader>, String> {
+        let mut reader = Db3Reader::new();
+        if let Some(m) = &self.metadata {
+            reader = reader
+                .with_metadata(m)
+                .map_err(|e| format!("{name}: {e}"))?;
+        }
+        if let Some(wal) = self.wal.take() {
+            reader.push_wal(&wal);
+        }
+        Ok(Box::new(reader))
     }
 
     /// Ends the current file: its reader hands over what is left.
@@ -339,13 +346,18 @@ impl BagFile {
     }
 }
 
+/// The first bytes of a zstd frame (a rosbag2 `.db3.zstd`).
+const ZSTD_MAGIC: [u8; 4] = [0x28, 0xb5, 0x2f, 0xfd];
+
 /// Which container a file is from its first bytes: `"ros1"`, `"mcap"`,
-/// `"sqlite"`, or `""` (not a bag: a CARMEN log, say).
+/// `"sqlite"` (also a zstd-compressed `.db3.zstd`), or `""` (not a bag: a
+/// CARMEN log, say).
 pub fn bag_kind(first_bytes: &[u8]) -> &'static str {
     match sniff(first_bytes) {
         Some(Container::Ros1) => "ros1",
         Some(Container::Mcap) => "mcap",
         Some(Container::Sqlite) => "sqlite",
+        None if first_bytes.starts_with(&ZSTD_MAGIC) => "sqlite",
         None => "",
     }
 }
@@ -364,4 +376,35 @@ fn printable(head: &[u8]) -> String {
         })
         .collect();
     format!("\"{text}\"")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_container_is_told_by_its_first_bytes() {
+        assert_eq!(bag_kind(b"#ROSBAG V2.0\nxxxx"), "ros1");
+        assert_eq!(bag_kind(b"#ROSRECORD V1.2\n"), "ros1");
+        assert_eq!(bag_kind(b"\x89MCAP0\r\nxxxxxxxx"), "mcap");
+        assert_eq!(bag_kind(b"SQLite format 3\0"), "sqlite");
+        // rosbag2's compression mode FILE: a zstd-compressed .db3.
+        assert_eq!(bag_kind(&[0x28, 0xb5, 0x2f, 0xfd, 0, 0, 0, 0]), "sqlite");
+        assert_eq!(bag_kind(b"FLASER 180 1.0 2"), "");
+        assert_eq!(bag_kind(&[0x1f, 0x8b, 8, 0]), "");
+    }
+
+    #[test]
+    fn a_file_that_is_no_bag_is_named_with_its_first_bytes() {
+        let mut bag = BagFile::new("x.bag");
+        bag.begin_file("x.bag").expect("begins");
+        let e = bag.push(b"hello, this is not a bag").unwrap_err();
+        assert!(
+            e.contains("x.bag: not a ROS bag") && e.contains("\"hello, this is n"),
+            "{e}"
+        );
+        let mut empty = BagFile::new("e.bag");
+        empty.begin_file("e.bag").expect("begins");
+        assert!(empty.finish().unwrap_err().contains("the file is empty"));
+    }
 }

@@ -69,7 +69,7 @@ export async function sortFiles(wasm, entries) {
       const here = inDir(dir);
       const folder = baseName(dir);
       const listed = metadataFiles(wasm, folder || 'rosbag2', text);
-      const data = listed.length ? listed : here.map((e) => baseName(e.path)).filter((n) => /\.(db3|mcap)$/i.test(n)).sort();
+      const data = listed.length ? listed : here.map((e) => baseName(e.path)).filter((n) => /\.(db3|mcap)(\.zstd)?$/i.test(n)).sort();
       const files = [];
       const missing = [];
       for (const n of data) {
@@ -88,7 +88,7 @@ export async function sortFiles(wasm, entries) {
         throw new Error(`${meta.path}: it lists ${data.join(', ') || 'no data file'}; pick or drop the folder's data files together with it`);
       }
       // Picked loose, the folder has no name: the bag is called after its first file.
-      const name = folder || data[0].replace(/\.(db3|mcap)$/i, '');
+      const name = folder || data[0].replace(/\.(db3|mcap)(\.zstd)?$/i, '');
       const bag = BagFile.open(wasm, name);
       bag.setMetadata(text);
       items.push({ name, bag, files, missing });
