@@ -33,6 +33,7 @@ import path from 'node:path';
 import { ARTIFACTS, newPage, useBrowser, waitReady } from './support/browser.mjs';
 import { centredFrame, floorPlan, mapImage, mapYaml, symmetricPlan } from './support/synthetic-maps.mjs';
 import { ringLog } from './support/synthetic-log.mjs';
+import { gridOf, mapBag } from './support/map-bags.mjs';
 
 const env = useBrowser();
 const tmp = mkdtempSync(path.join(tmpdir(), 'slamlab-page-real-'));
@@ -171,6 +172,27 @@ test('your maps: open two maps, merge them, read the verdict and the transform, 
   // Closing the view brings the lab back as it was.
   await page.getByRole('button', { name: /Close your maps/ }).click();
   assert.equal(await page.locator('#real').isHidden(), true);
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});
+
+test('your maps: a saved map and a robot\'s bag with its /map merge to the transform that made them', { timeout: 180000 }, async () => {
+  const maps = twoMaps('bagged', 30, 20, 640, 440, 640, 7);
+  // Map B as a robot's recording: the last OccupancyGrid on /map of an MCAP.
+  const bag = path.join(tmp, 'robot-b.mcap');
+  writeFileSync(bag, mapBag(gridOf(readFileSync(maps.files[3])), [0, 0, 0]));
+  const { context, page, problems } = await newPage(env.browser);
+  await openView(page);
+  await page.setInputFiles('#real-files', [maps.files[0], maps.files[1], bag]);
+  await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().report, null, { timeout: 120000 });
+  assert.equal(await page.locator('.real-card').count(), 2, 'a card per map');
+  assert.match(await page.locator('.real-card').nth(1).innerText(), /robot-b\.mcap[\s\S]*640 × 640 cells · 0\.05 m/);
+  const report = (await snapshot(page)).report;
+  assert.equal(report.merge.status, 'merged', report.merge.reason);
+  const [x, y, th] = report.merge.transforms[1].pose;
+  const [tx, ty, tt] = maps.truth;
+  assert.ok(Math.hypot(x - tx, y - ty) < 0.1, `the bag's map is off by ${Math.hypot(x - tx, y - ty)} m`);
+  assert.ok(Math.abs(th - tt) < (0.5 * Math.PI) / 180, `the bag's map is off by ${((th - tt) * 180) / Math.PI} deg`);
   assert.deepEqual(problems, [], 'no console errors or page errors');
   await context.close();
 });

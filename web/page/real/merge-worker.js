@@ -22,6 +22,7 @@
 
 import init, * as wasm from '../../pkg/slamlab.js';
 import { SavedMaps, mapImagePath } from '../../saved-maps.js';
+import { BagFile, bagKind } from '../../bag-file.js';
 import { groupFiles } from './files.js';
 import { previewOf } from './preview.js';
 import { compose, drawPlaced, fitView } from './overlay.js';
@@ -43,16 +44,39 @@ function message(e) {
   return e instanceof Error ? e.message : String(e);
 }
 
-/** Reads the picked files into maps; the good ones load even if some are bad. */
+/** True for a bag file: named as one, or starting as one. */
+function isBag(f) {
+  return /\.(bag|mcap|db3)$/i.test(f.name) || bagKind(wasm, new Uint8Array(f.bytes, 0, Math.min(16, f.bytes.byteLength))) !== '';
+}
+
+/** A bag's /map (or only OccupancyGrid topic), read in pieces, into the saved maps; its index. */
+function addBag(f) {
+  const bag = BagFile.open(wasm, f.name);
+  try {
+    const bytes = new Uint8Array(f.bytes);
+    for (let at = 0; at < bytes.length; at += 8 << 20) bag.push(bytes.subarray(at, at + (8 << 20)));
+    bag.finish();
+    return savedMaps.addBagMap(bag);
+  } finally {
+    bag.free();
+  }
+}
+
+/** Reads the picked files into maps (a bag's map too); the good ones load even if some are bad. */
 async function add({ files, resolution, colours }) {
   savedMaps ??= SavedMaps.open(wasm);
-  const { maps, errors } = groupFiles(files, (name, yaml) => mapImagePath(wasm, name, yaml), resolution);
+  const bags = files.filter(isBag);
+  const { maps, errors } = groupFiles(files.filter((f) => !isBag(f)), (name, yaml) => mapImagePath(wasm, name, yaml), resolution);
   const added = [];
   const transfer = [];
-  for (const m of maps) {
+  const reads = [
+    ...maps.map((m) => [m.imageName, () => savedMaps.addMap(m.name, m.yaml, m.imageName, m.image)]),
+    ...bags.map((f) => [f.name, () => addBag(f)]),
+  ];
+  for (const [imageName, read] of reads) {
     let index;
     try {
-      index = savedMaps.addMap(m.name, m.yaml, m.imageName, m.image);
+      index = read();
     } catch (e) {
       errors.push(message(e));
       continue;
@@ -62,7 +86,7 @@ async function add({ files, resolution, colours }) {
     const { thumb, ...preview } = await previewOf(savedMaps.mapPixels(index), info.width, info.height, colour);
     pictures.set(info.name, { ...info, index, preview });
     transfer.push(thumb);
-    added.push({ ...info, index, imageName: m.imageName, colour, thumb });
+    added.push({ ...info, index, imageName, colour, thumb });
   }
   return { result: { added, errors }, transfer };
 }

@@ -28,12 +28,13 @@ const HTML = `
     <button type="button" class="real-close" aria-label="Close your maps and go back to the lab">Close</button>
   </div>
   <p class="real-note">Open two to sixteen ROS <code>map_server</code> maps, each a YAML with the PGM or PNG image it
-    names (pick or drop them together). The lab merges them with the same automatic merge as
+    names (pick or drop them together), or a ROS bag (<code>.bag</code>, <code>.mcap</code>, <code>.db3</code>) whose
+    <code>/map</code> topic holds a robot's map (its last <code>nav_msgs/OccupancyGrid</code>). The lab merges them with the same automatic merge as
     <code>node web/cli.mjs merge-maps</code>, off the page's main thread. Your scenario and runs stay as they are.</p>
   <div class="real-drop" tabindex="0" aria-label="Drop map files here">
     <span>Drop map files here, or</span>
     <label class="button primary" for="real-files">Open maps…</label>
-    <input id="real-files" type="file" multiple accept=".yaml,.yml,.pgm,.png" hidden>
+    <input id="real-files" type="file" multiple accept=".yaml,.yml,.pgm,.png,.bag,.mcap,.db3" hidden>
     <label for="real-resolution" title="For an image picked without a YAML">Resolution of an image without YAML</label>
     <input id="real-resolution" type="number" min="0.001" step="0.01" value="0.05" class="num"><span class="unit">m</span>
     <button type="button" id="real-clear">Clear maps</button>
