@@ -120,6 +120,28 @@ test('run-log --from/--to replays a stretch; --out writes PGM, YAML and PNG', ()
   assert.equal(j.scans.at(-1).index, 40);
 });
 
+test('run-log --trajectory writes the SLAM poses as a TUM trajectory, one line a scan', () => {
+  const out = path.join(tempDir(), 'run.tum');
+  const r = run('run-log', plain, '--json', '--trajectory', out);
+  assert.equal(r.code, 0, r.stderr);
+  const report = JSON.parse(r.stdout);
+  const lines = readFileSync(out, 'utf8').trim().split('\n');
+  assert.match(lines[0], /^# timestamp x y z qx qy qz qw/);
+  const rows = lines.slice(1).map((l) => l.split(' ').map(Number));
+  assert.equal(rows.length, report.scans.length);
+  rows.forEach((row, k) => {
+    const scan = report.scans[k];
+    assert.equal(row.length, 8);
+    assert.ok(Math.abs(row[0] - scan.time) < 1e-6, `time of scan ${k}`);
+    assert.ok(Math.abs(row[1] - scan.pose[0]) < 1e-9 && Math.abs(row[2] - scan.pose[1]) < 1e-9, `position of scan ${k}`);
+    assert.deepEqual([row[3], row[4], row[5]], [0, 0, 0]);
+    // A rotation about z by the scan's heading: (0, 0, sin θ/2, cos θ/2).
+    const th = 2 * Math.atan2(row[6], row[7]);
+    const d = Math.atan2(Math.sin(th - scan.pose[2]), Math.cos(th - scan.pose[2]));
+    assert.ok(Math.abs(d) < 1e-9 && Math.abs(Math.hypot(row[6], row[7]) - 1) < 1e-9, `heading of scan ${k}`);
+  });
+});
+
 test('run-log: bad input exits 2 with a message naming the line', () => {
   const lines = text.split('\n');
   // Line 10 cut short in the middle of its ranges.
