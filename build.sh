@@ -21,7 +21,7 @@ export PATH="$HOME/.cargo/bin:$PATH"
 SIMD_FLAGS='-C target-feature=+simd128'
 # The real-data suite's test files (each fails loudly without ../shared/data).
 REAL_RUST_TESTS='--test real_maps --test real_logs --test real_bags --test real_bag_containers --test real_bag_db3'
-REAL_NODE_TESTS='tests/page-bags.test.mjs'
+REAL_NODE_TESTS='tests/real-bags.test.mjs tests/page-bags.test.mjs'
 
 log() { printf '\033[1;34m==>\033[0m %s\n' "$*" >&2; }
 
