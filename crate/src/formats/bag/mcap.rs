@@ -58,7 +58,9 @@
 //! channel record has not come yet waits for it; messages whose channel
 //! never comes are reported lost.
 
-use super::stream::{byte_count, shown, u64_at, Extent, Flow, Records, Waiting, RECORD_LIMIT};
+use super::stream::{
+    byte_count, record_at, shown, u64_at, Extent, Flow, Records, Waiting, RECORD_LIMIT,
+};
 use super::{BagError, BagReader, Encoding, MessageSink, RawMessage, ReadEnd, Topic};
 use mcap::records::{op, Record};
 use std::borrow::Cow;
@@ -217,10 +219,6 @@ fn not_mcap(start: &[u8]) -> BagError {
             shown(MAGIC)
         ),
     )
-}
-
-fn record_at(at: u64) -> String {
-    format!("the record at byte {}", byte_count(at))
 }
 
 /// Measures the record at the front of `bytes` (file offset `at`):

@@ -69,7 +69,7 @@
 //! 1's `rosbag` tools read 1.2 and always write 2.0, so copying the bag
 //! with them (`rosbag filter old.bag new.bag True`) converts it.
 
-use super::stream::{byte_count, shown, u32_at, Extent, Flow, Records, Waiting};
+use super::stream::{byte_count, record_at, shown, u32_at, Extent, Flow, Records, Waiting};
 use super::stream::{HEADER_LIMIT, RECORD_LIMIT};
 use super::{BagError, BagReader, Encoding, MessageSink, RawMessage, ReadEnd, Topic};
 use std::borrow::Cow;
@@ -313,11 +313,6 @@ fn not_a_bag(start: &[u8]) -> BagError {
             shown(MAGIC)
         ),
     )
-}
-
-/// The record label of messages: "the record at byte 4,117".
-fn record_at(at: u64) -> String {
-    format!("the record at byte {}", byte_count(at))
 }
 
 /// Measures the record at the front of `bytes` (file offset `at`):

@@ -236,6 +236,11 @@ pub fn byte_count(n: u64) -> String {
     out
 }
 
+/// A record's label in messages: "the record at byte 4,117".
+pub fn record_at(at: u64) -> String {
+    format!("the record at byte {}", byte_count(at))
+}
+
 /// Bytes as a quoted string for a message: printable ASCII as it is,
 /// anything else as `\xNN` (`\n` as `\n`).
 pub fn shown(bytes: &[u8]) -> String {
