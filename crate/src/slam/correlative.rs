@@ -122,7 +122,7 @@ fn search_blocks(
     let w = (cfg.linear_window_m / res).round() as i64;
     let k = field.k as i64;
     let nt = (cfg.angular_window_rad / cfg.angular_step_rad).round() as i64;
-    let scan = Rotated::new(field, points, prior, cfg.angular_step_rad, nt, w);
+    let scan = Rotated::new(field, points, prior, cfg.angular_step_rad, nt);
     // Coarse candidates: every block of `k × k` translations at every
     // rotation, bounded by the coarse table.
     let starts: Vec<i64> = (0..).map(|i| -w + i * k).take_while(|&o| o <= w).collect();
@@ -133,6 +133,7 @@ fn search_blocks(
         k,
         nt,
         excluded: Excluded::new(exclude, prior, res),
+        scratch: Vec::new(),
     };
     if starts.len() < deep_from {
         blocks_flat(&scan, &starts, &mut bnb);
@@ -156,14 +157,8 @@ fn search_blocks(
 struct Rotated<'a> {
     field: &'a LikelihoodField,
     n: usize,
+    n_theta: usize,
     cells: Vec<[i64; 2]>,
-    /// The cells as indices into the tables.
-    index: Vec<i64>,
-    /// Per rotation: every offset the search reads (±w cells, plus a
-    /// coarse block) stays inside the window, so its sums need no bounds
-    /// tests. Rotations where some point comes nearer an edge keep the
-    /// checked reads. Both read the same values in the same order.
-    inside: Vec<bool>,
 }
 
 impl<'a> Rotated<'a> {
@@ -173,55 +168,78 @@ impl<'a> Rotated<'a> {
         prior: &Pose2,
         step_rad: f64,
         nt: i64,
-        w: i64,
     ) -> Self {
         let n_theta = (2 * nt + 1) as usize;
-        let n = points.len();
-        let k = field.k as i64;
-        let mut cells = Vec::with_capacity(n * n_theta);
-        let mut inside = Vec::with_capacity(n_theta);
-        let mut index = Vec::with_capacity(n * n_theta);
-        let (wd, ht) = (field.width as i64, field.height as i64);
+        let mut cells = Vec::with_capacity(points.len() * n_theta);
         for t in -nt..=nt {
             let theta = prior.theta + t as f64 * step_rad;
             let frame = Pose2::new(prior.x, prior.y, theta).frame();
-            let mut all = true;
-            for &p in points {
-                let c = field.cell_of(frame.to_parent(p));
-                all &= c[0] - w >= 0 && c[1] - w >= 0 && c[0] + w + k < wd && c[1] + w + k < ht;
-                cells.push(c);
-                index.push(c[1] * wd + c[0]);
-            }
-            inside.push(all);
+            cells.extend(points.iter().map(|&p| field.cell_of(frame.to_parent(p))));
         }
         Rotated {
             field,
-            n,
+            n: points.len(),
+            n_theta,
             cells,
-            index,
-            inside,
         }
     }
 
     fn rotations(&self) -> usize {
-        self.inside.len()
+        self.n_theta
     }
 
-    /// The sum of `table` (laid out as the field's) over the points at
-    /// rotation `ti`, shifted by `(ox, oy)` cells.
-    fn sum(&self, table: &[f32], ti: usize, ox: i64, oy: i64) -> f32 {
-        let n = self.n;
-        if self.inside[ti] {
-            let off = oy * self.field.width as i64 + ox;
-            self.index[ti * n..(ti + 1) * n]
-                .iter()
-                .fold(0f32, |a, &i| a + table[(i + off) as usize])
-        } else {
-            self.cells[ti * n..(ti + 1) * n]
-                .iter()
-                .map(|c| table_at(table, self.field, c[0] + ox, c[1] + oy))
-                .sum()
+    /// The sums of `table` (laid out as the field's) over the points at
+    /// rotation `ti`, shifted by every `(xs[i], ys[j])` cells (both
+    /// ascending), into `out[j * xs.len() + i]`; cells beyond the table
+    /// count 0.
+    ///
+    /// The points are the outer loop: each point's shifts read a few nearby
+    /// cells — side by side for a block's fine shifts, one slice per row,
+    /// which the compiler adds as vectors — instead of the whole table once
+    /// per shift. A shift whose cell lies beyond the table is skipped
+    /// rather than adding 0 to a non-negative sum, which leaves it as it
+    /// is. So every sum adds the same values in the same order as a sum per
+    /// shift, bit for bit.
+    fn sums(&self, table: &[f32], ti: usize, xs: &[i64], ys: &[i64], out: &mut Vec<f32>) {
+        let nx = xs.len();
+        out.clear();
+        out.resize(nx * ys.len(), 0.0);
+        let (Some(&x0), Some(&x1), Some(&y0), Some(&y1)) =
+            (xs.first(), xs.last(), ys.first(), ys.last())
+        else {
+            return;
+        };
+        let (wd, ht) = (self.field.width as i64, self.field.height as i64);
+        let contiguous = xs.iter().zip(x0..).all(|(&x, y)| x == y);
+        for c in &self.cells[ti * self.n..(ti + 1) * self.n] {
+            let inside = c[0] + x0 >= 0 && c[0] + x1 < wd && c[1] + y0 >= 0 && c[1] + y1 < ht;
+            for (row, &oy) in out.chunks_exact_mut(nx).zip(ys) {
+                let y = c[1] + oy;
+                if inside && contiguous {
+                    let at = (y * wd + c[0] + x0) as usize;
+                    add(row, &table[at..at + nx]);
+                } else if inside {
+                    let at = y * wd + c[0];
+                    for (acc, &ox) in row.iter_mut().zip(xs) {
+                        *acc += table[(at + ox) as usize];
+                    }
+                } else if (0..ht).contains(&y) {
+                    for (acc, &ox) in row.iter_mut().zip(xs) {
+                        let x = c[0] + ox;
+                        if (0..wd).contains(&x) {
+                            *acc += table[(y * wd + x) as usize];
+                        }
+                    }
+                }
+            }
         }
+    }
+}
+
+/// `acc[i] += v[i]` (equal lengths).
+fn add(acc: &mut [f32], v: &[f32]) {
+    for (a, &b) in acc.iter_mut().zip(v) {
+        *a += b;
     }
 }
 
@@ -259,6 +277,8 @@ struct BranchAndBound {
     k: i64,
     nt: i64,
     excluded: Excluded,
+    /// The block's fine sums, kept between visits.
+    scratch: Vec<f32>,
 }
 
 impl BranchAndBound {
@@ -282,12 +302,15 @@ impl BranchAndBound {
             && c.ox + k > e.x - e.r
             && c.oy <= e.y + e.r
             && c.oy + k > e.y - e.r;
-        for oy in c.oy..(c.oy + k).min(w + 1) {
-            for ox in c.ox..(c.ox + k).min(w + 1) {
+        let xs: Vec<i64> = (c.ox..(c.ox + k).min(w + 1)).collect();
+        let ys: Vec<i64> = (c.oy..(c.oy + k).min(w + 1)).collect();
+        let mut sums = std::mem::take(&mut self.scratch);
+        scan.sums(&scan.field.fine, ti, &xs, &ys, &mut sums);
+        for (row, &oy) in sums.chunks_exact(xs.len().max(1)).zip(&ys) {
+            for (&s, &ox) in row.iter().zip(&xs) {
                 if meets && (ox - e.x).abs() <= e.r && (oy - e.y).abs() <= e.r {
                     continue;
                 }
-                let s = scan.sum(&scan.field.fine, ti, ox, oy);
                 self.evaluations += 1;
                 let better = match self.best {
                     None => true,
@@ -300,35 +323,53 @@ impl BranchAndBound {
                 }
             }
         }
+        self.scratch = sums;
         true
     }
 }
 
-/// The two-level search: every coarse block scored, sorted best first
-/// (equal scores in the order scored, as a stable sort would), and
-/// expanded until the next cannot win.
+/// The two-level search: every coarse block scored, taken best first
+/// (equal scores in the order scored) from a heap, and expanded until the
+/// next cannot win.
 fn blocks_flat(scan: &Rotated, starts: &[i64], bnb: &mut BranchAndBound) {
     let per_axis = starts.len();
-    let mut candidates = Vec::with_capacity(scan.rotations() * per_axis * per_axis);
+    let mut blocks = Vec::with_capacity(scan.rotations() * per_axis * per_axis);
+    let coarse = &scan.field.coarse;
+    let mut sums = Vec::new();
     for ti in 0..scan.rotations() {
-        for &oy in starts {
-            for &ox in starts {
-                let order = candidates.len() as u32;
-                candidates.push(Candidate {
-                    score: scan.sum(&scan.field.coarse, ti, ox, oy),
-                    t: ti as i64 - bnb.nt,
-                    ox,
-                    oy,
-                    order,
-                });
-            }
+        scan.sums(coarse, ti, starts, starts, &mut sums);
+        for &score in &sums {
+            let order = blocks.len() as u32;
+            blocks.push(Queued {
+                score,
+                group: false,
+                order,
+            });
         }
     }
-    candidates.sort_unstable_by(|a, b| b.score.total_cmp(&a.score).then(a.order.cmp(&b.order)));
-    for c in &candidates {
-        if !bnb.visit(scan, c) {
+    // A heap hands the blocks out best first without sorting those the
+    // search never reaches.
+    let mut queue = std::collections::BinaryHeap::from(blocks);
+    while let Some(q) = queue.pop() {
+        if !bnb.visit(scan, &block(&q, starts, bnb.nt)) {
             break;
         }
+    }
+}
+
+/// The coarse block `q` (not a group) stands for.
+fn block(q: &Queued, starts: &[i64], nt: i64) -> Candidate {
+    let (o, per_axis) = (q.order as usize, starts.len());
+    let (ti, iy, ix) = (
+        o / (per_axis * per_axis),
+        o / per_axis % per_axis,
+        o % per_axis,
+    );
+    Candidate {
+        score: q.score,
+        t: ti as i64 - nt,
+        ox: starts[ix],
+        oy: starts[iy],
     }
 }
 
@@ -340,16 +381,17 @@ fn blocks_deep(scan: &Rotated, starts: &[i64], bnb: &mut BranchAndBound) {
     let per_axis = starts.len();
     let groups = per_axis.div_ceil(TOP_BLOCKS);
     let mut queue = std::collections::BinaryHeap::new();
+    let firsts: Vec<i64> = starts.iter().step_by(TOP_BLOCKS).copied().collect();
+    let coarse = &scan.field.coarse;
+    let mut sums = Vec::new();
     for ti in 0..scan.rotations() {
-        for gy in 0..groups {
-            for gx in 0..groups {
-                let (ox, oy) = (starts[gx * TOP_BLOCKS], starts[gy * TOP_BLOCKS]);
-                queue.push(Queued {
-                    score: scan.sum(&top, ti, ox, oy),
-                    group: true,
-                    order: ((ti * groups + gy) * groups + gx) as u32,
-                });
-            }
+        scan.sums(&top, ti, &firsts, &firsts, &mut sums);
+        for (g, &score) in sums.iter().enumerate() {
+            queue.push(Queued {
+                score,
+                group: true,
+                order: (ti * groups * groups + g) as u32,
+            });
         }
     }
     while let Some(q) = queue.pop() {
@@ -359,31 +401,20 @@ fn blocks_deep(scan: &Rotated, starts: &[i64], bnb: &mut BranchAndBound) {
         let o = q.order as usize;
         if q.group {
             let (ti, gy, gx) = (o / (groups * groups), o / groups % groups, o % groups);
-            for iy in gy * TOP_BLOCKS..((gy + 1) * TOP_BLOCKS).min(per_axis) {
-                for ix in gx * TOP_BLOCKS..((gx + 1) * TOP_BLOCKS).min(per_axis) {
-                    queue.push(Queued {
-                        score: scan.sum(&scan.field.coarse, ti, starts[ix], starts[iy]),
-                        group: false,
-                        order: ((ti * per_axis + iy) * per_axis + ix) as u32,
-                    });
-                }
+            let iys = gy * TOP_BLOCKS..((gy + 1) * TOP_BLOCKS).min(per_axis);
+            let ixs = gx * TOP_BLOCKS..((gx + 1) * TOP_BLOCKS).min(per_axis);
+            let (ys, xs) = (&starts[iys.clone()], &starts[ixs.clone()]);
+            scan.sums(coarse, ti, xs, ys, &mut sums);
+            let blocks = iys.flat_map(|iy| ixs.clone().map(move |ix| (ix, iy)));
+            for (&score, (ix, iy)) in sums.iter().zip(blocks) {
+                queue.push(Queued {
+                    score,
+                    group: false,
+                    order: ((ti * per_axis + iy) * per_axis + ix) as u32,
+                });
             }
-        } else {
-            let (ti, iy, ix) = (
-                o / (per_axis * per_axis),
-                o / per_axis % per_axis,
-                o % per_axis,
-            );
-            let c = Candidate {
-                score: q.score,
-                t: ti as i64 - bnb.nt,
-                ox: starts[ix],
-                oy: starts[iy],
-                order: q.order,
-            };
-            if !bnb.visit(scan, &c) {
-                break;
-            }
+        } else if !bnb.visit(scan, &block(&q, starts, bnb.nt)) {
+            break;
         }
     }
 }
@@ -394,7 +425,6 @@ struct Candidate {
     t: i64,
     ox: i64,
     oy: i64,
-    order: u32,
 }
 
 /// From this many coarse blocks along each axis of the window on, the
@@ -477,15 +507,6 @@ fn top_table(field: &LikelihoodField) -> Vec<f32> {
         }
     }
     top
-}
-
-/// `table` (laid out as `field`'s) at window cell `(x, y)`, 0 outside.
-fn table_at(table: &[f32], field: &LikelihoodField, x: i64, y: i64) -> f32 {
-    if x < 0 || y < 0 || x >= field.width as i64 || y >= field.height as i64 {
-        0.0
-    } else {
-        table[y as usize * field.width + x as usize]
-    }
 }
 
 #[cfg(test)]
