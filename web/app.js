@@ -74,7 +74,8 @@ const cancelDrag = () => pointer.cancel();
 
 const runner = new RunController(store, {
   guard, cancelDrag, refreshPanels, refreshControls, invalidate, readouts: (force) => toolbar.readouts(force),
-  finished: (st) => st.robots.length >= 2 && !guide.isOpen && mergePanel.reveal(),
+  // The guide, when open, says what comes next in its own steps.
+  finished: (st) => (guide.isOpen ? guide.announce() : st.robots.length >= 2 && mergePanel.reveal()),
 });
 const view = new WorldView(canvas, store, {
   running: () => runner.running, editable, state: () => runner.state, readState: () => runner.readState(),
@@ -120,6 +121,7 @@ const mergePanel = new MergePanel($('merge'), $('pair-overlay'), {
   robotCount: () => store.scenario?.robots.length ?? 0,
   onError,
   setStatus,
+  quiet: () => guide.isOpen,
   download,
   report: () => store.lab.reportText(),
 });
@@ -142,8 +144,10 @@ const guide = new GuidedTour($('guide'), $('guided-open'), {
   },
   zoomTo: (points) => view.zoomTo(points),
   onError,
+  setStatus,
   onToggle: (open) => {
     document.body.classList.toggle('guided', open);
+    if (!open) mergePanel.flushStatus();
     view.invalidate();
   },
 });
