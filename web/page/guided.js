@@ -437,7 +437,9 @@ export class GuidedTour {
         : 'Press Run (Space) to let the robots finish their run.');
       return this.setLive(lines, false, '');
     }
-    lines.push(`Run finished at t = ${fmt(run.time_s, 1)} s. Frames: ${frames}.`);
+    const period = Number(lab.camera().period_s.toFixed(2));
+    lines.push(`Run finished at t = ${fmt(run.time_s, 1)} s. Frames: ${frames}: one every ${period} s of simulated time, ` +
+      `from t = 0 s to ${fmt(run.time_s, 0)} s. The merge will not compare them all: step 2 keeps a few of each robot\u2019s.`);
     const ate = run.robots.map((name, i) => {
       const f = lab.slamFigures(i);
       return `${name} ${fmt(f.ate_m)} m (odometry alone ${fmt(f.odometry_ate_m)} m)`;

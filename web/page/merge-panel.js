@@ -9,7 +9,7 @@
 // its legend and keyboard cursor). Clicking a cell opens the two frames
 // with their matches and the matched-region quad (thesis Figure 8;
 // web/page/pair-view.js). At the
-// end the verdict appears with its reason, the transform of each robot's map
+// end the verdict appears (scrolled into view) with its reason, the transform of each robot's map
 // frame, its error against the ground truth, and the merged map with
 // downloads (PNG, ROS map_server PGM + YAML, report JSON). A merge the
 // ground truth puts more than 0.5 m or 5° off is called a wrong merge, in
@@ -303,6 +303,8 @@ export class MergePanel {
         p = lab.mergeAdvance(2);
       } while (!p.finished && performance.now() - t0 < SLICE_MS);
       this.view = lab.mergeView();
+      // the rule that chose the table's frames, read once a merge
+      if (!this.matchTable.rule && this.view.tables.length) this.matchTable.rule = lab.mergeSelection();
     } catch (e) {
       this.active = false;
       this.hooks.onError(e);
@@ -404,6 +406,9 @@ export class MergePanel {
     }
     this.showGroup(first);
     this.remember(r);
+    // The verdict is what the user waited for: into view (the guide, when
+    // open, brings the panel into view at its own step).
+    if (!this.hooks.quiet?.()) this.verdict.scrollIntoView({ block: 'start', behavior: 'smooth' });
     this.say(
       wrong ? `Wrong merge: ${wrongWords(wrong)} (against the ground truth), though the method reports success.`
         : this.groupList ? groupsStatus(r) : merged ? `Maps merged: ${r.transforms.length} robots joined.` : `No merge: ${plainReason(r.reason)}`,
