@@ -11,6 +11,8 @@
 //     the table says how many frames each robot kept and by which rule (the
 //     merge's own numbers); the lab's words have no status names
 //     (`no_merge`), no "inf" and no command-line jargon.
+//   - Map files and logs dropped on the lab's map open "Your maps" and
+//     "Your log" with them, and the lab's run stays as it was.
 //
 // Needs the wasm build in web/pkg (`./build.sh build`). Run alone with
 //   node --test tests/page-lab-ux.test.mjs
@@ -18,6 +20,8 @@ import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import path from 'node:path';
 import { ARTIFACTS, newPage, useBrowser, waitReady } from './support/browser.mjs';
+import { centredFrame, floorPlan, mapImage, mapYaml } from './support/synthetic-maps.mjs';
+import { ringLog } from './support/synthetic-log.mjs';
 
 const env = useBrowser();
 const statusText = (page) => page.locator('#status').innerText();
@@ -202,6 +206,76 @@ test('Space after the speed slider; the verdict in view after Merge maps; the ke
     assert.equal(hit, null, `the lab's words have no ${bad}: "${hit?.[0]}"`);
   }
   await page.keyboard.press('Escape');
+
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});
+
+/**
+ * Drops `files` ([{name, base64}]) on the lab's map as a drag from a file
+ * manager arrives: dragenter, dragover and drop on #world, the DataTransfer
+ * holding File objects. Returns whether the page took the drop (a drop
+ * nobody cancels makes the browser leave the page for the file).
+ */
+function dropOnLab(page, files) {
+  return page.evaluate((files) => {
+    const dt = new DataTransfer();
+    for (const f of files) {
+      const bytes = Uint8Array.from(atob(f.base64), (c) => c.charCodeAt(0));
+      dt.items.add(new File([bytes], f.name));
+    }
+    const world = document.querySelector('#world');
+    const r = world.getBoundingClientRect();
+    const at = { clientX: r.x + r.width / 2, clientY: r.y + r.height / 2 };
+    const taken = {};
+    for (const type of ['dragenter', 'dragover', 'drop']) {
+      taken[type] = !world.dispatchEvent(new DragEvent(type, { dataTransfer: dt, bubbles: true, cancelable: true, ...at }));
+    }
+    return taken;
+  }, files);
+}
+
+const file = (name, data) => ({ name, base64: Buffer.from(data).toString('base64') });
+
+test('files dropped on the lab open Your maps or Your log with them; the lab keeps its run', { timeout: 120000 }, async () => {
+  const { context, page, problems } = await newPage(env.browser, { width: 1366, height: 768 });
+  await page.goto(env.baseUrl);
+  await waitReady(page);
+  await page.getByRole('button', { name: 'Run', exact: true }).click();
+  await page.waitForFunction(() => window.slamlab.state().time_s >= 2);
+  await page.getByRole('button', { name: 'Pause', exact: true }).click();
+  const lab = () => page.evaluate(() => ({ t: window.slamlab.state().time_s, scenario: JSON.stringify(window.slamlab.scenario()) }));
+  const before = await lab();
+
+  // A saved map (YAML + PGM) dropped on the map: Your maps opens with it.
+  const plan = floorPlan(12, 9, 5);
+  const map = [file('drop-a.yaml', mapYaml('drop-a.pgm')),
+    file('drop-a.pgm', mapImage(plan, centredFrame(6, 4.5, 0, 160, 120), 160, 120, () => true))];
+  const taken = await dropOnLab(page, map);
+  assert.deepEqual(taken, { dragenter: false, dragover: true, drop: true }, 'the lab takes the drop (the browser stays on the page)');
+  await page.waitForSelector('#real:not([hidden])');
+  await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().maps.length === 1, null, { timeout: 20000 });
+  assert.deepEqual(await page.evaluate(() => window.slamlab.savedMaps.snapshot().maps.map((m) => m.name)), ['drop-a.yaml']);
+  assert.equal(await page.locator('#logview').isHidden(), true);
+  await page.screenshot({ path: path.join(ARTIFACTS, 'issue55-dropped-map-1366x768.png') });
+  await page.locator('#real .real-close').click();
+  assert.deepEqual(await lab(), before, 'the lab\u2019s run and scenario are as they were');
+
+  // A CARMEN log dropped on the map: Your log opens with it.
+  await dropOnLab(page, [file('drop-ring.log', ringLog({ laps: 1, perLap: 40 }).text)]);
+  await page.waitForSelector('#logview:not([hidden])');
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().name === 'drop-ring.log', null, { timeout: 20000 });
+  assert.ok((await page.evaluate(() => window.slamlab.logView.snapshot().robots.length)) >= 1, 'the log is one robot');
+  assert.equal(await page.locator('#real').isHidden(), true);
+  await page.locator('#logview .real-close').click();
+
+  // Anything else is refused in words, and nothing opens.
+  await dropOnLab(page, [file('notes.txt', 'hello')]);
+  await page.waitForFunction(() => /cannot open notes\.txt/.test(document.querySelector('#status').textContent));
+  assert.equal(await page.locator('#real').isHidden(), true);
+  assert.equal(await page.locator('#logview').isHidden(), true);
+  assert.deepEqual(await lab(), before, 'the lab\u2019s run and scenario are as they were');
+  assert.equal(page.url(), env.baseUrl, 'the page is still the lab');
 
   assert.deepEqual(problems, [], 'no console errors or page errors');
   await context.close();

@@ -17,7 +17,8 @@
 //                   pair-view.js (+ pair-map.js) the merge's frame pair,
 //                   match-table.js, merge-words.js, hidpi.js (pixel ratio)
 //   frame.js        an animation frame's work and pacing (+ frame-times.js)
-//   real/           saved maps and logs, merged and replayed in workers
+//   real/           saved maps and logs, merged and replayed in workers;
+//                   lab-drop.js hands files dropped on the lab to them
 // and web/lab.js, the facade over the wasm `Lab` the command line uses too.
 //
 // Data flows one way: input handlers call the store or a controller; the
@@ -50,6 +51,7 @@ import { GuidedTour } from './page/guided.js';
 import { Covers } from './page/real/cover.js';
 import { SavedMapsView } from './page/real/panel.js';
 import { LogView } from './page/real/log-panel.js';
+import { takeDrops } from './page/lab-drop.js';
 
 const $ = (id) => document.getElementById(id);
 const canvas = $('world');
@@ -244,6 +246,7 @@ async function main() {
   $('guided-open').addEventListener('click', () => guide.toggle());
   savedMaps.wire();
   logView.wire();
+  takeDrops(document, { maps: savedMaps, log: logView, say: setStatus });
   pointer.listen();
   keys.listen();
   persistence.listen();
