@@ -186,7 +186,7 @@ export class MatchTable {
     this.hint.textContent =
       `${ra.name}: ${rows} of ${ra.captured} frames kept, ${rb.name}: ${cols} of ${rb.captured}` +
       `${keptRule(this.view.method, this.rule)}. ${checked}` +
-      `A row is one of ${ra.name}\u2019s kept frames, a column one of ${rb.name}\u2019s; a cell counts ${counts}. ` +
+      `A row is one of ${ra.name}\u2019s frames, a column one of ${rb.name}\u2019s; a cell counts ${counts}. ` +
       'Click a cell, or Tab to the table and use the arrow keys and Enter, to see a pair\u2019s matches.';
   }
 
