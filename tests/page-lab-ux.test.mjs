@@ -60,6 +60,8 @@ for (const viewport of [{ width: 1366, height: 768 }, { width: 1920, height: 108
     const afterRun = await statusText(page);
     assert.match(afterRun, /^Guide, step 1 of 5/, `after the run the status line speaks for the guide: "${afterRun}"`);
     assert.doesNotMatch(afterRun, /Merge maps|merge the robots/i, 'it does not send the user to the Merge panel ahead of the guide');
+    const mapHint = await page.locator('#world').getAttribute('data-hint');
+    assert.match(mapHint, /^Run finished: the guide below/, `nor does the hint on the map: "${mapHint}"`);
 
     // Step 2 (selection), then step 3 (matching), with the Next button.
     await page.locator('#guide-next').click();

@@ -81,7 +81,7 @@ const runner = new RunController(store, {
 });
 const view = new WorldView(canvas, store, {
   running: () => runner.running, editable, state: () => runner.state, readState: () => runner.readState(),
-  tool: () => editor.tool, preview: () => pointer.preview,
+  tool: () => editor.tool, preview: () => pointer.preview, guided: () => guide.isOpen,
 });
 const editor = new Editor(store, {
   guard, editable, cancelDrag, refreshControls, invalidate, validate: (text) => wasm.validateScenario(text),
