@@ -17,7 +17,8 @@
 //                   pair-view.js (+ pair-map.js) the merge's frame pair,
 //                   match-table.js, merge-words.js, hidpi.js (pixel ratio)
 //   frame.js        an animation frame's work and pacing (+ frame-times.js)
-//   real/           saved maps and logs, merged and replayed in workers
+//   real/           saved maps and logs, merged and replayed in workers;
+//                   lab-drop.js hands files dropped on the lab to them
 // and web/lab.js, the facade over the wasm `Lab` the command line uses too.
 //
 // Data flows one way: input handlers call the store or a controller; the
@@ -50,6 +51,7 @@ import { GuidedTour } from './page/guided.js';
 import { Covers } from './page/real/cover.js';
 import { SavedMapsView } from './page/real/panel.js';
 import { LogView } from './page/real/log-panel.js';
+import { takeDrops } from './page/lab-drop.js';
 
 const $ = (id) => document.getElementById(id);
 const canvas = $('world');
@@ -74,11 +76,12 @@ const cancelDrag = () => pointer.cancel();
 
 const runner = new RunController(store, {
   guard, cancelDrag, refreshPanels, refreshControls, invalidate, readouts: (force) => toolbar.readouts(force),
-  finished: (st) => st.robots.length >= 2 && !guide.isOpen && mergePanel.reveal(),
+  // The guide, when open, says what comes next in its own steps.
+  finished: (st) => (guide.isOpen ? guide.announce() : st.robots.length >= 2 && mergePanel.reveal()),
 });
 const view = new WorldView(canvas, store, {
   running: () => runner.running, editable, state: () => runner.state, readState: () => runner.readState(),
-  tool: () => editor.tool, preview: () => pointer.preview,
+  tool: () => editor.tool, preview: () => pointer.preview, guided: () => guide.isOpen,
 });
 const editor = new Editor(store, {
   guard, editable, cancelDrag, refreshControls, invalidate, validate: (text) => wasm.validateScenario(text),
@@ -120,6 +123,7 @@ const mergePanel = new MergePanel($('merge'), $('pair-overlay'), {
   robotCount: () => store.scenario?.robots.length ?? 0,
   onError,
   setStatus,
+  quiet: () => guide.isOpen,
   download,
   report: () => store.lab.reportText(),
 });
@@ -142,8 +146,10 @@ const guide = new GuidedTour($('guide'), $('guided-open'), {
   },
   zoomTo: (points) => view.zoomTo(points),
   onError,
+  setStatus,
   onToggle: (open) => {
     document.body.classList.toggle('guided', open);
+    if (!open) mergePanel.flushStatus();
     view.invalidate();
   },
 });
@@ -240,6 +246,7 @@ async function main() {
   $('guided-open').addEventListener('click', () => guide.toggle());
   savedMaps.wire();
   logView.wire();
+  takeDrops(document, { maps: savedMaps, log: logView, say: setStatus });
   pointer.listen();
   keys.listen();
   persistence.listen();

@@ -18,8 +18,12 @@
 // formula it uses with the live result, which is read from the Lab every
 // quarter second. The guide drives the existing panels (web/merge-panel.js)
 // rather than duplicating them, and never reads anything the page could not
-// show anyway. Keyboard: every control is a button; Escape closes (app.js).
+// show anyway. While it is open the status line speaks for the guide ("Guide,
+// step 3 of 5 (§6.2.3 Image matching): …"): the merge panel keeps its news
+// until the guide closes, so the line never runs ahead to a step the guide
+// has not reached. Keyboard: every control is a button; Escape closes (app.js).
 import { deg, el, fmt } from './dom.js';
+import { plainReason, wrongMerge, wrongWords } from './merge-words.js';
 
 const REFRESH_MS = 100; // the live text follows the clock closely
 
@@ -111,6 +115,7 @@ export class GuidedTour {
    *          reveal: (id: string, block?: string) => void,
    *          zoomTo: (points: number[][] | null) => void,
    *          onError: (e: unknown) => void,
+   *          setStatus: (text: string, kind: string) => void,
    *          onToggle: (open: boolean) => void}} hooks
    */
   constructor(host, opener, hooks) {
@@ -169,6 +174,7 @@ export class GuidedTour {
   close() {
     if (!this.isOpen) return;
     this.isOpen = false;
+    this.said = '';
     this.host.hidden = true;
     this.opener.setAttribute('aria-expanded', 'false');
     this.hooks.merge.release();
@@ -349,7 +355,7 @@ export class GuidedTour {
   }
 
   /** Replaces the live lines when they changed (so focus and selection survive). */
-  setLive(lines, ready, verdict) {
+  setLive(lines, ready, verdict, kind) {
     const key = JSON.stringify(lines);
     if (key !== this.liveKey) {
       this.liveKey = key;
@@ -361,6 +367,21 @@ export class GuidedTour {
     }
     if (this.verdict.textContent !== verdict) this.verdict.textContent = verdict;
     this.next.disabled = !ready;
+    this.announce(false, verdict, kind ?? (ready ? 'ok' : 'info'));
+  }
+
+  /**
+   * Puts the guide's step and verdict in the status line (the merge panel
+   * keeps quiet while the guide is open, so the line never tells of a step
+   * the guide has not reached); only when it changed, unless `force`.
+   */
+  announce(force = true, verdict = this.verdict.textContent, kind = this.next.disabled ? 'info' : 'ok') {
+    if (!this.isOpen) return;
+    const s = STEPS[this.step];
+    const text = `Guide, step ${this.step + 1} of ${STEPS.length} (§${s.section} ${s.title})${verdict ? `: ${verdict}` : '.'}`;
+    if (!force && text === this.said) return;
+    this.said = text;
+    this.hooks.setStatus(text, kind);
   }
 
   refresh() {
@@ -416,7 +437,9 @@ export class GuidedTour {
         : 'Press Run (Space) to let the robots finish their run.');
       return this.setLive(lines, false, '');
     }
-    lines.push(`Run finished at t = ${fmt(run.time_s, 1)} s. Frames: ${frames}.`);
+    const period = Number(lab.camera().period_s.toFixed(2));
+    lines.push(`Run finished at t = ${fmt(run.time_s, 1)} s. Frames: ${frames}: one every ${period} s of simulated time, ` +
+      `from t = 0 s to ${fmt(run.time_s, 0)} s. The merge will not compare them all: step 2 keeps a few of each robot\u2019s.`);
     const ate = run.robots.map((name, i) => {
       const f = lab.slamFigures(i);
       return `${name} ${fmt(f.ate_m)} m (odometry alone ${fmt(f.odometry_ate_m)} m)`;
@@ -546,9 +569,12 @@ export class GuidedTour {
     if (!r) return this.setLive(['Waiting for the merge to finish…'], false, '');
     const lines = [];
     const merged = r.status === 'merged';
-    lines.push({ class: merged ? 'ok' : 'warn', text: merged
-      ? `Merged (confidence ${fmt(r.confidence)}): the merged map is in the Merge panel, right.`
-      : `No merge, because ${r.reason}.` });
+    const wrong = wrongMerge(r);
+    lines.push({ class: merged && !wrong ? 'ok' : 'warn', text: wrong
+      ? `Wrong merge: ${wrongWords(wrong)} (against the ground truth), though the method reports success.`
+      : merged
+        ? `Merged (confidence ${fmt(r.confidence)}): the merged map is in the Merge panel, right.`
+        : `No merge, because ${plainReason(r.reason)}.` });
     for (const t of r.transforms.slice(1)) {
       const e = r.errors.find((x) => x.robot === t.robot);
       lines.push({ formula: [
@@ -563,6 +589,7 @@ export class GuidedTour {
     }
     lines.push('Now change one thing (the seed, a robot\u2019s follow distance, a wall\u2019s texture set to “plain”), run ' +
       'again and step through once more; the Merge panel\u2019s chart compares the methods on each run.');
-    this.setLive(lines, true, merged ? 'The thesis\u2019s experiment is reproduced.' : 'This run gives no merge.');
+    if (wrong) return this.setLive(lines, true, `Wrong merge: ${wrongWords(wrong)}.`, 'error');
+    this.setLive(lines, true, merged ? 'The thesis\u2019s experiment is reproduced.' : 'This run gives no merge.', merged ? 'ok' : 'warn');
   }
 }

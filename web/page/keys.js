@@ -1,14 +1,19 @@
 // The keyboard: every shortcut the help overlay (`?`) lists. Keys typed into
 // a field stay there (Esc leaves the field); focused buttons and links keep
-// their own Space and Enter. Space is both run/pause (on release) and, held
+// their own Space and Enter. A slider (the speed) keeps its arrow keys but
+// not Space, which a slider has no use for: after moving the speed, Space
+// still runs and pauses. Space is both run/pause (on release) and, held
 // down, pan-by-dragging (web/page/pointer.js), so the run toggles only if
 // no drag used it. While the summary is open it has the keyboard: Esc closes
 // it and Tab stays inside it.
 
+/** A slider: it keeps every key but Space. */
+const isSlider = (t) => t?.tagName === 'INPUT' && t.type === 'range';
+
 function typingTarget(t) {
   if (!t || !t.tagName) return false;
   if (t.tagName === 'TEXTAREA' || t.tagName === 'SELECT') return true;
-  if (t.tagName === 'INPUT') return !['checkbox', 'radio', 'button', 'file'].includes(t.type);
+  if (t.tagName === 'INPUT') return !['checkbox', 'radio', 'button', 'file', 'range'].includes(t.type);
   return t.isContentEditable;
 }
 
@@ -34,12 +39,13 @@ export class Keys {
       summary.key(e);
       return;
     }
-    if (typingTarget(t)) {
+    const slider = isSlider(t);
+    if (typingTarget(t) || (slider && e.key !== ' ')) {
       if (e.key === 'Escape') t.blur();
       return;
     }
     // Let focused buttons and links keep their own Space/Enter.
-    if ((e.key === ' ' || e.key === 'Enter') && t.closest?.('button, a, label.button, input')) return;
+    if (!slider && (e.key === ' ' || e.key === 'Enter') && t.closest?.('button, a, label.button, input')) return;
     if ((e.ctrlKey || e.metaKey) && (e.key === 'z' || e.key === 'Z')) {
       e.preventDefault();
       editor.undo();

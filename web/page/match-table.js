@@ -6,7 +6,8 @@
 // Readable at any size: cells are never smaller than MIN_CELL CSS pixels
 // (a long run's table scrolls in its box instead of shrinking to dots), the
 // canvas is drawn at the screen's pixel density, a legend names every
-// colour, and the words under it say what a cell counts. By keyboard the
+// colour, and the words under it say how many frames of each robot were
+// kept and by which rule, and what a cell counts. By keyboard the
 // table is one tab stop: the arrow keys move a cursor from cell to cell
 // (Shift: ten at a time; Home/End: the row's ends), Enter opens the pair
 // under the cursor, which starts on the best pair.
@@ -24,6 +25,25 @@ const EMPTY = '#b9b9b9'; // checked, nothing agreed
 const BEST = '#e6550d';
 const CURSOR = '#111';
 
+/** A number in plain form: 0.5, 15, 0.05. */
+const plain = (x) => String(Number(x.toFixed(2)));
+
+/**
+ * Why those frames were kept, from the merge's own rule (`lab.mergeSelection()`):
+ * the automatic method keeps one per place and heading, the thesis method
+ * the frames facing a wall squarely, some distance apart.
+ */
+export function keptRule(method, rule) {
+  if (!rule) return '';
+  if (method === 'thesis') {
+    return ` (taken facing a wall squarely, sonars 4 and 5 within ${plain(rule.sonar_tolerance_m)} m of each other, ` +
+      `at least ${plain(rule.min_separation_m)} m apart)`;
+  }
+  const m = plain(rule.min_motion_m);
+  const d = plain((rule.min_turn_rad * 180) / Math.PI);
+  return `: one per ${m} m or ${d}° (a frame taken within ${m} m and ${d}° of one already kept adds little)`;
+}
+
 const swatch = (style) => el('span', { class: 'swatch-box', style });
 
 export class MatchTable {
@@ -31,6 +51,7 @@ export class MatchTable {
   constructor(hooks) {
     this.hooks = hooks;
     this.view = null;
+    this.rule = null; // the merge's frame selection rule (lab.mergeSelection())
     this.cursor = null; // [row, col] of the keyboard cursor
     this.canvas = el('canvas', {
       id: 'merge-table', class: 'merge-table', width: String(BOX_W), height: '60', tabindex: '0',
@@ -89,6 +110,7 @@ export class MatchTable {
 
   reset() {
     this.view = null;
+    this.rule = null;
     this.cursor = null;
     this.shownBest = false;
   }
@@ -150,14 +172,21 @@ export class MatchTable {
 
   words({ t, rows, cols }) {
     const names = this.view.robots;
+    const [ra, rb] = [names[t.a], names[t.b]];
     const extra = this.view.tables.length > 1 ? ` (the first of ${this.view.tables.length} robot pairs)` : '';
-    const counts = this.view.method === 'thesis'
+    const thesis = this.view.method === 'thesis';
+    const counts = thesis
       ? 'the feature matches that fit one homography between the two pictures (MSAC inliers, as in the thesis\u2019s Table 1)'
       : 'the feature matches that agree on one placement of the two maps (each feature is put on its wall ' +
         'with the laser\u2019s distance, then the pairs must agree on one rigid move)';
+    const all = rows * cols;
+    const checked = t.planned < all
+      ? `${t.cells.length} of ${t.planned} pairs checked${extra}: not all ${all}, only each frame\u2019s few partners whose pictures look most alike. `
+      : `${t.cells.length} of ${t.planned} pairs checked${extra}. `;
     this.hint.textContent =
-      `${rows} × ${cols} frames, ${t.cells.length} of ${t.planned} pairs checked${extra}. ` +
-      `A row is one of ${names[t.a].name}\u2019s frames, a column one of ${names[t.b].name}\u2019s; a cell counts ${counts}. ` +
+      `${ra.name}: ${rows} of ${ra.captured} frames kept, ${rb.name}: ${cols} of ${rb.captured}` +
+      `${keptRule(this.view.method, this.rule)}. ${checked}` +
+      `A row is one of ${ra.name}\u2019s frames, a column one of ${rb.name}\u2019s; a cell counts ${counts}. ` +
       'Click a cell, or Tab to the table and use the arrow keys and Enter, to see a pair\u2019s matches.';
   }
 

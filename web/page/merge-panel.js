@@ -9,7 +9,7 @@
 // its legend and keyboard cursor). Clicking a cell opens the two frames
 // with their matches and the matched-region quad (thesis Figure 8;
 // web/page/pair-view.js). At the
-// end the verdict appears with its reason, the transform of each robot's map
+// end the verdict appears (scrolled into view) with its reason, the transform of each robot's map
 // frame, its error against the ground truth, and the merged map with
 // downloads (PNG, ROS map_server PGM + YAML, report JSON). A merge the
 // ground truth puts more than 0.5 m or 5° off is called a wrong merge, in
@@ -51,6 +51,7 @@ export class MergePanel {
    * @param {HTMLElement} pairHost an overlay element for the pair view
    * @param {{lab: () => any, canMerge: () => boolean, onError: (e: unknown) => void,
    *          setStatus: (text: string, kind: string) => void,
+   *          quiet?: () => boolean,
    *          download: (name: string, data: BlobPart, type: string) => void,
    *          report: () => string}} hooks
    */
@@ -204,6 +205,7 @@ export class MergePanel {
   /** Called when the run changed: any merge of the old maps is gone. */
   invalidate() {
     this.active = false;
+    this.said = null;
     this.hold = false;
     this.view = null;
     this.groupList = null;
@@ -240,8 +242,23 @@ export class MergePanel {
     this.hold = hold && this.active;
     if (this.hold) {
       this.stageText.textContent = 'waiting: press Next in the guide to match';
-      this.hooks.setStatus('The thesis method has selected its frames (marked on the map); the matching waits for Next.', 'info');
+      this.say('The thesis method has selected its frames (marked on the map); the matching waits for Next.', 'info');
     }
+  }
+
+  /**
+   * The merge's news for the status line. While the guided mode is open
+   * (`hooks.quiet()`), the guide speaks for its steps and the news waits
+   * for `flushStatus()`.
+   */
+  say(text, kind) {
+    this.said = [text, kind];
+    if (!this.hooks.quiet?.()) this.hooks.setStatus(text, kind);
+  }
+
+  /** Puts the merge's last news in the status line (the guide has closed). */
+  flushStatus() {
+    if (this.said && (this.active || this.view)) this.hooks.setStatus(...this.said);
   }
 
   /** Lets a held merge advance. */
@@ -263,7 +280,7 @@ export class MergePanel {
       this.hint.textContent = '';
       this.closePair();
       this.refreshIdle();
-      this.hooks.setStatus('Merging the maps…', 'info');
+      this.say('Merging the maps…', 'info');
     } catch (e) {
       this.hooks.onError(e);
     }
@@ -286,6 +303,8 @@ export class MergePanel {
         p = lab.mergeAdvance(2);
       } while (!p.finished && performance.now() - t0 < SLICE_MS);
       this.view = lab.mergeView();
+      // the rule that chose the table's frames, read once a merge
+      if (!this.matchTable.rule && this.view.tables.length) this.matchTable.rule = lab.mergeSelection();
     } catch (e) {
       this.active = false;
       this.hooks.onError(e);
@@ -387,7 +406,10 @@ export class MergePanel {
     }
     this.showGroup(first);
     this.remember(r);
-    this.hooks.setStatus(
+    // The verdict is what the user waited for: into view (the guide, when
+    // open, brings the panel into view at its own step).
+    if (!this.hooks.quiet?.()) this.verdict.scrollIntoView({ block: 'start', behavior: 'smooth' });
+    this.say(
       wrong ? `Wrong merge: ${wrongWords(wrong)} (against the ground truth), though the method reports success.`
         : this.groupList ? groupsStatus(r) : merged ? `Maps merged: ${r.transforms.length} robots joined.` : `No merge: ${plainReason(r.reason)}`,
       wrong ? 'error' : merged || first >= 0 ? 'ok' : 'warn',

@@ -41,10 +41,18 @@ export function wrongWords(e) {
     'from where it really belongs';
 }
 
-/** The method's reason without repeating the verdict, and its terms explained. */
+/**
+ * The method's reason without repeating the verdict, in plain words: its
+ * terms explained, no status names (`merged`, `no_merge`) and no "inf
+ * times" (a margin over a rival that does not exist).
+ */
 export function plainReason(reason) {
   return String(reason ?? '')
+    .replace(/^merged: /, '')
     .replace(/: merged: /g, ': ')
+    .replace(/: no_merge: /g, ': no merge, ')
+    .replace(/\bno_merge\b/g, 'no merge')
+    .replace(/\binf times\b/g, 'incomparably more than')
     .replace(/(\d+) wall cells\b/, '$1 wall cells (grid cells that are wall in both maps once joined)');
 }
 

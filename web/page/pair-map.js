@@ -1,7 +1,8 @@
 // Where the two frames of a pair were taken: a small map of the world's
 // walls inside the pair view (web/page/pair-view.js), with each frame's
 // camera marked in its robot's colour: a dot where the robot stood, its
-// name and frame number ("robot1 #143"), and the camera's view cone cut
+// name and frame number ("robot1 #143", placed where it covers no other
+// label and no dot), and the camera's view cone cut
 // off at the walls it saw, whose visible stretch is drawn thick. A student
 // who compares two look-alike frames then sees at a glance whether they
 // show the same wall (a true match) or two different walls that only look
@@ -16,7 +17,9 @@
 // The canvas is drawn at the device pixel ratio (web/page/hidpi.js). Its
 // world-to-canvas mapping is left on the canvas as `data-view`
 // ("x0,y0,scale": logical px = (x − x0)·scale, (y0 − y)·scale) so that a
-// test can find the marks from the poses.
+// test can find the marks from the poses, and the labels' boxes as
+// `data-labels` (JSON `[[x, y, w, h]]`, logical px) so that it can check
+// they stay apart.
 import { fitCanvas } from './hidpi.js';
 import { darkerColour, robotColour } from './palette.js';
 
@@ -113,35 +116,82 @@ export function drawPairMap(canvas, walls, marks, hfovDeg, logicalW) {
     });
     ctx.stroke();
   }
-  for (const m of marks) drawLabel(ctx, m, px(m.pose[0]), py(m.pose[1]), logicalW, logicalH);
+  const dots = marks.map((m) => [px(m.pose[0]), py(m.pose[1])]);
+  const labels = placeLabels(ctx, marks, dots, logicalW, logicalH);
+  labels.forEach((l, k) => drawLabel(ctx, marks[k], l));
+  canvas.dataset.labels = JSON.stringify(labels.map((l) => [l.x, l.y, l.w, l.h].map((v) => Math.round(v * 10) / 10)));
   // the dots last, so that no label covers where a robot stood
-  for (const m of marks) {
+  marks.forEach((m, k) => {
     ctx.beginPath();
-    ctx.arc(px(m.pose[0]), py(m.pose[1]), DOT_PX, 0, 2 * Math.PI);
+    ctx.arc(dots[k][0], dots[k][1], DOT_PX, 0, 2 * Math.PI);
     ctx.fillStyle = robotColour(m.robot);
     ctx.fill();
     ctx.lineWidth = 1.5;
     ctx.strokeStyle = '#fff';
     ctx.stroke();
-  }
+  });
   return { x0, y0, scale };
 }
 
-/** "robot1 #143" beside the dot, on the side away from the view cone, kept inside the canvas. */
-function drawLabel(ctx, m, x, y, w, h) {
+const LABEL_FONT = '600 11px system-ui, sans-serif';
+const LABEL_H = 13; // the text's box: 10 px above the baseline, 3 below
+const LABEL_ASCENT = 10;
+
+/** How much two boxes `{x, y, w, h}` overlap (area, px²). */
+function overlap(a, b) {
+  const dx = Math.min(a.x + a.w, b.x + b.w) - Math.max(a.x, b.x);
+  const dy = Math.min(a.y + a.h, b.y + b.h) - Math.max(a.y, b.y);
+  return dx > 0 && dy > 0 ? dx * dy : 0;
+}
+
+/**
+ * Where each "robot1 #143" goes: a box beside its dot that covers no other
+ * label and no dot, inside the canvas. The first choice is behind the
+ * camera (opposite its heading, away from its view cone); when that box is
+ * taken, the next free one of eight directions around the dot, then the
+ * same twice as far out; if every one is taken, the least covered. Returns
+ * one box `{x, y, w, h}` (logical px, top-left corner) per mark.
+ */
+function placeLabels(ctx, marks, dots, w, h) {
+  ctx.font = LABEL_FONT;
+  const dotBoxes = dots.map(([x, y]) => ({ x: x - DOT_PX - 1, y: y - DOT_PX - 1, w: 2 * DOT_PX + 2, h: 2 * DOT_PX + 2 }));
+  const placed = [];
+  marks.forEach((m, k) => {
+    const tw = ctx.measureText(`${m.name} #${m.frame}`).width;
+    const [x, y] = dots[k];
+    // behind the camera first (canvas y grows downwards), then around the dot
+    const dirs = [[-Math.cos(m.pose[2]), Math.sin(m.pose[2])]];
+    for (let a = 0; a < 8; a++) dirs.push([Math.cos((a * Math.PI) / 4), Math.sin((a * Math.PI) / 4)]);
+    let best = null;
+    for (const reach of [12, 24]) {
+      for (const [bx, by] of dirs) {
+        const cx = x + bx * reach;
+        const cy = y + by * reach;
+        // the box's side towards the dot sits at (cx, cy)
+        let lx = bx < -0.3 ? cx - tw : bx > 0.3 ? cx : cx - tw / 2;
+        let ly = by > 0.3 ? cy : by < -0.3 ? cy - LABEL_H : cy - LABEL_H / 2;
+        lx = Math.min(Math.max(lx, 2), w - tw - 2);
+        ly = Math.min(Math.max(ly, 2), h - LABEL_H - 2);
+        const box = { x: lx, y: ly, w: tw, h: LABEL_H };
+        const covered = [...placed, ...dotBoxes].reduce((s, b) => s + overlap(box, b), 0);
+        if (!best || covered < best.covered) best = { box, covered };
+        if (covered === 0) break;
+      }
+      if (best.covered === 0) break;
+    }
+    placed.push(best.box);
+  });
+  return placed;
+}
+
+/** Draws a mark's "robot1 #143" in its box, in the robot's darker colour on a white halo. */
+function drawLabel(ctx, m, box) {
   const text = `${m.name} #${m.frame}`;
-  ctx.font = '600 11px system-ui, sans-serif';
-  const tw = ctx.measureText(text).width;
-  // behind the camera: opposite its heading (canvas y grows downwards)
-  const bx = -Math.cos(m.pose[2]);
-  const by = Math.sin(m.pose[2]);
-  let lx = x + bx * 12 + (bx < -0.3 ? -tw : bx > 0.3 ? 0 : -tw / 2);
-  let ly = y + by * 12 + (by > 0.3 ? 10 : by < -0.3 ? 0 : 4);
-  lx = Math.min(Math.max(lx, 2), w - tw - 2);
-  ly = Math.min(Math.max(ly, 11), h - 3);
+  ctx.font = LABEL_FONT;
+  ctx.textAlign = 'left';
   ctx.lineWidth = 3;
   ctx.strokeStyle = 'rgba(255,255,255,0.9)';
-  ctx.strokeText(text, lx, ly);
+  ctx.strokeText(text, box.x, box.y + LABEL_ASCENT);
   ctx.fillStyle = darkerColour(m.robot);
-  ctx.fillText(text, lx, ly);
+  ctx.fillText(text, box.x, box.y + LABEL_ASCENT);
 }

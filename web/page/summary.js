@@ -138,8 +138,8 @@ export function buildSummary(host, data, { onPrint, onClose }) {
       ran.map((k) => {
         const x = results[k];
         return x.status === 'merged'
-          ? [METHOD_NAMES[k], isWrong(x) ? 'merged WRONG' : 'merged', `${fmt(x.error_m, 3)} m`, `${fmt(Math.abs(x.error_deg), 2)}°`]
-          : [METHOD_NAMES[k], 'no merge', '–', '–'];
+          ? [METHOD_NAMES[k], isWrong(x) ? 'Wrong merge' : 'Merged', `${fmt(x.error_m, 3)} m`, `${fmt(Math.abs(x.error_deg), 2)}°`]
+          : [METHOD_NAMES[k], 'No merge', '–', '–'];
       })));
   }
   host.replaceChildren(...parts);

@@ -26,7 +26,8 @@ export class WorldView {
    * @param {HTMLCanvasElement} canvas
    * @param {import('./state.js').Store} store
    * @param {{running: () => boolean, editable: () => boolean, state: () => any,
-   *          readState: () => any, tool: () => string, preview: () => number[] | null}} hooks
+   *          readState: () => any, tool: () => string, preview: () => number[] | null,
+   *          guided?: () => boolean}} hooks (guided: the guide is open and says what comes next)
    */
   constructor(canvas, store, hooks) {
     this.canvas = canvas;
@@ -223,6 +224,7 @@ export class WorldView {
     this.drawScale();
     // A one-line hint for the current tool in the top-left corner.
     const hint = this.hint();
+    this.canvas.dataset.hint = hint; // what the canvas says, for the page tests
     if (hint) {
       ctx.font = '12.5px system-ui, sans-serif';
       const w = ctx.measureText(hint).width;
@@ -336,8 +338,9 @@ export class WorldView {
     const sel = this.store.selection;
     if (!this.hooks.editable()) {
       return this.hooks.state()?.finished
-        ? (scenario.robots.length >= 2 ? 'Run finished: merge the maps (Merge panel), or Reset (R) to run again or edit.'
-          : 'Run finished: press Reset (R) to run again or to edit the map.')
+        ? (this.hooks.guided?.() ? 'Run finished: the guide below says what comes next.'
+          : scenario.robots.length >= 2 ? 'Run finished: merge the maps (Merge panel), or Reset (R) to run again or edit.'
+            : 'Run finished: press Reset (R) to run again or to edit the map.')
         : 'Paused: press Reset (R) to edit the map.';
     }
     if (this.hooks.tool() === 'wall') return 'Wall tool: drag to draw a wall (snaps to 0.1 m and 15°; Alt or Shift: any angle). Esc: back to Select.';

@@ -51,10 +51,11 @@ impl Lab {
         json!({"grid_m": grid_step_m(s), "scale_bar_m": scale_bar_m(s)}).to_string()
     }
 
-    /// The camera image size as JSON `{width, height, hfov_deg}`.
+    /// The camera image size, field of view and capture period as JSON
+    /// `{width, height, hfov_deg, period_s}`.
     pub fn camera_info_json(&self) -> String {
         let c = &self.scenario().camera;
-        json!({"width": c.width, "height": c.height, "hfov_deg": c.hfov_deg}).to_string()
+        json!({"width": c.width, "height": c.height, "hfov_deg": c.hfov_deg, "period_s": c.period_s}).to_string()
     }
 
     /// Robot `robot`'s captured frames' metadata ([`frame_meta`]) as a JSON
@@ -71,9 +72,12 @@ impl Lab {
 
     /// The current merge's image selection (thesis §6.2.2) with the numbers
     /// behind it: `{method, sonar_tolerance_m, min_front_range_m,
-    /// max_front_range_m, max_turn_per_step_rad, min_separation_m, robots:
-    /// [{name, captured, square, selected: [{frame, step, sonar4_m,
-    /// sonar5_m, pose}]}]}`. `square` counts the captured frames that pass
+    /// max_front_range_m, max_turn_per_step_rad, min_separation_m,
+    /// min_motion_m, min_turn_rad, robots: [{name, captured, square,
+    /// selected: [{frame, step, sonar4_m, sonar5_m, pose}]}]}`. The thesis
+    /// method keeps square frames `min_separation_m` apart; the automatic
+    /// method keeps a frame unless one already kept was taken within
+    /// `min_motion_m` and `min_turn_rad` of it. `square` counts the captured frames that pass
     /// the squareness test (sonars 4 and 5 alike, not turning) before the
     /// thinning; `selected` lists the frames that take part, in table
     /// order, with the robot's own SLAM pose `[x, y, theta]` at capture
@@ -115,6 +119,8 @@ impl Lab {
             "max_front_range_m": cfg.max_front_range_m,
             "max_turn_per_step_rad": cfg.max_turn_per_step_rad,
             "min_separation_m": cfg.min_separation_m,
+            "min_motion_m": job.config.min_motion_m,
+            "min_turn_rad": job.config.min_turn_rad,
             "robots": robots,
         }))
     }

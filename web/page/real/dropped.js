@@ -5,6 +5,28 @@
 // whose files are read here, each with its path in the folder, so the log
 // worker (bag-read.js) can tell which files belong together. Plain files
 // keep their name as their path (or the path a folder picker gives them).
+//
+// Files dropped on the lab itself (web/page/lab-drop.js) go to the view
+// that reads them, told by their names (`dropKind`): a log or a bag —
+// CARMEN `.log`/`.clf` (gzipped too), ROS `.bag`, `.mcap`, rosbag2 `.db3`
+// (`.db3.zstd`), or a rosbag2 folder's `metadata.yaml` beside its data —
+// opens "Your log"; a saved map — map_server `.yaml`/`.yml` with its
+// `.pgm` or `.png` image — opens "Your maps".
+
+const LOG_NAME = /\.(log|clf|bag|mcap|db3|relations)(\.(gz|zstd))?$/i;
+const MAP_NAME = /\.(ya?ml|pgm|png)$/i;
+
+/**
+ * Which view takes the dropped files (`[{file, path}]`): `'log'` when any is
+ * a log or a bag (a rosbag2 folder's `metadata.yaml` goes with its bag),
+ * `'maps'` when any is a saved map's YAML or image, `null` when neither.
+ */
+export function dropKind(entries) {
+  const names = entries.map((e) => e.path || e.file?.name || '');
+  if (names.some((n) => LOG_NAME.test(n))) return 'log';
+  if (names.some((n) => MAP_NAME.test(n))) return 'maps';
+  return null;
+}
 
 /** A picked file as the worker takes it: `{file, path}`. */
 export function picked(file) {
