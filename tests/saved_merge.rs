@@ -1,7 +1,8 @@
 //! The merge of saved maps (crate/src/merge/saved/) on maps cut
 //! from generated buildings with known transforms: a pair merges to the
 //! truth, three maps join along the spanning tree, two different buildings
-//! are refused, and the merged map is written as ROS map_server files.
+//! are refused, maps of two buildings form two groups, and the merged map
+//! is written as ROS map_server files.
 
 use glam::DVec2;
 use slamlab::formats::rosmap::{self, RosMap};
@@ -229,9 +230,9 @@ fn the_merged_map_is_written_as_map_server_files() {
 #[path = "merge_support/guess.rs"]
 mod guess;
 use guess::{middle, nudged, refined};
-use slamlab::merge::saved::join;
 use slamlab::merge::saved::refine::refine_pair;
 use slamlab::merge::saved::wallmap::WallMap;
+use slamlab::merge::saved::{join, PairResult};
 
 /// The first test's pair (A the west part of a building, B the east part
 /// turned by 0.7 rad, both with YAML origins) and B's true pose in A.
@@ -439,4 +440,75 @@ fn refine_is_refused_where_the_automatic_merge_found_a_clear_winner_elsewhere() 
         "{}",
         beaten.reason
     );
+}
+
+/// A judged pair: merged at `pose` with `confidence`, or refused (`None`).
+fn judged(a: usize, b: usize, merged: Option<(Pose2, f64)>, reason: &str) -> PairResult {
+    let mut p = PairResult::unjudged(a, b);
+    p.reason = reason.into();
+    if let Some((pose, confidence)) = merged {
+        p.status = MergeStatus::Merged;
+        p.pose = Some(pose);
+        p.confidence = confidence;
+    }
+    p
+}
+
+#[test]
+fn maps_of_two_buildings_form_two_groups_each_in_its_first_maps_frame() {
+    // Five small maps: 0 and 2 of one building, 1, 3 and 4 of another
+    // (4 joined through 3), opened interleaved.
+    let blank =
+        |name: &str| RosMap::from_values(name, 4, 4, 0.05, Pose2::IDENTITY, vec![0; 16]).unwrap();
+    let maps: Vec<RosMap> = ["a0", "b0", "a1", "b1", "b2"]
+        .iter()
+        .map(|n| blank(n))
+        .collect();
+    let p02 = Pose2::new(3.0, 1.0, 0.5);
+    let (p13, p34) = (Pose2::new(-2.0, 4.0, -1.0), Pose2::new(1.0, 0.0, 0.25));
+    let mut pairs = Vec::new();
+    for a in 0..5 {
+        for b in a + 1..5 {
+            let merged = match (a, b) {
+                (0, 2) => Some((p02, 0.9)),
+                (1, 3) => Some((p13, 0.7)),
+                (3, 4) => Some((p34, 0.6)),
+                _ => None,
+            };
+            pairs.push(judged(a, b, merged, &format!("pair {a} {b}")));
+        }
+    }
+    let r = join(&maps, pairs);
+    let members: Vec<Vec<usize>> = r.groups.iter().map(|g| g.maps.clone()).collect();
+    assert_eq!(members, vec![vec![0, 2], vec![1, 3, 4]], "{}", r.reason);
+    // The first map's group is the merge's own: the same poses.
+    assert_eq!(r.groups[0].poses, r.poses);
+    assert_eq!(r.unjoined, vec![1, 3, 4]);
+    let g = &r.groups[1];
+    assert_eq!(g.poses[1], Some(Pose2::IDENTITY));
+    assert_eq!(g.poses[3], Some(p13));
+    let (dm, dd) = error(&g.poses[4].unwrap(), &p13.compose(&p34));
+    assert!(dm < 1e-9 && dd < 1e-9, "map 4 off by {dm} m {dd} deg");
+    assert_eq!((r.groups[0].confidence, g.confidence), (0.9, 0.6));
+    assert!(r.groups.iter().all(|g| g.reason.is_none()));
+    let report = r.report(&maps);
+    let groups = report["merge"]["groups"].as_array().unwrap();
+    assert_eq!(groups[1]["maps"], serde_json::json!(["b0", "b1", "b2"]));
+    assert_eq!(groups[1]["transforms"][0]["map"], "b0");
+    assert_eq!(
+        groups[1]["transforms"][1]["pose"],
+        serde_json::json!([-2.0, 4.0, -1.0])
+    );
+}
+
+#[test]
+fn a_map_alone_is_a_group_of_its_own_with_its_reason() {
+    let (a, b, _) = two_buildings();
+    let r = merge_all(&[a, b], &SavedMergeConfig::default(), &mut |_| {});
+    assert_eq!(r.groups.len(), 2);
+    for (k, g) in r.groups.iter().enumerate() {
+        assert_eq!(g.maps, vec![k]);
+        assert_eq!(g.confidence, 0.0);
+        assert_eq!(g.reason.as_deref(), Some(r.pairs[0].reason.as_str()));
+    }
 }

@@ -121,6 +121,23 @@ export class SavedMaps {
   mergedYaml(image) {
     return this.raw.mergedYaml(image);
   }
+
+  // --- Each group's merged map (report.merge.groups[k], in its first map's frame) --
+
+  /** Group `k`'s merged map as a binary PGM (Uint8Array); group 0 is the merged map. */
+  groupPgm(k) {
+    return this.raw.groupPgm(k);
+  }
+
+  /** Group `k`'s merged map as a PNG (Uint8Array). */
+  groupPng(k) {
+    return this.raw.groupPng(k);
+  }
+
+  /** Group `k`'s map_server YAML text naming `image`. */
+  groupYaml(k, image) {
+    return this.raw.groupYaml(k, image);
+  }
 }
 
 /** The `image` a map's YAML names (its path relative to the YAML's folder), so the caller knows what to read; throws on a bad YAML. */

@@ -141,4 +141,23 @@ impl MapMerge {
     pub fn merged_yaml(&mut self, image: &str) -> Result<String, JsError> {
         self.inner.merged_yaml(image).map_err(err)
     }
+
+    /// Group `group`'s merged map (its maps joined in the frame of its
+    /// first map; the report's `merge.groups[group]`) as a binary PGM.
+    #[wasm_bindgen(js_name = groupPgm)]
+    pub fn group_pgm(&mut self, group: u32) -> Result<Vec<u8>, JsError> {
+        self.inner.group_pgm(group as usize).map_err(err)
+    }
+
+    /// The same pixels as a PNG.
+    #[wasm_bindgen(js_name = groupPng)]
+    pub fn group_png(&mut self, group: u32) -> Result<Vec<u8>, JsError> {
+        self.inner.group_png(group as usize).map_err(err)
+    }
+
+    /// Group `group`'s map_server YAML naming `image`.
+    #[wasm_bindgen(js_name = groupYaml)]
+    pub fn group_yaml(&mut self, group: u32, image: &str) -> Result<String, JsError> {
+        self.inner.group_yaml(group as usize, image).map_err(err)
+    }
 }

@@ -11,6 +11,8 @@ use crate::geom::Pose2;
 use crate::merge::saved::refine::{refine_pair, refuse_if_beaten};
 use crate::merge::saved::wallmap::WallMap;
 use crate::merge::saved::{merge_all, PairResult, SavedMerge, SavedMergeConfig};
+use crate::slam::export::yaml_text;
+use glam::DVec2;
 use serde::Serialize;
 
 /// The most maps merged at once.
@@ -23,7 +25,9 @@ pub struct SavedMaps {
     result: Option<SavedMerge>,
     /// The automatic merge's pairs, kept for Refine's check.
     automatic: Vec<PairResult>,
-    merged: Option<MergedMap>,
+    /// Each group's merged map, made once per result (group 0 is the
+    /// first map's: the merged map).
+    merged: Vec<Option<MergedMap>>,
 }
 
 /// Size, resolution and origin of one map (fields in the order the page
@@ -83,7 +87,7 @@ impl SavedMaps {
         }
         self.maps.push(map);
         self.result = None;
-        self.merged = None;
+        self.merged.clear();
         Ok(self.maps.len() - 1)
     }
 
@@ -129,7 +133,7 @@ impl SavedMaps {
         let report = result.report(&self.maps);
         self.automatic = result.pairs.clone();
         self.result = Some(result);
-        self.merged = None;
+        self.merged.clear();
         Ok(report)
     }
 
@@ -180,7 +184,7 @@ impl SavedMaps {
         let k = result
             .replace_pair(&self.maps, pair)
             .ok_or("refine: that pair was not judged")?;
-        self.merged = None;
+        self.merged.clear();
         let report = result.report(&self.maps);
         Ok(report["merge"]["pairs"][k].clone())
     }
@@ -192,33 +196,68 @@ impl SavedMaps {
         Ok(r.report(&self.maps))
     }
 
-    /// The merged map: the maps joined to the first, made once per result.
-    fn merged(&mut self) -> Result<&MergedMap, String> {
-        if self.merged.is_none() {
-            let r = self.result.as_ref().ok_or("merge first")?;
-            let joined: Vec<(&RosMap, Pose2)> = r
+    /// Group `group`'s merged map: its maps joined in the frame of its
+    /// first map, made once per result. Group 0 is the first map's, whose
+    /// frame is the merged frame.
+    fn merged(&mut self, group: usize) -> Result<&MergedMap, String> {
+        let r = self.result.as_ref().ok_or("merge first")?;
+        let g = r.groups.get(group).ok_or_else(|| {
+            format!(
+                "there is no group {} of maps: the merge found {}",
+                group + 1,
+                r.groups.len()
+            )
+        })?;
+        if self.merged.len() != r.groups.len() {
+            self.merged = vec![None; r.groups.len()];
+        }
+        if self.merged[group].is_none() {
+            let joined: Vec<(&RosMap, Pose2)> = g
                 .poses
                 .iter()
                 .zip(&self.maps)
                 .filter_map(|(p, m)| p.map(|p| (m, p)))
                 .collect();
-            self.merged = Some(rosmap::write::merge_maps(&joined).map_err(|e| e.to_string())?);
+            self.merged[group] =
+                Some(rosmap::write::merge_maps(&joined).map_err(|e| e.to_string())?);
         }
-        self.merged.as_ref().ok_or_else(|| "no merged map".into())
+        self.merged[group]
+            .as_ref()
+            .ok_or_else(|| "no merged map".into())
     }
 
-    /// The merged map as a binary PGM.
+    /// The merged map (the first map's group) as a binary PGM.
     pub fn merged_pgm(&mut self) -> Result<Vec<u8>, String> {
-        Ok(self.merged()?.pgm())
+        self.group_pgm(0)
     }
 
     /// The same pixels as a PNG.
     pub fn merged_png(&mut self) -> Result<Vec<u8>, String> {
-        self.merged()?.png().map_err(|e| e.to_string())
+        self.group_png(0)
     }
 
     /// The map_server YAML naming `image`.
     pub fn merged_yaml(&mut self, image: &str) -> Result<String, String> {
-        Ok(self.merged()?.yaml(image))
+        self.group_yaml(0, image)
+    }
+
+    /// Group `group`'s merged map as a binary PGM (its first map's frame).
+    pub fn group_pgm(&mut self, group: usize) -> Result<Vec<u8>, String> {
+        Ok(self.merged(group)?.pgm())
+    }
+
+    /// Group `group`'s merged map as a PNG.
+    pub fn group_png(&mut self, group: usize) -> Result<Vec<u8>, String> {
+        self.merged(group)?.png().map_err(|e| e.to_string())
+    }
+
+    /// Group `group`'s map_server YAML naming `image`, its origin rounded
+    /// to the micrometre (the sums that place the maps leave float noise:
+    /// `1.2000000000000002`).
+    pub fn group_yaml(&mut self, group: usize, image: &str) -> Result<String, String> {
+        let m = self.merged(group)?;
+        let tidy = |v: f64| (v * 1e6).round() / 1e6 + 0.0;
+        let origin = DVec2::new(tidy(m.origin.x), tidy(m.origin.y));
+        Ok(yaml_text(image, m.resolution, origin))
     }
 }

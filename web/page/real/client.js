@@ -58,7 +58,7 @@ export class SavedMapsClient extends WorkerClient {
     return this.request({ type: 'add', files, resolution, colours }, files.map((f) => f.bytes));
   }
 
-  /** Merges the maps read so far: `{report, files}` (files null on no_merge). */
+  /** Merges the maps read so far: `{report, files, groupFiles}` (each group's files, null for a map alone). */
   merge() {
     return this.request({ type: 'merge' });
   }
@@ -76,6 +76,11 @@ export class SavedMapsClient extends WorkerClient {
   /** Aligns map `b` on map `a` from `pose`: `{pair, report, files}`. */
   refine(a, b, pose) {
     return this.request({ type: 'refine', a, b, pose });
+  }
+
+  /** Shows group `group` of the last report in the overlay: `{view}`. */
+  showGroup(group) {
+    return this.request({ type: 'group', group });
   }
 
   /** Forgets every map. */

@@ -6,12 +6,14 @@
 // into maps (files.js matches each YAML to its image), draws each map into
 // a small coloured picture for the page (preview.js), merges on request
 // (the whole merge runs here, so the page never waits on it), hands back
-// the report and the merged map's PGM, PNG and YAML, and draws the merged
-// overlay (overlay.js) into the page's canvas, which the page hands over
-// once. Messages in:
+// the report and each group's merged map as PGM, PNG and YAML (maps of
+// two buildings make two groups, each joined in its first map's frame),
+// and draws the merged overlay of the group shown (overlay.js) into the
+// page's canvas, which the page hands over once. Messages in:
 // `{id, type: 'add', files, resolution, colours}`, `{id, type: 'merge'}`,
 // `{id, type: 'canvas', canvas}`, `{id, type: 'draw', width, height, dpr,
-// alpha}`, `{id, type: 'clear'}`, and for placing a map by hand (the
+// alpha}`, `{id, type: 'group', group}` (the overlay shows that group of
+// the report's `merge.groups`), `{id, type: 'clear'}`, and for placing a map by hand (the
 // page's Refine, adjust.js): `{id, type: 'adjust', a, b, pose, fit}` (map
 // b's frame at `pose` in map a's: shown, the view kept still unless
 // `fit`), `{id, type: 'refine', a, b, pose}` (aligns from there, answers
@@ -34,6 +36,9 @@ let colourIndex = 0;
 /** What the overlay needs of each map read (by name), the last merge's placing, the canvas. */
 let pictures = new Map();
 let placed = [];
+/** The last report, and which of its groups the overlay shows. */
+let lastReport = null;
+let shownGroup = 0;
 let overlay = null;
 /** While a map is placed by hand: `{a, b, pose}` (indices) and the still view. */
 let adjusting = null;
@@ -111,22 +116,42 @@ function refine({ a, b, pose }) {
   return out;
 }
 
-/** The report with the merged map's files (when merged) and the overlay's placing. */
+/** The files of a group of two or more maps: PGM, PNG and YAML naming `stem`.pgm. */
+function filesOfGroup(k, stem) {
+  const pgm = savedMaps.groupPgm(k);
+  const png = savedMaps.groupPng(k);
+  return { pgm, png, yaml: savedMaps.groupYaml(k, `${stem}.pgm`), stem };
+}
+
+/**
+ * The report with each group's merged map (`groups[k]`, null for a map
+ * alone; `files` the first joined group's, as before groups) and the
+ * overlay's placing.
+ */
 function withFiles(report, t0) {
   const t1 = performance.now();
-  let files = null;
   const transfer = [];
-  if (report.merge.status === 'merged') {
-    const pgm = savedMaps.mergedPgm();
-    const png = savedMaps.mergedPng();
-    files = { pgm, png, yaml: savedMaps.mergedYaml('merged.pgm') };
-    transfer.push(pgm.buffer, png.buffer);
-  }
+  const groups = report.merge.groups ?? [];
+  const joined = groups.filter((g) => g.maps.length > 1).length;
+  let n = 0;
+  const files = groups.map((g, k) => {
+    if (g.maps.length < 2) return null;
+    n += 1;
+    const f = filesOfGroup(k, joined > 1 ? `merged-group-${n}` : 'merged');
+    transfer.push(f.pgm.buffer, f.png.buffer);
+    return f;
+  });
   report.timings_ms = { merge: t1 - t0, write: performance.now() - t1 };
-  placed = report.merge.transforms
-    .filter((t) => pictures.has(t.map))
-    .map((t) => ({ map: pictures.get(t.map), pose: t.pose }));
-  return { result: { report, files }, transfer };
+  lastReport = report;
+  shownGroup = Math.max(0, files.findIndex((f) => f));
+  place();
+  return { result: { report, files: files.find((f) => f) ?? null, groupFiles: files }, transfer };
+}
+
+/** The overlay's placing: the shown group's maps in its first map's frame. */
+function place() {
+  const transforms = lastReport?.merge.groups?.[shownGroup]?.transforms ?? lastReport?.merge.transforms ?? [];
+  placed = transforms.filter((t) => pictures.has(t.map)).map((t) => ({ map: pictures.get(t.map), pose: t.pose }));
 }
 
 self.onmessage = async ({ data }) => {
@@ -144,6 +169,10 @@ self.onmessage = async ({ data }) => {
     } else if (type === 'refine') {
       if (!savedMaps) throw new Error('open two or more maps first');
       out = refine(data);
+    } else if (type === 'group') {
+      shownGroup = data.group;
+      place();
+      out = { result: { view: draw(lastSize) }, transfer: [] };
     } else if (type === 'draw') {
       out = { result: { view: draw(data) }, transfer: [] };
     } else if (type === 'adjust') {
@@ -160,6 +189,7 @@ self.onmessage = async ({ data }) => {
       colourIndex = 0;
       pictures = new Map();
       placed = [];
+      lastReport = null;
       adjusting = null;
       view = null;
       out = { result: {}, transfer: [] };

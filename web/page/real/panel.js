@@ -7,13 +7,16 @@
 // confidence, each map's transform (metres, degrees, and the arguments of
 // ROS's static_transform_publisher) and each pair's verdict, sees the
 // joined maps overlaid in their colours, and downloads the merged map (PGM
-// + YAML + PNG) and the transforms (JSON); a pair the merge declined can be
-// placed by hand and refined (adjust.js). The reading, drawing and merging
+// + YAML + PNG) and the transforms (JSON); maps of several buildings form
+// groups, each with its own transforms, overlay and downloads
+// (map-groups.js); a pair the merge declined can be placed by hand and
+// refined (adjust.js). The reading, drawing and merging
 // run in a Web Worker (merge-worker.js), so the page stays responsive; the
 // lab's own scenario and runs behind this view are never touched.
 
 import { ADJUST_HTML, PlaceByHand } from './adjust.js';
 import { SavedMapsClient } from './client.js';
+import { MapGroupsView, showsGroups } from './map-groups.js';
 import { OverlayCanvas, mergeHtml, saveMerge, showMerge, swatch } from './merge-result.js';
 
 /** One colour per map (up to 16), told apart on white. */
@@ -61,6 +64,9 @@ export class SavedMapsView {
     this.maps = [];
     this.report = null;
     this.files = null;
+    /** Each group's merged map files (null for a map alone), and the group shown. */
+    this.groupFiles = [];
+    this.group = -1;
     this.busy = false;
     this.queue = Promise.resolve();
     this.client = new SavedMapsClient((text) => this.progress(text));
@@ -70,7 +76,7 @@ export class SavedMapsView {
       report: () => this.report,
       refined: (out) => {
         this.report = out.report;
-        this.files = out.files;
+        this.groupFiles = out.groupFiles ?? [];
         this.showResult();
       },
       say: (text, kind) => this.say(text, kind),
@@ -85,6 +91,10 @@ export class SavedMapsView {
     root.innerHTML = HTML;
     this.adjust.wire();
     const q = (s) => root.querySelector(s);
+    this.groups = new MapGroupsView(q('#real-groups'), {
+      select: (k) => this.showGroup(k),
+      colour: (name) => this.maps.find((m) => m.name === name)?.colour ?? '#111',
+    });
     this.opener.addEventListener('click', () => this.toggle(true));
     q('.real-close').addEventListener('click', () => this.toggle(false));
     root.addEventListener('keydown', (e) => {
@@ -187,7 +197,7 @@ export class SavedMapsView {
     }
     performance.mark('real-merged');
     this.report = out.report;
-    this.files = out.files;
+    this.groupFiles = out.groupFiles ?? [];
     this.mergeMs = performance.now() - t0;
     this.stage(`merged in ${(this.mergeMs / 1000).toFixed(2)} s (the merge itself ${(out.report.timings_ms.merge / 1000).toFixed(2)} s)`);
     await nextFrame();
@@ -221,6 +231,9 @@ export class SavedMapsView {
     this.adjust.active = null;
     this.report = null;
     this.files = null;
+    this.groupFiles = [];
+    this.group = -1;
+    this.groups?.hide();
     this.root.querySelector('#real-result').hidden = true;
     this.stage('');
   }
@@ -236,10 +249,32 @@ export class SavedMapsView {
   }
 
   showResult() {
-    showMerge(this.root, 'real', this.report.merge, !!this.files);
+    this.group = this.groups.show(this.report.merge);
+    this.showTables();
     this.adjust.show(this.report);
     // The overlay in a task of its own, after the tables are laid out.
     nextFrame().then(() => this.drawOverlay());
+  }
+
+  /** The verdict, the tables and the downloads of the group shown (all maps when one group). */
+  showTables() {
+    this.files = this.groupFiles[this.group] ?? null;
+    const group = showsGroups(this.report.merge) ? this.report.merge.groups[this.group] : null;
+    showMerge(this.root, 'real', this.report.merge, !!this.files, { group });
+  }
+
+  /** Shows group `k`: its transforms, its downloads and its overlay. */
+  async showGroup(k) {
+    this.group = k;
+    this.showTables();
+    await this.client.showGroup(k);
+    this.drawOverlay();
+  }
+
+  /** The maps placed in the overlay: the group shown, else every joined map. */
+  placedTransforms() {
+    const merge = this.report.merge;
+    return (showsGroups(merge) ? merge.groups[this.group]?.transforms : null) ?? merge.transforms;
   }
 
   /** The joined maps in the first map's frame, each in its colour: drawn by the worker (merge-result.js). */
@@ -269,7 +304,7 @@ export class SavedMapsView {
     }
     if (!this.report) return;
     const byName = new Map(this.maps.map((m) => [m.name, m]));
-    const placed = this.report.merge.transforms.filter((t) => byName.has(t.map)).map((t) => ({ map: byName.get(t.map) }));
+    const placed = this.placedTransforms().filter((t) => byName.has(t.map)).map((t) => ({ map: byName.get(t.map) }));
     legend.replaceChildren(
       ...placed.map(({ map }) => swatch(map.colour, map.name)),
       placed.length > 1 ? 'Walls of two maps that fall on each other show dark.' : '',
@@ -277,7 +312,7 @@ export class SavedMapsView {
   }
 
   save(kind) {
-    saveMerge(this.download, this.report, this.files, kind);
+    saveMerge(this.download, this.report, this.files, kind, showsGroups(this.report.merge) ? this.group : -1);
   }
 
   /** For tests and the console: what the view holds. */
@@ -285,6 +320,7 @@ export class SavedMapsView {
     return {
       maps: this.maps.map(({ name, width, height, resolution, origin }) => ({ name, width, height, resolution, origin })),
       report: this.report,
+      group: this.group,
       mergeMs: this.mergeMs,
       busy: this.busy,
       adjust: this.adjust.snapshot(),

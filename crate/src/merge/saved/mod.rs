@@ -19,7 +19,15 @@
 //! when its verdict is "merged", weighted by its confidence, and the maps
 //! are joined along the maximum spanning tree from the first map, as the
 //! lab joins three or more robots. The first map's frame is the merged
-//! frame. A transform is reported as the pose of a map's own frame (the
+//! frame.
+//!
+//! Maps of two buildings opened together join into several *groups*
+//! ([`crate::merge::graph::groups`]): each group is a connected part of the
+//! graph of merged pairs, joined along its own spanning tree from its
+//! lowest-numbered map, whose frame is that group's frame. The first group
+//! is always the first map's, exactly as the merged frame above; a map no
+//! merged pair reaches is a group of its own, with the reason of its
+//! best-supported pair. A transform is reported as the pose of a map's own frame (the
 //! frame its YAML `origin` is written in) in the first map's frame:
 //! the search works in image frames (the image's lower-left corner), so a
 //! pair's image-frame overlay `P` becomes `origin_A ⊕ P ⊕ origin_B⁻¹`.
@@ -37,7 +45,7 @@ use self::search::{propose, RefineConfig, SearchConfig};
 use self::wallmap::WallMap;
 use crate::formats::rosmap::RosMap;
 use crate::geom::Pose2;
-use crate::merge::graph::{spanning_tree, PairEdge};
+use crate::merge::graph::{groups, spanning_tree, Joined, PairEdge};
 use crate::merge::MergeStatus;
 use glam::DVec2;
 use serde_json::json;
@@ -131,6 +139,54 @@ pub struct SavedMerge {
     pub poses: Vec<Option<Pose2>>,
     pub unjoined: Vec<usize>,
     pub pairs: Vec<PairResult>,
+    /// Every connected group of maps (the first map's first).
+    pub groups: Vec<MapGroup>,
+}
+
+/// One group of maps joined to each other and to no map outside it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MapGroup {
+    /// Its maps, in the order they were opened.
+    pub maps: Vec<usize>,
+    /// Each map's frame in the frame of the group's first map (`None` for
+    /// maps of other groups).
+    pub poses: Vec<Option<Pose2>>,
+    /// The weakest confidence of the pairs that join it (0 for one map).
+    pub confidence: f64,
+    /// Why a map stands alone (groups of one map only): the reason of the
+    /// pair with the most net support among its pairs.
+    pub reason: Option<String>,
+}
+
+impl MapGroup {
+    fn new(tree: Joined, edges: &[PairEdge], pairs: &[PairResult]) -> MapGroup {
+        let maps: Vec<usize> = (0..tree.poses.len())
+            .filter(|&i| tree.poses[i].is_some())
+            .collect();
+        let confidence = tree
+            .edges_used
+            .iter()
+            .filter_map(|&k| edges.get(k).map(|e| e.confidence))
+            .reduce(f64::min)
+            .unwrap_or(0.0);
+        let reason = match maps.as_slice() {
+            [only] => pairs
+                .iter()
+                .filter(|p| p.a == *only || p.b == *only)
+                .max_by(|p, q| {
+                    let s = |r: &PairResult| r.evidence.map_or(f64::MIN, |e| e.support_m);
+                    s(p).total_cmp(&s(q))
+                })
+                .map(|p| p.reason.clone()),
+            _ => None,
+        };
+        MapGroup {
+            maps,
+            poses: tree.poses,
+            confidence,
+            reason,
+        }
+    }
 }
 
 /// Searches and judges one pair (maps A and B, prepared as `wa`, `wb`).
@@ -246,6 +302,10 @@ pub fn join(maps: &[RosMap], pairs: Vec<PairResult>) -> SavedMerge {
         })
         .collect();
     let joined = spanning_tree(maps.len(), &edges);
+    let map_groups = groups(maps.len(), &edges)
+        .into_iter()
+        .map(|tree| MapGroup::new(tree, &edges, &pairs))
+        .collect();
     let unjoined = joined.unjoined();
     let used: Vec<&PairEdge> = joined.edges_used.iter().map(|&k| &edges[k]).collect();
     let confidence = used
@@ -297,6 +357,7 @@ pub fn join(maps: &[RosMap], pairs: Vec<PairResult>) -> SavedMerge {
         poses: joined.poses,
         unjoined,
         pairs,
+        groups: map_groups,
     }
 }
 
@@ -317,6 +378,27 @@ impl SavedMerge {
 
 fn pose_json(p: &Pose2) -> serde_json::Value {
     json!([p.x, p.y, p.theta])
+}
+
+/// One group as the report gives it: its maps, each one's frame in the
+/// group's first map's frame, the weakest confidence joining it and, for a
+/// map alone, why.
+fn group_json<'a>(g: &MapGroup, name: &dyn Fn(usize) -> &'a str) -> serde_json::Value {
+    let transforms: Vec<_> = g
+        .poses
+        .iter()
+        .enumerate()
+        .filter_map(|(i, p)| p.map(|p| json!({ "map": name(i), "pose": pose_json(&p) })))
+        .collect();
+    let mut out = json!({
+        "maps": g.maps.iter().map(|&i| name(i)).collect::<Vec<_>>(),
+        "transforms": transforms,
+        "confidence": g.confidence,
+    });
+    if let Some(r) = &g.reason {
+        out["reason"] = json!(r);
+    }
+    out
 }
 
 fn status_name(s: MergeStatus) -> &'static str {
@@ -369,6 +451,7 @@ impl SavedMerge {
                 "transforms": transforms,
                 "unjoined": self.unjoined.iter().map(|&i| name(i)).collect::<Vec<_>>(),
                 "pairs": pairs,
+                "groups": self.groups.iter().map(|g| group_json(g, &name)).collect::<Vec<_>>(),
             },
         })
     }

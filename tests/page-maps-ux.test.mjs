@@ -1,0 +1,181 @@
+// "Your maps" (web/page/real/) as a roboticist meets it, in headless
+// Chromium (tests/support/browser.mjs), driven with real mouse and key
+// events.
+//
+// Groups: two maps of building A (which merge) and two of building B (a
+// different floor plan; they merge with each other and with neither of
+// A's) opened together read "Merged into 2 groups", list each group, and
+// each group's tab shows its own transform (against the truth), overlay
+// legend and downloads (the merged PGM as large as the truth gives, its
+// YAML, the transforms JSON in that group's frame).
+//
+// Needs the wasm build in web/pkg (`./build.sh build`). Run alone with
+//   node --test tests/page-maps-ux.test.mjs
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import path from 'node:path';
+import { ROOT, newPage, useBrowser, waitReady } from './support/browser.mjs';
+import { centredFrame, floorPlan, mapImage, mapYaml } from './support/synthetic-maps.mjs';
+
+const env = useBrowser();
+const tmp = mkdtempSync(path.join(tmpdir(), 'slamlab-maps-ux-'));
+const RES = 0.05;
+
+function file(name, data) {
+  const p = path.join(tmp, name);
+  writeFileSync(p, data);
+  return p;
+}
+
+/**
+ * Two maps of a 30 x 20 m plan made from `seed`: `tag`-west (560 x 440
+ * cells, seeing x <= 19.5 m, its image's corner at (-0.5, -0.5)) and
+ * `tag`-east (600 x 600, seeing x >= 9 m, turned by `theta`). Both YAML
+ * origins are 0, so the east map's frame in the west map's is its image
+ * frame moved by 0.5 m.
+ */
+function building(tag, seed, theta) {
+  const plan = floorPlan(30, 20, seed);
+  const west = [-0.5, -0.5, 0];
+  const east = centredFrame(19, 10, theta, 600, 600);
+  const files = [
+    file(`${tag}-west.yaml`, mapYaml(`${tag}-west.pgm`)),
+    file(`${tag}-west.pgm`, mapImage(plan, west, 560, 440, ([x]) => x <= 19.5)),
+    file(`${tag}-east.yaml`, mapYaml(`${tag}-east.pgm`)),
+    file(`${tag}-east.pgm`, mapImage(plan, east, 600, 600, ([x]) => x >= 9)),
+  ];
+  return { files, truth: [east[0] + 0.5, east[1] + 0.5, east[2]], sizes: [[560, 440], [600, 600]] };
+}
+
+/** Size of the merged grid of a west map and an east map placed at `pose` in its frame (origins 0). */
+function mergedSize({ sizes: [[wx, wy], [ex, ey]] }, [x, y, t]) {
+  const pts = [[0, 0], [1, 0], [1, 1], [0, 1]].flatMap(([u, v]) => {
+    const bu = u * ex * RES, bv = v * ey * RES;
+    return [[u * wx * RES, v * wy * RES], [x + Math.cos(t) * bu - Math.sin(t) * bv, y + Math.sin(t) * bu + Math.cos(t) * bv]];
+  });
+  const span = (k) => Math.max(...pts.map((p) => p[k])) - Math.min(...pts.map((p) => p[k]));
+  return [Math.ceil(span(0) / RES), Math.ceil(span(1) / RES)];
+}
+
+const snapshot = (page) => page.evaluate(() => window.slamlab.savedMaps.snapshot());
+
+async function openView(page) {
+  await page.goto(env.baseUrl);
+  await waitReady(page);
+  await page.getByRole('button', { name: 'Your maps…' }).click();
+  await page.waitForSelector('#real:not([hidden])');
+}
+
+/** Clicks a download button and returns the file's name and bytes. */
+async function downloaded(page, kind) {
+  const [d] = await Promise.all([page.waitForEvent('download'), page.click(`#real-downloads button[data-file="${kind}"]`)]);
+  return { name: d.suggestedFilename(), bytes: readFileSync(await d.path()) };
+}
+
+/** Width and height in a binary PGM's header. */
+function pgmSize(bytes) {
+  const m = /^P5\n(?:#[^\n]*\n)*(\d+) (\d+)\n255\n/.exec(bytes.subarray(0, 200).toString('latin1'));
+  assert.ok(m, 'a binary PGM header');
+  assert.equal(bytes.length, m[0].length + Number(m[1]) * Number(m[2]));
+  return [Number(m[1]), Number(m[2])];
+}
+
+/** The transforms table's row of `map`: its cells. */
+async function row(page, map) {
+  const rows = await page.locator('#real-transforms tr').evaluateAll((trs) => trs.map((tr) => [...tr.cells].map((c) => c.textContent)));
+  return rows.find((r) => r[0] === map);
+}
+
+/** The table's row of `map` is `truth` [x, y, theta] within 0.1 m and 0.5°. */
+function near(cells, [tx, ty, tt], what) {
+  assert.ok(cells, `${what} has a row`);
+  const [x, y, deg] = cells.slice(1, 4).map(Number);
+  assert.ok(Math.hypot(x - tx, y - ty) < 0.1, `${what}: ${cells} against ${tx}, ${ty}`);
+  assert.ok(Math.abs(deg - (tt * 180) / Math.PI) < 0.5, `${what}: ${cells} against ${(tt * 180) / Math.PI}°`);
+}
+
+test('your maps: maps of two buildings merge into two groups, each with its transforms, overlay and downloads', { timeout: 300000 }, async () => {
+  const a = building('a', 7, 0.9);
+  const b = building('b', 21, -0.6);
+  const { context, page, problems } = await newPage(env.browser, { width: 1920, height: 1080 });
+  await openView(page);
+  await page.setInputFiles('#real-files', [...a.files, ...b.files]);
+  await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().report, null, { timeout: 240000 });
+  const { report } = await snapshot(page);
+  const members = report.merge.groups.map((g) => g.maps);
+  assert.deepEqual(members, [['a-west.yaml', 'a-east.yaml'], ['b-west.yaml', 'b-east.yaml']], report.merge.reason);
+
+  // The verdict names both groups and never says "No merge" or "not joined".
+  const verdict = await page.locator('#real-verdict').innerText();
+  assert.equal(verdict, 'Merged into 2 groups that share no wall with each other: a-west.yaml + a-east.yaml; b-west.yaml + b-east.yaml.');
+  assert.equal(await page.locator('#real-verdict').getAttribute('class'), 'real-verdict ok');
+  const list = await page.locator('#real-groups li').allInnerTexts();
+  assert.equal(list.length, 2);
+  assert.match(list[0], /^Group 1: a-west\.yaml \+ a-east\.yaml \(confidence (0\.\d\d|1\.00)\)$/);
+  assert.match(list[1], /^Group 2: b-west\.yaml \+ b-east\.yaml \(confidence (0\.\d\d|1\.00)\)$/);
+  const pairs = await page.locator('#real-pairs').innerText();
+  assert.doesNotMatch(pairs, /no_merge/);
+  assert.match(pairs, /a-west\.yaml \+ b-west\.yaml\s+not merged/);
+  assert.match(pairs, /a-west\.yaml \+ a-east\.yaml\s+merged/);
+
+  // Group 1 first: its transform, "in another group" for B's maps, its downloads.
+  const tabs = page.locator('#real-groups [role="tab"]');
+  assert.equal(await tabs.count(), 2);
+  assert.equal(await tabs.nth(0).getAttribute('aria-selected'), 'true');
+  near(await row(page, 'a-east.yaml'), a.truth, "group 1's a-east.yaml");
+  assert.deepEqual((await row(page, 'b-east.yaml')).slice(1), ['–', '–', '–', 'in another group']);
+  assert.match(await page.locator('#real-legend').innerText(), /a-west\.yaml\s*a-east\.yaml/);
+  assert.doesNotMatch(await page.locator('#real-legend').innerText(), /b-west/);
+  for (const b of await page.locator('#real-downloads button').all()) assert.equal(await b.isDisabled(), false);
+  const pgmA = await downloaded(page, 'pgm');
+  assert.equal(pgmA.name, 'merged-group-1.pgm');
+  const [wa, ha] = pgmSize(pgmA.bytes);
+  const [ewa, eha] = mergedSize(a, a.truth);
+  assert.ok(Math.abs(wa - ewa) <= 2 && Math.abs(ha - eha) <= 2, `group 1 merged ${wa} x ${ha}, the truth gives ${ewa} x ${eha}`);
+  const jsonA = JSON.parse((await downloaded(page, 'json')).bytes.toString('utf8'));
+  assert.equal(jsonA.status, 'merged');
+  assert.equal(jsonA.group, 1);
+  assert.equal(jsonA.frame, 'a_west');
+  assert.deepEqual(jsonA.transforms.map((t) => t.map), ['a-west.yaml', 'a-east.yaml']);
+
+  // Group 2 by a real click on its tab: B's transform in b-west's frame and B's files.
+  await tabs.nth(1).click();
+  assert.equal(await tabs.nth(1).getAttribute('aria-selected'), 'true');
+  near(await row(page, 'b-east.yaml'), b.truth, "group 2's b-east.yaml");
+  // The reference map has no row of its own (tf2 refuses a frame to itself): the caption names it.
+  assert.equal(await row(page, 'b-west.yaml'), undefined);
+  assert.equal(await page.locator('#real-transforms caption').innerText(), "Each map's frame in the frame of b-west.yaml (the reference)");
+  assert.deepEqual((await row(page, 'a-west.yaml')).slice(1), ['–', '–', '–', 'in another group']);
+  await page.waitForFunction(() => /b-west\.yaml/.test(document.querySelector('#real-legend').textContent));
+  assert.doesNotMatch(await page.locator('#real-legend').innerText(), /a-west/);
+  const pgmB = await downloaded(page, 'pgm');
+  assert.equal(pgmB.name, 'merged-group-2.pgm');
+  const [wb, hb] = pgmSize(pgmB.bytes);
+  const [ewb, ehb] = mergedSize(b, b.truth);
+  assert.ok(Math.abs(wb - ewb) <= 2 && Math.abs(hb - ehb) <= 2, `group 2 merged ${wb} x ${hb}, the truth gives ${ewb} x ${ehb}`);
+  const yamlB = await downloaded(page, 'yaml');
+  assert.equal(yamlB.name, 'merged-group-2.yaml');
+  assert.match(yamlB.bytes.toString('utf8'), /image: "?merged-group-2\.pgm"?/);
+  const pngB = await downloaded(page, 'png');
+  assert.equal(pngB.name, 'merged-group-2.png');
+  const jsonB = JSON.parse((await downloaded(page, 'json')).bytes.toString('utf8'));
+  assert.equal(jsonB.group, 2);
+  assert.equal(jsonB.frame, 'b_west');
+  const [x, y] = jsonB.transforms[1].pose;
+  assert.ok(Math.hypot(x - b.truth[0], y - b.truth[1]) < 0.1, `JSON group 2: ${jsonB.transforms[1].pose}`);
+
+  // The arrow keys move between the tabs too.
+  await tabs.nth(1).focus();
+  await page.keyboard.press('ArrowLeft');
+  assert.equal(await tabs.nth(0).getAttribute('aria-selected'), 'true');
+  near(await row(page, 'a-east.yaml'), a.truth, "group 1's a-east.yaml again");
+
+  await page.locator('#real-verdict').evaluate((e) => e.scrollIntoView({ block: 'start' }));
+  await tabs.nth(1).click();
+  await page.waitForTimeout(300);
+  await page.screenshot({ path: path.join(ROOT, 'docs/issue55-two-building-groups.png') });
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});
