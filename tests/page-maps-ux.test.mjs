@@ -16,7 +16,7 @@ import assert from 'node:assert/strict';
 import { mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
-import { ROOT, newPage, useBrowser, waitReady } from './support/browser.mjs';
+import { ARTIFACTS, ROOT, newPage, useBrowser, waitReady } from './support/browser.mjs';
 import { centredFrame, floorPlan, mapImage, mapYaml } from './support/synthetic-maps.mjs';
 
 const env = useBrowser();
@@ -176,6 +176,117 @@ test('your maps: maps of two buildings merge into two groups, each with its tran
   await tabs.nth(1).click();
   await page.waitForTimeout(300);
   await page.screenshot({ path: path.join(ROOT, 'docs/issue55-two-building-groups.png') });
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});
+
+/** `a ∘ b` for poses [x, y, theta]. */
+function compose([ax, ay, at], [bx, by, bt]) {
+  const c = Math.cos(at), s = Math.sin(at);
+  return [ax + c * bx - s * by, ay + s * bx + c * by, at + bt];
+}
+
+/** The page's point (CSS pixels) of `[x, y]` in map a's frame, while a map is placed by hand. */
+async function onScreen(page, [x, y]) {
+  const { view } = (await snapshot(page)).adjust;
+  const box = await page.locator('#real-overlay').boundingBox();
+  return [box.x + (view.k * x + view.e) / view.dpr, box.y + (view.f - view.k * y) / view.dpr];
+}
+
+/** A real mouse drag of the placed map's middle by `[dx, dy]` metres. */
+async function dragBy(page, [dx, dy]) {
+  const { pose, pivot } = (await snapshot(page)).adjust.placing;
+  const middle = compose(pose, [...pivot, 0]);
+  const from = await onScreen(page, middle), to = await onScreen(page, [middle[0] + dx, middle[1] + dy]);
+  await page.mouse.move(...from);
+  await page.mouse.down();
+  await page.mouse.move(...to, { steps: 12 });
+  await page.mouse.up();
+  await page.waitForFunction(() => !document.querySelector('#real-overlay').dataset.sending);
+  return (await snapshot(page)).adjust.placing.pose;
+}
+
+/** Presses Refine and waits for its verdict. */
+async function refine(page) {
+  await page.getByRole('button', { name: 'Refine' }).click();
+  await page.waitForFunction(() => {
+    const s = window.slamlab.savedMaps.snapshot();
+    return s.adjust.pair && !s.busy && !s.adjust.placing;
+  }, null, { timeout: 120000 });
+  return snapshot(page);
+}
+
+const close = (p, q) => p.every((v, i) => Math.abs(v - q[i]) < 1e-9);
+
+test('your maps: a refused Refine keeps your placement, shows what was judged, and "Use my placement" joins it, not verified', { timeout: 300000 }, async () => {
+  // Two different buildings: never merged, whatever the placement.
+  const a = building('keep-a', 7, 0);
+  const b = building('keep-b', 21, 0.4);
+  const files = [a.files[0], a.files[1], b.files[2], b.files[3]];
+  const { context, page, problems } = await newPage(env.browser, { width: 1366, height: 768 });
+  await openView(page);
+  await page.setInputFiles('#real-files', files);
+  await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().report, null, { timeout: 120000 });
+  assert.equal((await snapshot(page)).report.merge.status, 'no_merge');
+  assert.equal(await page.locator('#real-keep').isHidden(), true, 'nothing to keep before a Refine');
+
+  await page.getByRole('button', { name: 'Place by hand' }).click();
+  await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().adjust.view);
+  const placed = await dragBy(page, [-24, 1]);
+  let snap = await refine(page);
+  assert.notEqual(snap.adjust.pair.status, 'merged', snap.adjust.pair.reason);
+  // The placement stays on screen, with the judged overlay outlined and the reason.
+  assert.ok(close(snap.adjust.kept.pose, placed), `kept ${snap.adjust.kept.pose}, placed ${placed}`);
+  assert.ok(snap.adjust.kept.judged, 'the refined overlay that was judged');
+  assert.equal(await page.locator('#real-overlay-title').innerText(), 'Your placement of keep-b-east.yaml (refused by Refine)');
+  assert.match(await page.locator('#real-legend').innerText(), /dashed: the refined overlay that was judged and refused/);
+  assert.match(await page.locator('#real-refined').innerText(), /^Refine of keep-b-east\.yaml on keep-a-west\.yaml: refused, because refined from your guess .*\d.*Your placement stays on screen/);
+  assert.equal(await page.locator('#real-keep').isVisible(), true);
+  assert.equal(await page.locator('#real-keep').innerText(), 'Use my placement (not verified)');
+
+  // Place by hand again starts from the last placement, not from the start.
+  await page.getByRole('button', { name: 'Place by hand' }).click();
+  await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().adjust.placing);
+  assert.ok(close((await snapshot(page)).adjust.placing.pose, placed), 'starts from the last placement');
+  const mine = await dragBy(page, [1.5, -1]);
+  snap = await refine(page);
+  assert.notEqual(snap.adjust.pair.status, 'merged');
+  assert.ok(close(snap.adjust.kept.pose, mine));
+  await page.locator('#real-adjust').evaluate((e) => e.scrollIntoView({ block: 'start' }));
+  await page.waitForTimeout(300);
+  await page.screenshot({ path: path.join(ROOT, 'docs/issue55-kept-placement.png') });
+
+  // Use my placement: joined exactly there, not verified everywhere it shows.
+  await page.getByRole('button', { name: 'Use my placement (not verified)' }).click();
+  await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().report.merge.verified === false && !window.slamlab.savedMaps.snapshot().busy);
+  snap = await snapshot(page);
+  assert.equal(snap.report.merge.status, 'merged');
+  assert.ok(close(snap.report.merge.transforms[1].pose, mine), `joined at ${snap.report.merge.transforms[1].pose}, placed at ${mine}`);
+  assert.match(await page.locator('#real-verdict').innerText(), /^Merged where you placed a map, not verified by the merge's tests: placed by hand and kept as placed, not verified \(the tests refused it: refined from your guess/);
+  assert.equal(await page.locator('#real-verdict').getAttribute('class'), 'real-verdict unverified');
+  assert.equal(await page.locator('#real-keep').isHidden(), true);
+  assert.match(await page.locator('#real-transforms caption').innerText(), /with your placement, not verified$/);
+  assert.equal((await row(page, 'keep-b-east.yaml (placed by hand, not verified)'))[1], mine[0].toFixed(3));
+  assert.match(await page.locator('#real-pair').innerText(), /keep-b-east\.yaml onto keep-a-west\.yaml \(placed by hand, not verified\)/);
+  assert.equal(await page.locator('#real-unverified').isVisible(), true);
+  assert.equal(await page.locator('#real-downloads [data-file="pgm"]').innerText(), 'Merged map PGM (not verified)');
+  const pgm = await downloaded(page, 'pgm');
+  assert.equal(pgm.name, 'merged-not-verified.pgm');
+  const [w, h] = pgmSize(pgm.bytes);
+  const [ew, eh] = mergedSize({ sizes: [a.sizes[0], b.sizes[1]] }, mine);
+  assert.ok(Math.abs(w - ew) <= 2 && Math.abs(h - eh) <= 2, `merged ${w} x ${h}, the placement gives ${ew} x ${eh}`);
+  const yaml = (await downloaded(page, 'yaml')).bytes.toString('utf8');
+  assert.match(yaml, /^# Joined where a person placed a map by hand: not verified/);
+  assert.match(yaml, /image: "?merged-not-verified\.pgm"?/);
+  const json = JSON.parse((await downloaded(page, 'json')).bytes.toString('utf8'));
+  assert.equal(json.verified, false);
+  assert.equal(json.status, 'merged');
+  assert.equal(json.pairs[0].verified, false);
+
+  assert.equal(await page.locator('#real-overlay-title').innerText(), 'Merged overlay (your placement, not verified)');
+  await page.locator('#real-adjust').evaluate((e) => e.scrollIntoView({ block: 'start' }));
+  await page.waitForTimeout(300);
+  await page.screenshot({ path: path.join(ARTIFACTS, 'page-maps-ux-kept.png') });
   assert.deepEqual(problems, [], 'no console errors or page errors');
   await context.close();
 });

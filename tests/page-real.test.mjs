@@ -347,7 +347,7 @@ test('your maps: a merge declined as ambiguous is placed by hand, turned and dra
   const auto = (await snapshot(page)).report.merge;
   assert.equal(auto.status, 'no_merge', auto.reason);
   assert.match(auto.reason, /ambiguous/);
-  assert.match(await page.locator('#real-pair').innerText(), /sym-b\.yaml onto sym-a\.yaml \(no merge\)/);
+  assert.match(await page.locator('#real-pair').innerText(), /sym-b\.yaml onto sym-a\.yaml \(not merged\)/);
 
   await page.getByRole('button', { name: 'Place by hand' }).click();
   await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().adjust.view);

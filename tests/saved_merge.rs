@@ -512,3 +512,59 @@ fn a_map_alone_is_a_group_of_its_own_with_its_reason() {
         assert_eq!(g.reason.as_deref(), Some(r.pairs[0].reason.as_str()));
     }
 }
+
+#[test]
+fn a_kept_placement_joins_as_placed_and_is_marked_not_verified() {
+    let blank =
+        |name: &str| RosMap::from_values(name, 4, 4, 0.05, Pose2::IDENTITY, vec![0; 16]).unwrap();
+    let maps: Vec<RosMap> = ["m0", "m1", "m2"].iter().map(|n| blank(n)).collect();
+    let p01 = Pose2::new(2.0, 0.5, 0.1);
+    let pairs = vec![
+        judged(0, 1, Some((p01, 0.8)), "agree"),
+        judged(0, 2, None, "the walls disagree"),
+        judged(1, 2, None, "too little common wall"),
+    ];
+    let mut r = join(&maps, pairs.clone());
+    assert_eq!(r.unjoined, vec![2]);
+    assert!(r.verified);
+    let mine = Pose2::new(-4.0, 3.0, 2.0);
+    let k = r
+        .keep_placement(
+            &maps,
+            (0, 2),
+            mine,
+            "refined from your guess: the walls disagree",
+        )
+        .unwrap();
+    assert_eq!(k, 1);
+    assert_eq!(r.status, MergeStatus::Merged, "{}", r.reason);
+    assert_eq!(r.poses[2], Some(mine), "joined exactly where it was placed");
+    assert!(!r.verified);
+    assert!(!r.pairs[1].verified && r.pairs[0].verified);
+    assert!(
+        r.pairs[1].reason.contains("not verified"),
+        "{}",
+        r.pairs[1].reason
+    );
+    assert!(
+        r.pairs[1].reason.contains("the walls disagree"),
+        "{}",
+        r.pairs[1].reason
+    );
+    assert!(!r.groups[0].verified);
+    let report = r.report(&maps);
+    assert_eq!(report["merge"]["verified"], false);
+    assert_eq!(report["merge"]["pairs"][1]["verified"], false);
+    assert_eq!(report["merge"]["groups"][0]["verified"], false);
+    assert!(report["merge"]["pairs"][0].get("verified").is_none());
+
+    // A verified chain to the same map wins over a kept placement.
+    let p12 = Pose2::new(1.0, 1.0, -0.3);
+    let mut with_chain = pairs;
+    with_chain[2] = judged(1, 2, Some((p12, 0.5)), "agree");
+    let mut r = join(&maps, with_chain);
+    r.keep_placement(&maps, (0, 2), mine, "").unwrap();
+    let (dm, dd) = error(&r.poses[2].unwrap(), &p01.compose(&p12));
+    assert!(dm < 1e-9 && dd < 1e-9, "off by {dm} m {dd} deg");
+    assert!(r.verified);
+}

@@ -100,6 +100,19 @@ export class SavedMaps {
     return JSON.parse(this.raw.refine(a, b, pose[0], pose[1], pose[2]));
   }
 
+  /**
+   * Keeps a person's placement of maps `a` and `b` (map b's frame at
+   * `pose` = [x, y, theta] in map a's) as it is, not verified, after the
+   * tests refused it; `report()` then says `verified: false`. Returns the
+   * pair's result (as `refine` does).
+   */
+  keepPlacement(a, b, pose) {
+    if (!Array.isArray(pose) || pose.length !== 3) {
+      throw new Error(`keep placement: the pose must be [x, y, theta], got ${JSON.stringify(pose)}`);
+    }
+    return JSON.parse(this.raw.keepPlacement(a, b, pose[0], pose[1], pose[2]));
+  }
+
   /** The report `merge` returned, after any `refine`. */
   report() {
     return JSON.parse(this.raw.reportJson());

@@ -117,6 +117,25 @@ impl MapMerge {
         to_json(&pair)
     }
 
+    /// Keeps a person's placement of maps `a` and `b` (map `b`'s frame at
+    /// `(x, y, theta)` in map `a`'s) as it is, not verified; returns the
+    /// pair's result as JSON (see `SavedMaps::keep_placement`).
+    #[wasm_bindgen(js_name = keepPlacement)]
+    pub fn keep_placement(
+        &mut self,
+        a: u32,
+        b: u32,
+        x: f64,
+        y: f64,
+        theta: f64,
+    ) -> Result<String, JsError> {
+        let pair = self
+            .inner
+            .keep_placement(a as usize, b as usize, Pose2::new(x, y, theta))
+            .map_err(err)?;
+        to_json(&pair)
+    }
+
     /// The report's `maps` and `merge` as JSON, as `merge` returned it,
     /// after any `refine`.
     #[wasm_bindgen(js_name = reportJson)]

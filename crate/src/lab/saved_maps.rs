@@ -189,6 +189,53 @@ impl SavedMaps {
         Ok(report["merge"]["pairs"][k].clone())
     }
 
+    /// Keeps a person's placement of maps `a` and `b` (map `b`'s frame at
+    /// `pose` in map `a`'s, as [`SavedMaps::refine`] takes it) as it is,
+    /// not verified, after the tests refused it: the maps are joined there
+    /// and the report says `verified: false`. Returns the pair's result in
+    /// the report's `pairs[]` format (for `a > b` as `b`, `a`).
+    pub fn keep_placement(
+        &mut self,
+        a: usize,
+        b: usize,
+        pose: Pose2,
+    ) -> Result<serde_json::Value, String> {
+        let n = self.maps.len();
+        if a >= n || b >= n || a == b {
+            return Err(format!(
+                "keep placement: maps {a} and {b} are not a pair of the {n} maps opened"
+            ));
+        }
+        if !pose.is_finite() {
+            return Err(format!(
+                "keep placement: the pose must be finite numbers, got x = {}, y = {}, theta = {}",
+                pose.x, pose.y, pose.theta
+            ));
+        }
+        let result = self.result.as_mut().ok_or("keep placement: merge first")?;
+        let judged = result
+            .pairs
+            .iter()
+            .find(|p| (p.a, p.b) == (a, b) || (p.a, p.b) == (b, a))
+            .ok_or("keep placement: that pair was not judged")?;
+        let (a, b, pose) = if judged.a == a {
+            (a, b, pose)
+        } else {
+            (b, a, pose.inverse())
+        };
+        let refused = if judged.guess.is_some() && judged.verified {
+            judged.reason.clone()
+        } else {
+            String::new()
+        };
+        let k = result
+            .keep_placement(&self.maps, (a, b), pose, &refused)
+            .ok_or("keep placement: that pair was not judged")?;
+        self.merged.clear();
+        let report = result.report(&self.maps);
+        Ok(report["merge"]["pairs"][k].clone())
+    }
+
     /// The report's `maps` and `merge`, as [`SavedMaps::merge`] returned
     /// it, after any [`SavedMaps::refine`].
     pub fn report(&self) -> Result<serde_json::Value, String> {

@@ -63,9 +63,18 @@ export class SavedMapsClient extends WorkerClient {
     return this.request({ type: 'merge' });
   }
 
-  /** Shows map `b` (index) with its frame at `pose` in map `a`'s; `fit` fits the view anew: `{view}`. */
-  adjust(a, b, pose, fit = false) {
-    return this.request({ type: 'adjust', a, b, pose, fit });
+  /**
+   * Shows map `b` (index) with its frame at `pose` in map `a`'s; `fit` fits
+   * the view anew; `judged` (a pose) outlines where a refused refine put
+   * it: `{view}`.
+   */
+  adjust(a, b, pose, fit = false, judged = null) {
+    return this.request({ type: 'adjust', a, b, pose, fit, judged });
+  }
+
+  /** Joins map `b` to map `a` at `pose` as placed, not verified: `{pair, report, files}`. */
+  keep(a, b, pose) {
+    return this.request({ type: 'keep', a, b, pose });
   }
 
   /** Back to the merge's overlay: `{view}`. */

@@ -11,7 +11,7 @@
 // `${p}-legend`, `${p}-downloads`, and `${p}-groups` (maps of several
 // buildings: one group of maps shown at a time, map-groups.js).
 
-import { joinedGroups, transformRows, transformsJson, verdictText } from './report.js';
+import { joinedGroups, transformRows, transformsJson, unverifiedMaps, verdictText } from './report.js';
 
 /**
  * The Merge maps row (`#${p}-merge`, a busy dot, the stage line `#stage`,
@@ -46,6 +46,7 @@ export function resultHtml(p, { frames, title, overlay, extra = '' }) {
     </div>
     <canvas id="${p}-overlay" class="real-overlay" aria-label="${overlay}"></canvas>
     <p id="${p}-legend" class="real-legend"></p>
+    <p id="${p}-unverified" class="real-unverified-note" hidden>These files join a map where you placed it: the merge's tests did not verify it.</p>
     <div id="${p}-downloads" class="real-downloads">
       <button type="button" data-file="pgm">Merged map PGM</button>
       <button type="button" data-file="yaml">Merged map YAML</button>
@@ -67,16 +68,18 @@ export function showMerge(root, p, merge, hasFiles, { name = (m) => m, what = 'm
   q(`#${p}-result`).hidden = false;
   const v = q(`#${p}-verdict`);
   v.textContent = verdictText(merge, name);
-  v.className = `real-verdict ${merge.status === 'merged' || joinedGroups(merge).length ? 'ok' : 'no'}`;
   const shown = group ? { ...merge, transforms: group.transforms } : merge;
-  const rows = transformRows(shown).map((r) => [name(r.map), r.x, r.y, r.deg, r.args]);
+  const verified = (group ?? merge).verified !== false;
+  v.className = `real-verdict ${!verified ? 'unverified' : merge.status === 'merged' || joinedGroups(merge).length ? 'ok' : 'no'}`;
+  const unsure = unverifiedMaps(shown);
+  const rows = transformRows(shown).map((r) => [name(r.map) + (unsure.has(r.map) ? ' (placed by hand, not verified)' : ''), r.x, r.y, r.deg, r.args]);
   const others = group ? (merge.groups ?? []).flatMap((g) => (g === group ? [] : g.maps)) : merge.unjoined;
   for (const m of others) rows.push([name(m), '–', '–', '–', group ? 'in another group' : 'not joined']);
   const table = q(`#${p}-transforms`);
   const reference = shown.transforms[0]?.map;
   table.querySelector('caption').textContent = reference === undefined
     ? `No ${what} joined another`
-    : `Each ${what}'s frame in the frame of ${name(reference)} (the reference)`;
+    : `Each ${what}'s frame in the frame of ${name(reference)} (the reference)${verified ? '' : ', with your placement, not verified'}`;
   fillTable(table, [what, 'x (m)', 'y (m)', 'θ (°)', 'static_transform_publisher'], rows);
   fillTable(
     q(`#${p}-pairs`),
@@ -85,7 +88,10 @@ export function showMerge(root, p, merge, hasFiles, { name = (m) => m, what = 'm
   );
   for (const b of root.querySelectorAll(`#${p}-downloads button`)) {
     b.disabled = b.dataset.file !== 'json' && !hasFiles;
+    b.textContent = b.textContent.replace(/ \(not verified\)$/, '') + (verified ? '' : ' (not verified)');
   }
+  const note = q(`#${p}-unverified`);
+  if (note) note.hidden = verified;
 }
 
 /**

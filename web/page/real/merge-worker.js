@@ -17,7 +17,10 @@
 // page's Refine, adjust.js): `{id, type: 'adjust', a, b, pose, fit}` (map
 // b's frame at `pose` in map a's: shown, the view kept still unless
 // `fit`), `{id, type: 'refine', a, b, pose}` (aligns from there, answers
-// `{pair, report, files}` as a merge does), `{id, type: 'endAdjust'}`;
+// `{pair, report, files}` as a merge does), `{id, type: 'keep', a, b,
+// pose}` (joins map b there as placed, not verified; answers as refine
+// does), `{id, type: 'endAdjust'}`; an `adjust` with `judged` (a pose)
+// also outlines, dashed, where a refused refine put map b;
 // out: `{id, ok, ...}` or `{id, ok: false, error}`, and
 // `{type: 'progress', text}` while merging. Draws answer with the view
 // used (`{view: {k, e, f, width, height, dpr}}`).
@@ -27,7 +30,7 @@ import { SavedMaps, mapImagePath } from '../../saved-maps.js';
 import { BagFile, bagKind } from '../../bag-file.js';
 import { groupFiles } from './files.js';
 import { previewOf } from './preview.js';
-import { compose, drawPlaced, fitView } from './overlay.js';
+import { compose, drawPlaced, fitView, outline } from './overlay.js';
 
 const ready = init();
 /** The maps read so far (a SavedMaps), null before the first. */
@@ -105,6 +108,17 @@ function merge(id) {
   return withFiles(report, t0);
 }
 
+/** Joins map b to map a as the page placed it, not verified; the report follows it. */
+function keep({ a, b, pose }) {
+  const t0 = performance.now();
+  const pair = savedMaps.keepPlacement(a, b, pose);
+  const out = withFiles(savedMaps.report(), t0);
+  adjusting = null;
+  view = null;
+  out.result.pair = pair;
+  return out;
+}
+
 /** Aligns map b on map a again from the page's guess; the report follows it. */
 function refine({ a, b, pose }) {
   const t0 = performance.now();
@@ -137,7 +151,9 @@ function withFiles(report, t0) {
   const files = groups.map((g, k) => {
     if (g.maps.length < 2) return null;
     n += 1;
-    const f = filesOfGroup(k, joined > 1 ? `merged-group-${n}` : 'merged');
+    const stem = joined > 1 ? `merged-group-${n}` : 'merged';
+    const f = filesOfGroup(k, g.verified === false ? `${stem}-not-verified` : stem);
+    if (g.verified === false) f.yaml = `# Joined where a person placed a map by hand: not verified by the merge's tests.\n${f.yaml}`;
     transfer.push(f.pgm.buffer, f.png.buffer);
     return f;
   });
@@ -169,6 +185,9 @@ self.onmessage = async ({ data }) => {
     } else if (type === 'refine') {
       if (!savedMaps) throw new Error('open two or more maps first');
       out = refine(data);
+    } else if (type === 'keep') {
+      if (!savedMaps) throw new Error('open two or more maps first');
+      out = keep(data);
     } else if (type === 'group') {
       shownGroup = data.group;
       place();
@@ -177,7 +196,7 @@ self.onmessage = async ({ data }) => {
       out = { result: { view: draw(data) }, transfer: [] };
     } else if (type === 'adjust') {
       if (data.fit || !adjusting) view = null;
-      adjusting = { a: data.a, b: data.b, pose: data.pose };
+      adjusting = { a: data.a, b: data.b, pose: data.pose, judged: data.judged ?? null };
       out = { result: { view: draw(lastSize) }, transfer: [] };
     } else if (type === 'endAdjust') {
       adjusting = null;
@@ -218,7 +237,8 @@ function draw(size) {
   if (!adjusting) return drawPlaced(overlay, lastSize, placed);
   const a = pictureOf(adjusting.a), b = pictureOf(adjusting.b);
   const shown = [{ map: a, pose: [0, 0, 0] }, { map: b, pose: adjusting.pose }];
-  view = drawPlaced(overlay, lastSize, shown, view ?? fitView(shown, lastSize, 0.15));
+  const fitted = adjusting.judged ? [...shown, { map: b, pose: adjusting.judged }] : shown;
+  view = drawPlaced(overlay, lastSize, shown, view ?? fitView(fitted, lastSize, 0.15));
   const [x, y] = compose(compose(adjusting.pose, b.origin), [(b.width * b.resolution) / 2, (b.height * b.resolution) / 2, 0]);
   const ctx = overlay.getContext('2d');
   const px = view.k * x + view.e, py = view.f - view.k * y, r = 9 * size.dpr;
@@ -232,5 +252,35 @@ function draw(size) {
   ctx.moveTo(px, py - 1.6 * r);
   ctx.lineTo(px, py + 1.6 * r);
   ctx.stroke();
+  if (adjusting.judged) outlineAt(ctx, b, adjusting.judged, size.dpr);
   return view;
+}
+
+/** The convex hull of points [x, y] (Andrew's monotone chain), counter-clockwise. */
+function hull(points) {
+  const p = [...points].sort((u, v) => u[0] - v[0] || u[1] - v[1]);
+  const cross = (o, u, v) => (u[0] - o[0]) * (v[1] - o[1]) - (u[1] - o[1]) * (v[0] - o[0]);
+  const half = (list) => {
+    const out = [];
+    for (const q of list) {
+      while (out.length > 1 && cross(out[out.length - 2], out[out.length - 1], q) <= 0) out.pop();
+      out.push(q);
+    }
+    out.pop();
+    return out;
+  };
+  return [...half(p), ...half([...p].reverse())];
+}
+
+/** A dashed outline round map `b`'s known cells with its frame at `pose`: where a refused refine put it. */
+function outlineAt(ctx, b, pose, dpr) {
+  const corners = hull(outline(b, pose));
+  ctx.setLineDash([8 * dpr, 6 * dpr]);
+  ctx.lineWidth = 2.5 * dpr;
+  ctx.strokeStyle = '#c2410c';
+  ctx.beginPath();
+  corners.forEach(([x, y], i) => (i ? ctx.lineTo : ctx.moveTo).call(ctx, view.k * x + view.e, view.f - view.k * y));
+  ctx.closePath();
+  ctx.stroke();
+  ctx.setLineDash([]);
 }

@@ -183,7 +183,7 @@ export class SavedMapsView {
       this.say('Open two or more maps to merge them.', 'warn');
       return;
     }
-    if (this.adjust.active) await this.adjust.stop();
+    if (this.adjust.active || this.adjust.kept) await this.adjust.stop();
     const n = this.maps.length;
     const t0 = performance.now();
     // Nothing ticks or animates while it runs: the page's main thread stays
@@ -229,6 +229,7 @@ export class SavedMapsView {
 
   dropResult() {
     this.adjust.active = null;
+    this.adjust.kept = null;
     this.report = null;
     this.files = null;
     this.groupFiles = [];
@@ -283,7 +284,7 @@ export class SavedMapsView {
     this.overlay.draw(
       (e) => this.say(e.message, 'error'),
       (r) => {
-        if (this.adjust.active && r?.view) this.adjust.view = r.view;
+        if ((this.adjust.active || this.adjust.kept) && r?.view) this.adjust.view = r.view;
       },
     );
     this.legend();
@@ -296,10 +297,18 @@ export class SavedMapsView {
 
   legend() {
     const legend = this.root.querySelector('#real-legend');
-    const placing = this.adjust.active;
-    this.root.querySelector('#real-overlay-title').textContent = placing ? `Placing ${placing.b.name} by hand` : 'Merged overlay';
+    const placing = this.adjust.active, kept = this.adjust.kept;
+    this.root.querySelector('#real-overlay-title').textContent = placing
+      ? `Placing ${placing.b.name} by hand`
+      : kept ? `Your placement of ${kept.b.name} (refused by Refine)`
+        : this.report?.merge.verified === false ? 'Merged overlay (your placement, not verified)' : 'Merged overlay';
     if (placing) {
       legend.replaceChildren(swatch(placing.a.colour, placing.a.name), swatch(placing.b.colour, `${placing.b.name} (drag it)`));
+      return;
+    }
+    if (kept) {
+      legend.replaceChildren(swatch(kept.a.colour, kept.a.name), swatch(kept.b.colour, `${kept.b.name} where you put it`),
+        kept.judged ? swatch('#c2410c', 'dashed: the refined overlay that was judged and refused') : '');
       return;
     }
     if (!this.report) return;

@@ -13,6 +13,12 @@ export function frameName(file) {
   return String(file).split(/[\\/]/).pop().replace(/\.[^.]*$/, '').replace(/[^\w]+/g, '_') || 'map';
 }
 
+/** Names of the maps joined by a placement kept by hand (not the reference of `merge`'s transforms). */
+export function unverifiedMaps(merge) {
+  const reference = merge.transforms[0]?.map;
+  return new Set(merge.pairs.filter((p) => p.verified === false).flatMap((p) => [p.a, p.b]).filter((m) => m !== reference));
+}
+
 /** The groups of two or more maps, with their positions in `merge.groups`. */
 export function joinedGroups(merge) {
   return (merge.groups ?? []).map((g, k) => ({ ...g, k })).filter((g) => g.maps.length > 1);
@@ -34,10 +40,11 @@ export function verdictText(merge, name = (m) => m) {
   if (several) {
     const alone = (merge.groups ?? []).filter((g) => g.maps.length === 1).map((g) => name(g.maps[0]));
     const head = joined.length > 1 ? `Merged into ${joined.length} groups that share no wall with each other` : 'Merged in part';
-    const list = joined.map((g) => g.maps.map(name).join(' + ')).join('; ');
+    const list = joined.map((g) => g.maps.map(name).join(' + ') + (g.verified === false ? ' (placed by hand, not verified)' : '')).join('; ');
     const rest = alone.length ? `; ${nameList(alone)} ${alone.length > 1 ? 'join' : 'joins'} no other map (see each pair's verdict)` : '';
     return `${head}: ${list}${rest}.`;
   }
+  if (merge.status === 'merged' && merge.verified === false) return `Merged where you placed a map, not verified by the merge's tests: ${merge.reason}`;
   if (merge.status === 'merged') return `Merged (confidence ${merge.confidence.toFixed(2)}): ${merge.reason}`;
   return `No merge, because ${merge.reason}`;
 }
@@ -71,6 +78,7 @@ export function transformsJson(report, group = -1) {
   const rows = transformRows(merge);
   const out = {
     status: g ? 'merged' : merge.status,
+    verified: (g ?? report.merge).verified !== false,
     reason: g ? verdictText(report.merge) : merge.reason,
     confidence: g ? g.confidence : merge.confidence,
     frame: frameName(merge.transforms[0]?.map ?? ''),

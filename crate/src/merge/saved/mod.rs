@@ -21,6 +21,13 @@
 //! lab joins three or more robots. The first map's frame is the merged
 //! frame.
 //!
+//! A person may also keep a placement of their own that the tests refused
+//! ([`SavedMerge::keep_placement`]): the pair then joins at exactly that
+//! pose, marked *not verified* (`verified: false` on the pair, on every
+//! group it joins and on the merge), with the refusal kept in its reason,
+//! and with the least confidence, so the spanning tree takes any verified
+//! chain first.
+//!
 //! Maps of two buildings opened together join into several *groups*
 //! ([`crate::merge::graph::groups`]): each group is a connected part of the
 //! graph of merged pairs, joined along its own spanning tree from its
@@ -78,6 +85,9 @@ pub struct PairResult {
     /// The person's guess this pair was refined from (B's map frame in
     /// A's), `None` for the automatic merge.
     pub guess: Option<Pose2>,
+    /// `false` for a placement a person kept although the tests refused
+    /// it ([`SavedMerge::keep_placement`]).
+    pub verified: bool,
 }
 
 impl PairResult {
@@ -94,6 +104,7 @@ impl PairResult {
             rival_support_m: 0.0,
             overlays: 0,
             guess: None,
+            verified: true,
         }
     }
 }
@@ -141,7 +152,14 @@ pub struct SavedMerge {
     pub pairs: Vec<PairResult>,
     /// Every connected group of maps (the first map's first).
     pub groups: Vec<MapGroup>,
+    /// `false` when a pair joining the first map's group is a placement
+    /// kept by hand, not verified.
+    pub verified: bool,
 }
+
+/// The confidence of a kept placement: above 0 (so it joins), below any
+/// verified pair's.
+pub const KEPT_CONFIDENCE: f64 = 1e-6;
 
 /// One group of maps joined to each other and to no map outside it.
 #[derive(Clone, Debug, PartialEq)]
@@ -156,17 +174,23 @@ pub struct MapGroup {
     /// Why a map stands alone (groups of one map only): the reason of the
     /// pair with the most net support among its pairs.
     pub reason: Option<String>,
+    /// `false` when a pair joining it is a placement kept by hand.
+    pub verified: bool,
 }
 
 impl MapGroup {
-    fn new(tree: Joined, edges: &[PairEdge], pairs: &[PairResult]) -> MapGroup {
+    fn new(tree: Joined, edges: &[(PairEdge, bool)], pairs: &[PairResult]) -> MapGroup {
+        let verified = tree
+            .edges_used
+            .iter()
+            .all(|&k| edges.get(k).is_none_or(|e| e.1));
         let maps: Vec<usize> = (0..tree.poses.len())
             .filter(|&i| tree.poses[i].is_some())
             .collect();
         let confidence = tree
             .edges_used
             .iter()
-            .filter_map(|&k| edges.get(k).map(|e| e.confidence))
+            .filter_map(|&k| edges.get(k).map(|e| e.0.confidence))
             .reduce(f64::min)
             .unwrap_or(0.0);
         let reason = match maps.as_slice() {
@@ -185,6 +209,7 @@ impl MapGroup {
             poses: tree.poses,
             confidence,
             reason,
+            verified,
         }
     }
 }
@@ -289,22 +314,27 @@ pub fn merge_all(
 /// Joins `maps` along the most confident spanning tree of the merged
 /// `pairs` (see the module doc) and words the verdict.
 pub fn join(maps: &[RosMap], pairs: Vec<PairResult>) -> SavedMerge {
-    let edges: Vec<PairEdge> = pairs
+    let marked: Vec<(PairEdge, bool)> = pairs
         .iter()
         .filter(|p| p.status == MergeStatus::Merged)
         .filter_map(|p| {
-            p.pose.map(|pose| PairEdge {
-                a: p.a,
-                b: p.b,
-                pose,
-                confidence: p.confidence,
+            p.pose.map(|pose| {
+                let edge = PairEdge {
+                    a: p.a,
+                    b: p.b,
+                    pose,
+                    confidence: p.confidence,
+                };
+                (edge, p.verified)
             })
         })
         .collect();
+    let edges: Vec<PairEdge> = marked.iter().map(|e| e.0).collect();
     let joined = spanning_tree(maps.len(), &edges);
+    let verified = joined.edges_used.iter().all(|&k| marked[k].1);
     let map_groups = groups(maps.len(), &edges)
         .into_iter()
-        .map(|tree| MapGroup::new(tree, &edges, &pairs))
+        .map(|tree| MapGroup::new(tree, &marked, &pairs))
         .collect();
     let unjoined = joined.unjoined();
     let used: Vec<&PairEdge> = joined.edges_used.iter().map(|&k| &edges[k]).collect();
@@ -358,6 +388,7 @@ pub fn join(maps: &[RosMap], pairs: Vec<PairResult>) -> SavedMerge {
         unjoined,
         pairs,
         groups: map_groups,
+        verified,
     }
 }
 
@@ -373,6 +404,34 @@ impl SavedMerge {
         pairs[k] = pair;
         *self = join(maps, pairs);
         Some(k)
+    }
+
+    /// Keeps a person's placement of the pair `a`, `b` (in the order the
+    /// merge judged it): map `b`'s frame at `pose` in map `a`'s, joined as
+    /// it is, not verified. `refused` is why the tests refused it (the
+    /// refine's reason). Returns the pair's index, `None` when no such pair
+    /// was judged.
+    pub fn keep_placement(
+        &mut self,
+        maps: &[RosMap],
+        (a, b): (usize, usize),
+        pose: Pose2,
+        refused: &str,
+    ) -> Option<usize> {
+        let mut pair = PairResult::unjudged(a, b);
+        pair.status = MergeStatus::Merged;
+        pair.confidence = KEPT_CONFIDENCE;
+        pair.pose = Some(pose);
+        pair.guess = Some(pose);
+        pair.verified = false;
+        pair.reason = if refused.is_empty() {
+            "placed by hand and kept as placed, not verified".to_string()
+        } else {
+            format!(
+                "placed by hand and kept as placed, not verified (the tests refused it: {refused})"
+            )
+        };
+        self.replace_pair(maps, pair)
     }
 }
 
@@ -394,6 +453,7 @@ fn group_json<'a>(g: &MapGroup, name: &dyn Fn(usize) -> &'a str) -> serde_json::
         "maps": g.maps.iter().map(|&i| name(i)).collect::<Vec<_>>(),
         "transforms": transforms,
         "confidence": g.confidence,
+        "verified": g.verified,
     });
     if let Some(r) = &g.reason {
         out["reason"] = json!(r);
@@ -437,6 +497,9 @@ impl SavedMerge {
                 if let Some(g) = p.guess {
                     pair["guess"] = pose_json(&g);
                 }
+                if !p.verified {
+                    pair["verified"] = json!(false);
+                }
                 pair
             })
             .collect();
@@ -446,6 +509,7 @@ impl SavedMerge {
             })).collect::<Vec<_>>(),
             "merge": {
                 "status": status_name(self.status),
+                "verified": self.verified,
                 "reason": self.reason,
                 "confidence": self.confidence,
                 "transforms": transforms,
