@@ -290,3 +290,84 @@ test('your maps: a refused Refine keeps your placement, shows what was judged, a
   assert.deepEqual(problems, [], 'no console errors or page errors');
   await context.close();
 });
+
+/** The text of map `name`'s card. */
+const cardText = (page, name) => page.locator(`.real-card[data-map="${name}"] figcaption`).innerText();
+
+test('your maps: an image without YAML shows its assumed resolution, and changing it reads the images again and merges them', { timeout: 300000 }, async () => {
+  const a = building('res', 7, 0.9);
+  const { context, page, problems } = await newPage(env.browser, { width: 1366, height: 768 });
+  await openView(page);
+  // Both images picked without their YAMLs, at a resolution typed wrong.
+  await page.fill('#real-resolution', '0.1');
+  await page.setInputFiles('#real-files', [a.files[1], a.files[3]]);
+  await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().report, null, { timeout: 120000 });
+  assert.match(await cardText(page, 'res-west.pgm'), /560 × 440 cells · 0\.1 m, assumed — change · origin \[0, 0, 0\]/);
+  assert.match(await cardText(page, 'res-east.pgm'), /0\.1 m, assumed — change/);
+  const before = (await snapshot(page)).report;
+  assert.deepEqual(before.maps.map((m) => m.resolution), [0.1, 0.1]);
+
+  // Change: type 0.05 on one card; both images (read at the same assumption) are read again and merged.
+  await page.locator('.real-card[data-map="res-west.pgm"] .real-assumed-change').click();
+  const box = page.getByRole('spinbutton', { name: 'Resolution of res-west.pgm in metres per cell' });
+  assert.equal(await box.inputValue(), '0.1');
+  await box.fill('0.05');
+  await box.press('Enter');
+  await page.waitForFunction(() => {
+    const s = window.slamlab.savedMaps.snapshot();
+    return s.report && s.report.maps[0].resolution === 0.05 && !s.busy;
+  }, null, { timeout: 120000 });
+  const { report, maps } = await snapshot(page);
+  assert.deepEqual(maps.map((m) => m.resolution), [0.05, 0.05]);
+  assert.match(await cardText(page, 'res-west.pgm'), /0\.05 m, assumed — change/);
+  assert.match(await cardText(page, 'res-east.pgm'), /0\.05 m, assumed — change/);
+  assert.equal(await page.locator('.real-card').count(), 2, 'read again in place, not added');
+  assert.equal(report.merge.status, 'merged', report.merge.reason);
+  const [x, y] = report.merge.transforms[1].pose;
+  assert.ok(Math.hypot(x - a.truth[0], y - a.truth[1]) < 0.1, `merged at ${report.merge.transforms[1].pose}, truth ${a.truth}`);
+  assert.match(await page.locator('#real-message').innerText(), /^Read res-west\.pgm, res-east\.pgm again at 0\.05 m per cell\.$/);
+  // A map with its YAML says nothing is assumed.
+  await page.setInputFiles('#real-files', [a.files[0], a.files[1]]);
+  await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().maps.length === 3 && window.slamlab.savedMaps.snapshot().report, null, { timeout: 120000 });
+  assert.doesNotMatch(await cardText(page, 'res-west.yaml'), /assumed/);
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});
+
+test('your maps: a file opened again under the same name replaces the one open, in its place', { timeout: 300000 }, async () => {
+  const a = building('again', 7, 0.9);
+  const { context, page, problems } = await newPage(env.browser, { width: 1366, height: 768 });
+  await openView(page);
+  await page.setInputFiles('#real-files', a.files);
+  await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().report, null, { timeout: 120000 });
+  const first = (await snapshot(page)).report;
+  // The east map again (the same files): still two maps, in the same order, merged again.
+  await page.setInputFiles('#real-files', [a.files[2], a.files[3]]);
+  await page.waitForFunction(() => /in place of/.test(document.querySelector('#real-message').textContent) && window.slamlab.savedMaps.snapshot().report, null, { timeout: 120000 });
+  const { maps, report } = await snapshot(page);
+  assert.deepEqual(maps.map((m) => m.name), ['again-west.yaml', 'again-east.yaml']);
+  assert.equal(await page.locator('.real-card').count(), 2);
+  assert.equal(await page.locator('#real-message').innerText(), 'Opened again-east.yaml. Opened again, in place of the one open: again-east.yaml.');
+  assert.equal(report.merge.pairs.length, 1);
+  assert.deepEqual(report.merge.transforms, first.merge.transforms);
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});
+
+test('your maps: a photograph opened as a map is warned about, with the figures measured', { timeout: 300000 }, async () => {
+  const data = process.env.SLAMLAB_DATA ?? path.join(ROOT, '..', 'shared', 'data');
+  const photo = path.join(data, 'images/oxford/graf/img1.png');
+  const a = building('photo', 7, 0.9);
+  const { context, page, problems } = await newPage(env.browser, { width: 1366, height: 768 });
+  await openView(page);
+  await page.setInputFiles('#real-files', [a.files[0], a.files[1], photo]);
+  await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().report, null, { timeout: 120000 });
+  const warning = await page.locator('.real-card[data-map="img1.png"] .real-card-warning').innerText();
+  const m = /^img1\.png does not look like an occupancy grid \(a photograph\?\): it uses (\d+) grey levels, and its three commonest hold only (\d+) % of its pixels/.exec(warning);
+  assert.ok(m, warning);
+  assert.ok(Number(m[1]) > 100 && Number(m[2]) < 20, warning);
+  assert.equal(await page.locator('.real-card[data-map="photo-west.yaml"] .real-card-warning').count(), 0, 'a map is not warned about');
+  await page.screenshot({ path: path.join(ARTIFACTS, 'page-maps-ux-photo.png') });
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});

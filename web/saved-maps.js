@@ -55,6 +55,15 @@ export class SavedMaps {
   }
 
   /**
+   * Reads a map in place of map `index` (a file opened again under the
+   * same name, an image read at another resolution): same arguments as
+   * `addMap`; the other maps keep their indices; drops the last merge.
+   */
+  replaceMap(index, name, yamlText, imageName, image) {
+    this.raw.replaceMap(index, name, yamlText, imageName, image);
+  }
+
+  /**
    * Adds the last map of a bag's `nav_msgs/OccupancyGrid` topic (`bag` a
    * finished web/bag-file.js `BagFile`; `topic` left out: `/map`, else the
    * bag's only map topic), named as the bag. Returns its index.

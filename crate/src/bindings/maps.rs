@@ -55,6 +55,22 @@ impl MapMerge {
         Ok(i as u32)
     }
 
+    /// Reads a map in place of map `i` (same arguments as `addMap`); the
+    /// other maps keep their indices.
+    #[wasm_bindgen(js_name = replaceMap)]
+    pub fn replace_map(
+        &mut self,
+        i: u32,
+        name: &str,
+        yaml_text: &str,
+        image_name: &str,
+        image: &[u8],
+    ) -> Result<(), JsError> {
+        self.inner
+            .replace_map(i as usize, name, yaml_text, image_name, image)
+            .map_err(err)
+    }
+
     /// Adds the last map of a bag's `nav_msgs/OccupancyGrid` topic
     /// (`topic` empty: `/map`, else the bag's only map topic), named as the
     /// bag. Returns its index.

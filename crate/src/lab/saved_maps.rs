@@ -91,6 +91,30 @@ impl SavedMaps {
         Ok(self.maps.len() - 1)
     }
 
+    /// Reads a map in place of map `i` (a file opened again under the same
+    /// name, or an image read again at another resolution): the other maps
+    /// keep their indices, and the last merge is dropped.
+    pub fn replace_map(
+        &mut self,
+        i: usize,
+        name: &str,
+        yaml_text: &str,
+        image_name: &str,
+        image: &[u8],
+    ) -> Result<(), String> {
+        let n = self.maps.len();
+        if i >= n {
+            return Err(format!(
+                "{name}: there is no map {i} to replace among the {n} opened"
+            ));
+        }
+        let map = rosmap::load(name, yaml_text, image_name, image).map_err(|e| e.to_string())?;
+        self.maps[i] = map;
+        self.result = None;
+        self.merged.clear();
+        Ok(())
+    }
+
     fn map(&self, i: usize) -> Result<&RosMap, String> {
         self.maps.get(i).ok_or_else(|| "no such map".to_string())
     }

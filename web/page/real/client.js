@@ -58,6 +58,11 @@ export class SavedMapsClient extends WorkerClient {
     return this.request({ type: 'add', files, resolution, colours }, files.map((f) => f.bytes));
   }
 
+  /** Reads image-only map `name` again at `resolution`: `{map}` (its card's facts, as `add` gives them). */
+  reread(name, resolution) {
+    return this.request({ type: 'reread', name, resolution });
+  }
+
   /** Merges the maps read so far: `{report, files, groupFiles}` (each group's files, null for a map alone). */
   merge() {
     return this.request({ type: 'merge' });

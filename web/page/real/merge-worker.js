@@ -28,7 +28,8 @@
 import init, * as wasm from '../../pkg/slamlab.js';
 import { SavedMaps, mapImagePath } from '../../saved-maps.js';
 import { BagFile, bagKind } from '../../bag-file.js';
-import { groupFiles } from './files.js';
+import { groupFiles, yamlForImage } from './files.js';
+import { gridWarning } from './grid-look.js';
 import { previewOf } from './preview.js';
 import { compose, drawPlaced, fitView, outline } from './overlay.js';
 
@@ -70,7 +71,13 @@ function addBag(f) {
   }
 }
 
-/** Reads the picked files into maps (a bag's map too); the good ones load even if some are bad. */
+/**
+ * Reads the picked files into maps (a bag's map too); the good ones load
+ * even if some are bad. A map named as one already open replaces it, in
+ * its place and colour. Each map comes back with `assumed` (the
+ * resolution an image without YAML was read at, else null) and `warning`
+ * (an image that does not look like an occupancy grid).
+ */
 async function add({ files, resolution, colours }) {
   savedMaps ??= SavedMaps.open(wasm);
   const bags = files.filter(isBag);
@@ -78,10 +85,15 @@ async function add({ files, resolution, colours }) {
   const added = [];
   const transfer = [];
   const reads = [
-    ...maps.map((m) => [m.imageName, () => savedMaps.addMap(m.name, m.yaml, m.imageName, m.image)]),
-    ...bags.map((f) => [f.name, () => addBag(f)]),
+    ...maps.map((m) => [m, () => {
+      const old = pictures.get(m.name);
+      if (!old) return savedMaps.addMap(m.name, m.yaml, m.imageName, m.image);
+      savedMaps.replaceMap(old.index, m.name, m.yaml, m.imageName, m.image);
+      return old.index;
+    }]),
+    ...bags.map((f) => [{ name: f.name, imageName: f.name }, () => addBag(f)]),
   ];
-  for (const [imageName, read] of reads) {
+  for (const [m, read] of reads) {
     let index;
     try {
       index = read();
@@ -89,14 +101,35 @@ async function add({ files, resolution, colours }) {
       errors.push(message(e));
       continue;
     }
-    const info = savedMaps.mapInfo(index);
-    const colour = colours[colourIndex++ % colours.length];
-    const { thumb, ...preview } = await previewOf(savedMaps.mapPixels(index), info.width, info.height, colour);
-    pictures.set(info.name, { ...info, index, preview });
-    transfer.push(thumb);
-    added.push({ ...info, index, imageName, colour, thumb });
+    const old = pictures.get(m.name);
+    const colour = old?.colour ?? colours[colourIndex++ % colours.length];
+    const source = m.assumed ? { image: m.image, imageName: m.imageName } : null;
+    const warning = m.image ? await gridWarning(m.imageName, m.image) : '';
+    const out = await picture(index, colour, { imageName: m.imageName, assumed: m.assumed ?? null, warning, source });
+    transfer.push(out.thumb);
+    added.push({ ...out, replaced: !!old });
   }
   return { result: { added, errors }, transfer };
+}
+
+/** Map `index`'s picture for the overlay (kept by name) and its card's facts (with the thumbnail). */
+async function picture(index, colour, extra) {
+  const info = savedMaps.mapInfo(index);
+  const { thumb, ...preview } = await previewOf(savedMaps.mapPixels(index), info.width, info.height, colour);
+  pictures.set(info.name, { ...info, index, preview, colour, source: extra.source });
+  return { ...info, index, colour, thumb, imageName: extra.imageName, assumed: extra.assumed, warning: extra.warning };
+}
+
+/** Reads an image opened without YAML again at `resolution` (m per cell), in its place. */
+async function reread({ name, resolution }) {
+  const p = pictures.get(name);
+  if (!p?.source) throw new Error(`${name}: only an image opened without a YAML is read at a resolution you give`);
+  const r = Number(resolution);
+  if (!(Number.isFinite(r) && r > 0)) throw new Error(`${name}: resolution: '${resolution}' is not a positive number of metres per cell`);
+  savedMaps.replaceMap(p.index, name, yamlForImage(p.source.imageName, r), p.source.imageName, p.source.image);
+  const warning = await gridWarning(p.source.imageName, p.source.image);
+  const out = await picture(p.index, p.colour, { imageName: p.source.imageName, assumed: r, warning, source: p.source });
+  return { result: { map: out }, transfer: [out.thumb] };
 }
 
 /** Merges every map read so far; the merged map's files come with the report. */
@@ -185,6 +218,9 @@ self.onmessage = async ({ data }) => {
     } else if (type === 'refine') {
       if (!savedMaps) throw new Error('open two or more maps first');
       out = refine(data);
+    } else if (type === 'reread') {
+      if (!savedMaps) throw new Error('open two or more maps first');
+      out = await reread(data);
     } else if (type === 'keep') {
       if (!savedMaps) throw new Error('open two or more maps first');
       out = keep(data);

@@ -15,6 +15,7 @@
 // lab's own scenario and runs behind this view are never touched.
 
 import { ADJUST_HTML, PlaceByHand } from './adjust.js';
+import { mapCard } from './card.js';
 import { SavedMapsClient } from './client.js';
 import { MapGroupsView, showsGroups } from './map-groups.js';
 import { OverlayCanvas, mergeHtml, saveMerge, showMerge, swatch } from './merge-result.js';
@@ -157,13 +158,56 @@ export class SavedMapsView {
         this.setBusy(false, '');
       }
       performance.mark('real-added');
-      this.maps.push(...out.added);
+      const replaced = this.place(out.added);
       if (out.added.length) this.dropResult();
-      if (out.errors.length) this.say(`Not opened: ${out.errors.join(' · ')}`, 'error');
-      else this.say(`Opened ${out.added.map((m) => m.name).join(', ')}.`, 'ok');
+      const again = replaced.length ? ` Opened again, in place of the one open: ${replaced.join(', ')}.` : '';
+      if (out.errors.length) this.say(`Not opened: ${out.errors.join(' · ')}${again}`, 'error');
+      else this.say(`Opened ${out.added.map((m) => m.name).join(', ')}.${again}`, 'ok');
       this.refresh();
       performance.mark('real-listed');
       if (out.added.length && this.maps.length >= 2) {
+        await nextFrame();
+        await this.merge();
+      }
+    });
+  }
+
+  /** Puts maps the worker read into the list: a map named as one open takes its place. Returns the names replaced. */
+  place(added) {
+    const replaced = [];
+    for (const m of added) {
+      const at = this.maps.findIndex((o) => o.name === m.name);
+      if (at < 0) {
+        this.maps.push(m);
+        continue;
+      }
+      this.maps[at] = m;
+      replaced.push(m.name);
+    }
+    return replaced;
+  }
+
+  /**
+   * Reads image-only map `name` again at `resolution`, with every image
+   * read at the same assumed resolution (opened together, most likely
+   * from one robot), and merges again.
+   */
+  reread(name, resolution) {
+    return this.enqueue(async () => {
+      const assumed = this.maps.find((m) => m.name === name)?.assumed;
+      const names = this.maps.filter((m) => m.name === name || (assumed && m.assumed === assumed)).map((m) => m.name);
+      this.setBusy(true, `reading ${names.join(', ')} again at ${resolution} m per cell…`);
+      const read = [];
+      try {
+        for (const n of names) read.push((await this.client.reread(n, resolution)).map);
+      } finally {
+        this.setBusy(false, '');
+      }
+      this.place(read);
+      this.dropResult();
+      this.say(`Read ${names.join(', ')} again at ${read[0].resolution} m per cell.`, 'ok');
+      this.refresh(true);
+      if (this.maps.length >= 2) {
         await nextFrame();
         await this.merge();
       }
@@ -239,14 +283,15 @@ export class SavedMapsView {
     this.stage('');
   }
 
-  /** The map cards and the state of the buttons. */
-  refresh() {
+  /** The map cards and the state of the buttons (`cards`: build the list again). */
+  refresh(cards = false) {
     const q = (s) => this.root.querySelector(s);
     q('#real-merge').disabled = this.busy || this.maps.length < 2;
     q('#real-clear').disabled = this.busy || this.maps.length === 0;
     const list = q('#real-maps');
-    if (list.childElementCount === this.maps.length) return;
-    list.replaceChildren(...this.maps.map((m) => (m.card ??= card(m))));
+    const shown = [...list.children];
+    if (!cards && shown.length === this.maps.length && this.maps.every((m, i) => m.card === shown[i])) return;
+    list.replaceChildren(...this.maps.map((m) => (m.card ??= mapCard(m, (name, r) => this.reread(name, r)))));
   }
 
   showResult() {
@@ -340,24 +385,4 @@ export class SavedMapsView {
 /** Resolves after the next frame has been drawn (work split into short tasks). */
 export function nextFrame() {
   return new Promise((resolve) => requestAnimationFrame(() => setTimeout(resolve, 0)));
-}
-
-/** One opened map: its picture, name, size and resolution. */
-function card(m) {
-  const div = document.createElement('figure');
-  div.className = 'real-card';
-  div.style.borderColor = m.colour;
-  // The worker made the thumbnail at its shown size (a large canvas shrunk
-  // by CSS would be shrunk again at every repaint of the page).
-  const c = document.createElement('canvas');
-  c.width = m.thumb.width;
-  c.height = m.thumb.height;
-  c.getContext('bitmaprenderer').transferFromImageBitmap(m.thumb);
-  c.setAttribute('aria-label', `${m.name}, drawn in its colour`);
-  const cap = document.createElement('figcaption');
-  const o = m.origin.map((v) => Number(v.toFixed(3)));
-  cap.innerHTML = `<b style="color:${m.colour}"></b><br>${m.width} × ${m.height} cells · ${m.resolution} m · origin [${o.join(', ')}]`;
-  cap.querySelector('b').textContent = m.imageName === m.name ? m.name : `${m.name} + ${m.imageName}`;
-  div.append(c, cap);
-  return div;
 }
