@@ -7,7 +7,23 @@
 // A's) opened together read "Merged into 2 groups", list each group, and
 // each group's tab shows its own transform (against the truth), overlay
 // legend and downloads (the merged PGM as large as the truth gives, its
-// YAML, the transforms JSON in that group's frame).
+// YAML, the transforms JSON in that group's frame); the reference map has
+// no row of its own, and the YAML's origin has no float noise.
+//
+// A placement you can keep: two maps of different buildings placed by
+// hand with real mouse drags; a refused Refine keeps the placement on
+// screen with the judged overlay outlined and the reason, Place by hand
+// starts again from it, and "Use my placement (not verified)" joins the
+// map exactly there, not verified in the verdict, the table, the pair
+// list, the downloads (names, a YAML comment) and the JSON.
+//
+// Resolutions: images picked without YAML at a resolution typed wrong say
+// "0.1 m, assumed — change" on their cards; typing 0.05 reads both again
+// and merges them at the truth. A file opened again replaces the one open.
+// The Oxford graf photograph (../shared/data/images, Mikolajczyk and
+// Schmid) opened as a map is warned about with its grey levels measured.
+// One map open says to open another; a card shows the known part of its
+// map, not the unknown around it.
 //
 // Needs the wasm build in web/pkg (`./build.sh build`). Run alone with
 //   node --test tests/page-maps-ux.test.mjs
@@ -158,6 +174,8 @@ test('your maps: maps of two buildings merge into two groups, each with its tran
   const yamlB = await downloaded(page, 'yaml');
   assert.equal(yamlB.name, 'merged-group-2.yaml');
   assert.match(yamlB.bytes.toString('utf8'), /image: "?merged-group-2\.pgm"?/);
+  // The origin without float noise (at most six decimals).
+  assert.match(yamlB.bytes.toString('utf8'), /\norigin: \[-?\d+(\.\d{1,6})?, -?\d+(\.\d{1,6})?, 0\.0\]\n/);
   const pngB = await downloaded(page, 'png');
   assert.equal(pngB.name, 'merged-group-2.png');
   const jsonB = JSON.parse((await downloaded(page, 'json')).bytes.toString('utf8'));
@@ -368,6 +386,25 @@ test('your maps: a photograph opened as a map is warned about, with the figures 
   assert.ok(Number(m[1]) > 100 && Number(m[2]) < 20, warning);
   assert.equal(await page.locator('.real-card[data-map="photo-west.yaml"] .real-card-warning').count(), 0, 'a map is not warned about');
   await page.screenshot({ path: path.join(ARTIFACTS, 'page-maps-ux-photo.png') });
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});
+
+test('your maps: one map open says to open another; a card shows the map cropped to what it knows', { timeout: 120000 }, async () => {
+  // A 10 x 5 m plan in a 40 x 40 m image of unknown: 200 x 100 known cells of 800 x 800.
+  const plan = floorPlan(10, 5, 3);
+  const files = [file('small.yaml', mapYaml('small.pgm', [-20.3, 1.1, 0])), file('small.pgm', mapImage(plan, [-20, -20, 0], 800, 800, () => true))];
+  const { context, page, problems } = await newPage(env.browser, { width: 1366, height: 768 });
+  await openView(page);
+  await page.setInputFiles('#real-files', files);
+  await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().maps.length === 1 && !window.slamlab.savedMaps.snapshot().busy);
+  await page.waitForFunction(() => /One map is open/.test(document.querySelector('#real-message').textContent));
+  assert.equal(await page.locator('#real-message').innerText(),
+    'Opened small.yaml. One map is open: open one more (or several) to merge it with, the map of another robot or another run of the same building.');
+  assert.equal(await page.locator('#real-merge').isDisabled(), true);
+  const size = await page.locator('.real-card canvas').evaluate((c) => [c.width, c.height]);
+  assert.ok(Math.abs(size[0] / size[1] - 2) < 0.1, `the card's picture is ${size[0]} x ${size[1]}: cropped to the 2:1 building, not the square image`);
+  assert.match(await cardText(page, 'small.yaml'), /800 × 800 cells · 0\.05 m · origin \[-20\.3, 1\.1, 0\]/);
   assert.deepEqual(problems, [], 'no console errors or page errors');
   await context.close();
 });

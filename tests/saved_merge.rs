@@ -568,3 +568,46 @@ fn a_kept_placement_joins_as_placed_and_is_marked_not_verified() {
     assert!(dm < 1e-9 && dd < 1e-9, "off by {dm} m {dd} deg");
     assert!(r.verified);
 }
+
+#[test]
+fn an_overlay_with_no_rival_is_said_in_words_not_inf() {
+    use slamlab::merge::saved::agreement_reason;
+    use slamlab::merge::saved::evidence::Evidence;
+    let e = Evidence {
+        agree_m: 40.0,
+        support_m: 38.0,
+        index: 0.95,
+        ..Evidence::default()
+    };
+    let cfg = SavedMergeConfig::default();
+    let alone = agreement_reason(&e, 0.0, &cfg, "near your guess");
+    assert!(!alone.contains("inf"), "{alone}");
+    assert!(
+        alone.ends_with("38.0 m of net support, and no other overlay near your guess has any"),
+        "{alone}"
+    );
+    let beaten = agreement_reason(&e, 19.0, &cfg, "");
+    assert!(
+        beaten.ends_with("2.0 times that of any other overlay"),
+        "{beaten}"
+    );
+}
+
+#[test]
+fn the_merged_yaml_origin_has_no_float_noise() {
+    use slamlab::lab::saved_maps::SavedMaps;
+    let blank = |name: &str, origin: Pose2| {
+        RosMap::from_values(name, 4, 4, 0.05, origin, vec![0; 16]).unwrap()
+    };
+    let mut maps = SavedMaps::new();
+    maps.add_loaded(blank("a", Pose2::new(1.0, 1.0, 0.0)))
+        .unwrap();
+    maps.add_loaded(blank("b", Pose2::new(0.2, 0.1, 0.0)))
+        .unwrap();
+    maps.merge(&mut |_| {}).unwrap();
+    // B's corner lands at 0.1 + 0.2 = 0.30000000000000004 in A's frame.
+    maps.keep_placement(0, 1, Pose2::new(0.1, 0.2, 0.0))
+        .unwrap();
+    let yaml = maps.merged_yaml("m.pgm").unwrap();
+    assert!(yaml.contains("origin: [0.3, 0.3, 0.0]"), "{yaml}");
+}

@@ -161,8 +161,11 @@ export class SavedMapsView {
       const replaced = this.place(out.added);
       if (out.added.length) this.dropResult();
       const again = replaced.length ? ` Opened again, in place of the one open: ${replaced.join(', ')}.` : '';
-      if (out.errors.length) this.say(`Not opened: ${out.errors.join(' · ')}${again}`, 'error');
-      else this.say(`Opened ${out.added.map((m) => m.name).join(', ')}.${again}`, 'ok');
+      const one = this.maps.length === 1
+        ? ` One map is open: open one more (or several) to merge it with, the map of another robot or another run of the same building.`
+        : '';
+      if (out.errors.length) this.say(`Not opened: ${out.errors.join(' · ')}${again}${one}`, 'error');
+      else this.say(`Opened ${out.added.map((m) => m.name).join(', ')}.${again}${one}`, one ? 'info' : 'ok');
       this.refresh();
       performance.mark('real-listed');
       if (out.added.length && this.maps.length >= 2) {

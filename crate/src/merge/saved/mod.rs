@@ -117,18 +117,22 @@ pub fn agreement_reason(
     cfg: &SavedMergeConfig,
     others: &str,
 ) -> String {
-    let ratio = if rival_support_m > 0.0 {
-        e.support_m / rival_support_m
-    } else {
-        f64::INFINITY
-    };
     let others = if others.is_empty() {
         String::new()
     } else {
         format!(" {others}")
     };
+    // With no rival at all the ratio would be infinite: say so in words.
+    let rival = if rival_support_m > 0.0 {
+        format!(
+            "{:.1} times that of any other overlay{others}",
+            e.support_m / rival_support_m
+        )
+    } else {
+        format!("and no other overlay{others} has any")
+    };
     format!(
-        "the maps agree: {:.1} m of wall of each on the other's within {:.2} m, acceptance index {:.2} ({} points agree, {} in the band, {} in free space), {:.1} m of net support, {:.1} times that of any other overlay{others}",
+        "the maps agree: {:.1} m of wall of each on the other's within {:.2} m, acceptance index {:.2} ({} points agree, {} in the band, {} in free space), {:.1} m of net support, {rival}",
         e.agree_m,
         cfg.evidence.agree_m,
         e.index,
@@ -136,7 +140,6 @@ pub fn agreement_reason(
         e.band[0] + e.band[1],
         e.disagree[0] + e.disagree[1],
         e.support_m,
-        ratio
     )
 }
 
