@@ -60,17 +60,19 @@ export function resultHtml(p, { frames, title, overlay, extra = '' }) {
  * Fills the verdict and the two tables of a merge (`merge`: the report's
  * `merge`); `name(map)` is how a map is called in them, `what` the first
  * column's heading; `group`: with maps of several buildings, the group
- * (an entry of `merge.groups`) whose transforms the table shows. Enables
+ * (an entry of `merge.groups`) whose transforms the table shows, `groups`
+ * whether the view lists the groups (the verdict then names them). Enables
  * the downloads there are files for.
  */
-export function showMerge(root, p, merge, hasFiles, { name = (m) => m, what = 'map', group = null } = {}) {
+export function showMerge(root, p, merge, hasFiles, { name = (m) => m, what = 'map', group = null, groups = false } = {}) {
   const q = (s) => root.querySelector(s);
   q(`#${p}-result`).hidden = false;
   const v = q(`#${p}-verdict`);
-  v.textContent = verdictText(merge, name);
+  v.textContent = verdictText(merge, name, groups);
   const shown = group ? { ...merge, transforms: group.transforms } : merge;
   const verified = (group ?? merge).verified !== false;
-  v.className = `real-verdict ${!verified ? 'unverified' : merge.status === 'merged' || joinedGroups(merge).length ? 'ok' : 'no'}`;
+  const joined = groups && joinedGroups(merge).length > 0;
+  v.className = `real-verdict ${!verified ? 'unverified' : merge.status === 'merged' || joined ? 'ok' : 'no'}`;
   const unsure = unverifiedMaps(shown);
   const rows = transformRows(shown).map((r) => [name(r.map) + (unsure.has(r.map) ? ' (placed by hand, not verified)' : ''), r.x, r.y, r.deg, r.args]);
   const others = group ? (merge.groups ?? []).flatMap((g) => (g === group ? [] : g.maps)) : merge.unjoined;

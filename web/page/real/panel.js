@@ -309,7 +309,7 @@ export class SavedMapsView {
   showTables() {
     this.files = this.groupFiles[this.group] ?? null;
     const group = showsGroups(this.report.merge) ? this.report.merge.groups[this.group] : null;
-    showMerge(this.root, 'real', this.report.merge, !!this.files, { group });
+    showMerge(this.root, 'real', this.report.merge, !!this.files, { group, groups: true });
   }
 
   /** Shows group `k`: its transforms, its downloads and its overlay. */

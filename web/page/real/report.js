@@ -30,12 +30,13 @@ export function nameList(names) {
 }
 
 /**
- * "Merged (confidence 0.93): …", "No merge, because …", or with maps of
- * several buildings "Merged into 2 groups: a + b; c + d." (and the maps
- * left alone); `name(map)` is how a map is called.
+ * "Merged (confidence 0.93): …", "No merge, because …", or, for a view
+ * that shows the groups (`groups`), with maps of several buildings
+ * "Merged into 2 groups: a + b; c + d." (and the maps left alone);
+ * `name(map)` is how a map is called.
  */
-export function verdictText(merge, name = (m) => m) {
-  const joined = joinedGroups(merge);
+export function verdictText(merge, name = (m) => m, groups = false) {
+  const joined = groups ? joinedGroups(merge) : [];
   const several = joined.length > 1 || (joined.length === 1 && merge.status !== 'merged');
   if (several) {
     const alone = (merge.groups ?? []).filter((g) => g.maps.length === 1).map((g) => name(g.maps[0]));
@@ -79,7 +80,7 @@ export function transformsJson(report, group = -1) {
   const out = {
     status: g ? 'merged' : merge.status,
     verified: (g ?? report.merge).verified !== false,
-    reason: g ? verdictText(report.merge) : merge.reason,
+    reason: g ? verdictText(report.merge, undefined, true) : merge.reason,
     confidence: g ? g.confidence : merge.confidence,
     frame: frameName(merge.transforms[0]?.map ?? ''),
     transforms: merge.transforms.map((t, i) => (i ? { ...t, static_transform_publisher: rows[i - 1].args } : { ...t, reference: true })),
