@@ -165,6 +165,7 @@ test('your maps: maps of two buildings merge into two groups, each with its tran
   assert.equal(await page.locator('#real-transforms caption').innerText(), "Each map's frame in the frame of b-west.yaml (the reference)");
   assert.deepEqual((await row(page, 'a-west.yaml')).slice(1), ['–', '–', '–', 'in another group']);
   await page.waitForFunction(() => /b-west\.yaml/.test(document.querySelector('#real-legend').textContent));
+  assert.equal(await page.locator('#real-overlay-title').innerText(), 'Merged overlay of group 2: b-west.yaml + b-east.yaml');
   assert.doesNotMatch(await page.locator('#real-legend').innerText(), /a-west/);
   const pgmB = await downloaded(page, 'pgm');
   assert.equal(pgmB.name, 'merged-group-2.pgm');

@@ -320,6 +320,15 @@ export class SavedMapsView {
     this.drawOverlay();
   }
 
+  /** "Merged overlay", or with groups listed "Merged overlay of group 2: c + d" (its downloads below it). */
+  overlayTitle() {
+    const merge = this.report?.merge;
+    if (!merge || !showsGroups(merge)) return 'Merged overlay';
+    const joined = merge.groups.filter((g) => g.maps.length > 1);
+    const g = merge.groups[this.group];
+    return g ? `Merged overlay of group ${joined.indexOf(g) + 1}: ${g.maps.join(' + ')}` : 'Merged overlay';
+  }
+
   /** The maps placed in the overlay: the group shown, else every joined map. */
   placedTransforms() {
     const merge = this.report.merge;
@@ -349,7 +358,7 @@ export class SavedMapsView {
     this.root.querySelector('#real-overlay-title').textContent = placing
       ? `Placing ${placing.b.name} by hand`
       : kept ? `Your placement of ${kept.b.name} (refused by Refine)`
-        : this.report?.merge.verified === false ? 'Merged overlay (your placement, not verified)' : 'Merged overlay';
+        : this.report?.merge.verified === false ? 'Merged overlay (your placement, not verified)' : this.overlayTitle();
     if (placing) {
       legend.replaceChildren(swatch(placing.a.colour, placing.a.name), swatch(placing.b.colour, `${placing.b.name} (drag it)`));
       return;
