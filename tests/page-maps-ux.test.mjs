@@ -19,7 +19,9 @@
 //
 // Resolutions: images picked without YAML at a resolution typed wrong say
 // "0.1 m, assumed — change" on their cards; typing 0.05 reads both again
-// and merges them at the truth. A file opened again replaces the one open.
+// and merges them at the truth; an image alone read at 0.1 beside a YAML
+// map at 0.05 is said to merge at 0.05 (measured), and does when changed.
+// A file opened again replaces the one open.
 // The Oxford graf photograph (../shared/data/images, Mikolajczyk and
 // Schmid) opened as a map is warned about with its grey levels measured.
 // One map open says to open another; a card shows the known part of its
@@ -406,6 +408,31 @@ test('your maps: one map open says to open another; a card shows the map cropped
   const size = await page.locator('.real-card canvas').evaluate((c) => [c.width, c.height]);
   assert.ok(Math.abs(size[0] / size[1] - 2) < 0.1, `the card's picture is ${size[0]} x ${size[1]}: cropped to the 2:1 building, not the square image`);
   assert.match(await cardText(page, 'small.yaml'), /800 × 800 cells · 0\.05 m · origin \[-20\.3, 1\.1, 0\]/);
+  assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});
+
+test('your maps: an image read at a wrong assumed resolution is said to merge at the one measured', { timeout: 300000 }, async () => {
+  const a = building('scale', 7, 0.9);
+  const { context, page, problems } = await newPage(env.browser, { width: 1366, height: 768 });
+  await openView(page);
+  await page.setInputFiles('#real-files', [a.files[0], a.files[1]]);
+  await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().maps.length === 1);
+  // The east image alone, read at 0.1 m per cell: its walls are twice as long as the west map's.
+  await page.fill('#real-resolution', '0.1');
+  await page.setInputFiles('#real-files', [a.files[3]]);
+  await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().report, null, { timeout: 120000 });
+  assert.equal((await snapshot(page)).report.merge.status, 'no_merge');
+  await page.waitForFunction(() => /measured/.test(document.querySelector('#real-message').textContent), null, { timeout: 120000 });
+  assert.match(await page.locator('#real-message').innerText(),
+    /^scale-east\.pgm does not fit scale-west\.yaml at the 0\.1 m per cell assumed, but merges with it read at 0\.05 m per cell \(measured: confidence (0\.\d\d|1\.00)\): change its resolution on its card\?$/);
+  // Following the hint merges them at the truth.
+  await page.locator('.real-card[data-map="scale-east.pgm"] .real-assumed-change').click();
+  await page.getByRole('spinbutton', { name: 'Resolution of scale-east.pgm in metres per cell' }).fill('0.05');
+  await page.getByRole('button', { name: 'Read again' }).click();
+  await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().report?.merge.status === 'merged', null, { timeout: 120000 });
+  const [x, y] = (await snapshot(page)).report.merge.transforms[1].pose;
+  assert.ok(Math.hypot(x - a.truth[0], y - a.truth[1]) < 0.1);
   assert.deepEqual(problems, [], 'no console errors or page errors');
   await context.close();
 });

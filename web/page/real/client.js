@@ -63,6 +63,11 @@ export class SavedMapsClient extends WorkerClient {
     return this.request({ type: 'reread', name, resolution });
   }
 
+  /** Images at an assumed resolution the last merge left alone, that merge at another: `{hints}` (scale-probe.js). */
+  scales() {
+    return this.request({ type: 'scales' });
+  }
+
   /** Merges the maps read so far: `{report, files, groupFiles}` (each group's files, null for a map alone). */
   merge() {
     return this.request({ type: 'merge' });

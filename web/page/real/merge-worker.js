@@ -30,6 +30,7 @@ import { SavedMaps, mapImagePath } from '../../saved-maps.js';
 import { BagFile, bagKind } from '../../bag-file.js';
 import { groupFiles, yamlForImage } from './files.js';
 import { gridWarning } from './grid-look.js';
+import { probeScales } from './scale-probe.js';
 import { previewOf } from './preview.js';
 import { compose, drawPlaced, fitView, outline } from './overlay.js';
 
@@ -105,7 +106,8 @@ async function add({ files, resolution, colours }) {
     const colour = old?.colour ?? colours[colourIndex++ % colours.length];
     const source = m.assumed ? { image: m.image, imageName: m.imageName } : null;
     const warning = m.image ? await gridWarning(m.imageName, m.image) : '';
-    const out = await picture(index, colour, { imageName: m.imageName, assumed: m.assumed ?? null, warning, source });
+    const files = m.image ? { yaml: m.yaml, image: m.image, imageName: m.imageName } : null;
+    const out = await picture(index, colour, { imageName: m.imageName, assumed: m.assumed ?? null, warning, source, read: files });
     transfer.push(out.thumb);
     added.push({ ...out, replaced: !!old });
   }
@@ -116,7 +118,7 @@ async function add({ files, resolution, colours }) {
 async function picture(index, colour, extra) {
   const info = savedMaps.mapInfo(index);
   const { thumb, ...preview } = await previewOf(savedMaps.mapPixels(index), info.width, info.height, colour);
-  pictures.set(info.name, { ...info, index, preview, colour, source: extra.source });
+  pictures.set(info.name, { ...info, index, preview, colour, source: extra.source, read: extra.read });
   return { ...info, index, colour, thumb, imageName: extra.imageName, assumed: extra.assumed, warning: extra.warning };
 }
 
@@ -126,9 +128,11 @@ async function reread({ name, resolution }) {
   if (!p?.source) throw new Error(`${name}: only an image opened without a YAML is read at a resolution you give`);
   const r = Number(resolution);
   if (!(Number.isFinite(r) && r > 0)) throw new Error(`${name}: resolution: '${resolution}' is not a positive number of metres per cell`);
-  savedMaps.replaceMap(p.index, name, yamlForImage(p.source.imageName, r), p.source.imageName, p.source.image);
+  const yaml = yamlForImage(p.source.imageName, r);
+  savedMaps.replaceMap(p.index, name, yaml, p.source.imageName, p.source.image);
   const warning = await gridWarning(p.source.imageName, p.source.image);
-  const out = await picture(p.index, p.colour, { imageName: p.source.imageName, assumed: r, warning, source: p.source });
+  const read = { yaml, image: p.source.image, imageName: p.source.imageName };
+  const out = await picture(p.index, p.colour, { imageName: p.source.imageName, assumed: r, warning, source: p.source, read });
   return { result: { map: out }, transfer: [out.thumb] };
 }
 
@@ -221,6 +225,8 @@ self.onmessage = async ({ data }) => {
     } else if (type === 'reread') {
       if (!savedMaps) throw new Error('open two or more maps first');
       out = await reread(data);
+    } else if (type === 'scales') {
+      out = { result: { hints: lastReport ? probeScales(wasm, SavedMaps, pictures, lastReport, yamlForImage) : [] }, transfer: [] };
     } else if (type === 'keep') {
       if (!savedMaps) throw new Error('open two or more maps first');
       out = keep(data);

@@ -16,6 +16,7 @@
 
 import { ADJUST_HTML, PlaceByHand } from './adjust.js';
 import { mapCard } from './card.js';
+import { scaleHintText } from './scale-probe.js';
 import { SavedMapsClient } from './client.js';
 import { MapGroupsView, showsGroups } from './map-groups.js';
 import { OverlayCanvas, mergeHtml, saveMerge, showMerge, swatch } from './merge-result.js';
@@ -250,6 +251,14 @@ export class SavedMapsView {
     await nextFrame();
     this.showResult();
     performance.mark('real-shown');
+    if (this.maps.some((m) => m.assumed)) this.scaleHints(out.report);
+  }
+
+  /** After a merge with images at an assumed resolution: says which merge at another (measured). */
+  async scaleHints(report) {
+    const { hints } = await this.client.scales();
+    if (this.report !== report || !hints.length) return;
+    this.say(hints.map(scaleHintText).join(' '), 'warn');
   }
 
   progress(text) {
