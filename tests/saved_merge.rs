@@ -1,7 +1,8 @@
 //! The merge of saved maps (crate/src/merge/saved/) on maps cut
 //! from generated buildings with known transforms: a pair merges to the
 //! truth, three maps join along the spanning tree, two different buildings
-//! are refused, and the merged map is written as ROS map_server files.
+//! are refused, maps of two buildings form two groups, and the merged map
+//! is written as ROS map_server files.
 
 use glam::DVec2;
 use slamlab::formats::rosmap::{self, RosMap};
@@ -229,9 +230,9 @@ fn the_merged_map_is_written_as_map_server_files() {
 #[path = "merge_support/guess.rs"]
 mod guess;
 use guess::{middle, nudged, refined};
-use slamlab::merge::saved::join;
 use slamlab::merge::saved::refine::refine_pair;
 use slamlab::merge::saved::wallmap::WallMap;
+use slamlab::merge::saved::{join, PairResult};
 
 /// The first test's pair (A the west part of a building, B the east part
 /// turned by 0.7 rad, both with YAML origins) and B's true pose in A.
@@ -439,4 +440,174 @@ fn refine_is_refused_where_the_automatic_merge_found_a_clear_winner_elsewhere() 
         "{}",
         beaten.reason
     );
+}
+
+/// A judged pair: merged at `pose` with `confidence`, or refused (`None`).
+fn judged(a: usize, b: usize, merged: Option<(Pose2, f64)>, reason: &str) -> PairResult {
+    let mut p = PairResult::unjudged(a, b);
+    p.reason = reason.into();
+    if let Some((pose, confidence)) = merged {
+        p.status = MergeStatus::Merged;
+        p.pose = Some(pose);
+        p.confidence = confidence;
+    }
+    p
+}
+
+#[test]
+fn maps_of_two_buildings_form_two_groups_each_in_its_first_maps_frame() {
+    // Five small maps: 0 and 2 of one building, 1, 3 and 4 of another
+    // (4 joined through 3), opened interleaved.
+    let blank =
+        |name: &str| RosMap::from_values(name, 4, 4, 0.05, Pose2::IDENTITY, vec![0; 16]).unwrap();
+    let maps: Vec<RosMap> = ["a0", "b0", "a1", "b1", "b2"]
+        .iter()
+        .map(|n| blank(n))
+        .collect();
+    let p02 = Pose2::new(3.0, 1.0, 0.5);
+    let (p13, p34) = (Pose2::new(-2.0, 4.0, -1.0), Pose2::new(1.0, 0.0, 0.25));
+    let mut pairs = Vec::new();
+    for a in 0..5 {
+        for b in a + 1..5 {
+            let merged = match (a, b) {
+                (0, 2) => Some((p02, 0.9)),
+                (1, 3) => Some((p13, 0.7)),
+                (3, 4) => Some((p34, 0.6)),
+                _ => None,
+            };
+            pairs.push(judged(a, b, merged, &format!("pair {a} {b}")));
+        }
+    }
+    let r = join(&maps, pairs);
+    let members: Vec<Vec<usize>> = r.groups.iter().map(|g| g.maps.clone()).collect();
+    assert_eq!(members, vec![vec![0, 2], vec![1, 3, 4]], "{}", r.reason);
+    // The first map's group is the merge's own: the same poses.
+    assert_eq!(r.groups[0].poses, r.poses);
+    assert_eq!(r.unjoined, vec![1, 3, 4]);
+    let g = &r.groups[1];
+    assert_eq!(g.poses[1], Some(Pose2::IDENTITY));
+    assert_eq!(g.poses[3], Some(p13));
+    let (dm, dd) = error(&g.poses[4].unwrap(), &p13.compose(&p34));
+    assert!(dm < 1e-9 && dd < 1e-9, "map 4 off by {dm} m {dd} deg");
+    assert_eq!((r.groups[0].confidence, g.confidence), (0.9, 0.6));
+    assert!(r.groups.iter().all(|g| g.reason.is_none()));
+    let report = r.report(&maps);
+    let groups = report["merge"]["groups"].as_array().unwrap();
+    assert_eq!(groups[1]["maps"], serde_json::json!(["b0", "b1", "b2"]));
+    assert_eq!(groups[1]["transforms"][0]["map"], "b0");
+    assert_eq!(
+        groups[1]["transforms"][1]["pose"],
+        serde_json::json!([-2.0, 4.0, -1.0])
+    );
+}
+
+#[test]
+fn a_map_alone_is_a_group_of_its_own_with_its_reason() {
+    let (a, b, _) = two_buildings();
+    let r = merge_all(&[a, b], &SavedMergeConfig::default(), &mut |_| {});
+    assert_eq!(r.groups.len(), 2);
+    for (k, g) in r.groups.iter().enumerate() {
+        assert_eq!(g.maps, vec![k]);
+        assert_eq!(g.confidence, 0.0);
+        assert_eq!(g.reason.as_deref(), Some(r.pairs[0].reason.as_str()));
+    }
+}
+
+#[test]
+fn a_kept_placement_joins_as_placed_and_is_marked_not_verified() {
+    let blank =
+        |name: &str| RosMap::from_values(name, 4, 4, 0.05, Pose2::IDENTITY, vec![0; 16]).unwrap();
+    let maps: Vec<RosMap> = ["m0", "m1", "m2"].iter().map(|n| blank(n)).collect();
+    let p01 = Pose2::new(2.0, 0.5, 0.1);
+    let pairs = vec![
+        judged(0, 1, Some((p01, 0.8)), "agree"),
+        judged(0, 2, None, "the walls disagree"),
+        judged(1, 2, None, "too little common wall"),
+    ];
+    let mut r = join(&maps, pairs.clone());
+    assert_eq!(r.unjoined, vec![2]);
+    assert!(r.verified);
+    let mine = Pose2::new(-4.0, 3.0, 2.0);
+    let k = r
+        .keep_placement(
+            &maps,
+            (0, 2),
+            mine,
+            "refined from your guess: the walls disagree",
+        )
+        .unwrap();
+    assert_eq!(k, 1);
+    assert_eq!(r.status, MergeStatus::Merged, "{}", r.reason);
+    assert_eq!(r.poses[2], Some(mine), "joined exactly where it was placed");
+    assert!(!r.verified);
+    assert!(!r.pairs[1].verified && r.pairs[0].verified);
+    assert!(
+        r.pairs[1].reason.contains("not verified"),
+        "{}",
+        r.pairs[1].reason
+    );
+    assert!(
+        r.pairs[1].reason.contains("the walls disagree"),
+        "{}",
+        r.pairs[1].reason
+    );
+    assert!(!r.groups[0].verified);
+    let report = r.report(&maps);
+    assert_eq!(report["merge"]["verified"], false);
+    assert_eq!(report["merge"]["pairs"][1]["verified"], false);
+    assert_eq!(report["merge"]["groups"][0]["verified"], false);
+    assert!(report["merge"]["pairs"][0].get("verified").is_none());
+
+    // A verified chain to the same map wins over a kept placement.
+    let p12 = Pose2::new(1.0, 1.0, -0.3);
+    let mut with_chain = pairs;
+    with_chain[2] = judged(1, 2, Some((p12, 0.5)), "agree");
+    let mut r = join(&maps, with_chain);
+    r.keep_placement(&maps, (0, 2), mine, "").unwrap();
+    let (dm, dd) = error(&r.poses[2].unwrap(), &p01.compose(&p12));
+    assert!(dm < 1e-9 && dd < 1e-9, "off by {dm} m {dd} deg");
+    assert!(r.verified);
+}
+
+#[test]
+fn an_overlay_with_no_rival_is_said_in_words_not_inf() {
+    use slamlab::merge::saved::agreement_reason;
+    use slamlab::merge::saved::evidence::Evidence;
+    let e = Evidence {
+        agree_m: 40.0,
+        support_m: 38.0,
+        index: 0.95,
+        ..Evidence::default()
+    };
+    let cfg = SavedMergeConfig::default();
+    let alone = agreement_reason(&e, 0.0, &cfg, "near your guess");
+    assert!(!alone.contains("inf"), "{alone}");
+    assert!(
+        alone.ends_with("38.0 m of net support, and no other overlay near your guess has any"),
+        "{alone}"
+    );
+    let beaten = agreement_reason(&e, 19.0, &cfg, "");
+    assert!(
+        beaten.ends_with("2.0 times that of any other overlay"),
+        "{beaten}"
+    );
+}
+
+#[test]
+fn the_merged_yaml_origin_has_no_float_noise() {
+    use slamlab::lab::saved_maps::SavedMaps;
+    let blank = |name: &str, origin: Pose2| {
+        RosMap::from_values(name, 4, 4, 0.05, origin, vec![0; 16]).unwrap()
+    };
+    let mut maps = SavedMaps::new();
+    maps.add_loaded(blank("a", Pose2::new(1.0, 1.0, 0.0)))
+        .unwrap();
+    maps.add_loaded(blank("b", Pose2::new(0.2, 0.1, 0.0)))
+        .unwrap();
+    maps.merge(&mut |_| {}).unwrap();
+    // B's corner lands at 0.1 + 0.2 = 0.30000000000000004 in A's frame.
+    maps.keep_placement(0, 1, Pose2::new(0.1, 0.2, 0.0))
+        .unwrap();
+    let yaml = maps.merged_yaml("m.pgm").unwrap();
+    assert!(yaml.contains("origin: [0.3, 0.3, 0.0]"), "{yaml}");
 }

@@ -55,6 +55,15 @@ export class SavedMaps {
   }
 
   /**
+   * Reads a map in place of map `index` (a file opened again under the
+   * same name, an image read at another resolution): same arguments as
+   * `addMap`; the other maps keep their indices; drops the last merge.
+   */
+  replaceMap(index, name, yamlText, imageName, image) {
+    this.raw.replaceMap(index, name, yamlText, imageName, image);
+  }
+
+  /**
    * Adds the last map of a bag's `nav_msgs/OccupancyGrid` topic (`bag` a
    * finished web/bag-file.js `BagFile`; `topic` left out: `/map`, else the
    * bag's only map topic), named as the bag. Returns its index.
@@ -100,6 +109,19 @@ export class SavedMaps {
     return JSON.parse(this.raw.refine(a, b, pose[0], pose[1], pose[2]));
   }
 
+  /**
+   * Keeps a person's placement of maps `a` and `b` (map b's frame at
+   * `pose` = [x, y, theta] in map a's) as it is, not verified, after the
+   * tests refused it; `report()` then says `verified: false`. Returns the
+   * pair's result (as `refine` does).
+   */
+  keepPlacement(a, b, pose) {
+    if (!Array.isArray(pose) || pose.length !== 3) {
+      throw new Error(`keep placement: the pose must be [x, y, theta], got ${JSON.stringify(pose)}`);
+    }
+    return JSON.parse(this.raw.keepPlacement(a, b, pose[0], pose[1], pose[2]));
+  }
+
   /** The report `merge` returned, after any `refine`. */
   report() {
     return JSON.parse(this.raw.reportJson());
@@ -120,6 +142,23 @@ export class SavedMaps {
   /** The map_server YAML text naming `image` (the PGM's file name). */
   mergedYaml(image) {
     return this.raw.mergedYaml(image);
+  }
+
+  // --- Each group's merged map (report.merge.groups[k], in its first map's frame) --
+
+  /** Group `k`'s merged map as a binary PGM (Uint8Array); group 0 is the merged map. */
+  groupPgm(k) {
+    return this.raw.groupPgm(k);
+  }
+
+  /** Group `k`'s merged map as a PNG (Uint8Array). */
+  groupPng(k) {
+    return this.raw.groupPng(k);
+  }
+
+  /** Group `k`'s map_server YAML text naming `image`. */
+  groupYaml(k, image) {
+    return this.raw.groupYaml(k, image);
   }
 }
 

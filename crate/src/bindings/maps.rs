@@ -55,6 +55,22 @@ impl MapMerge {
         Ok(i as u32)
     }
 
+    /// Reads a map in place of map `i` (same arguments as `addMap`); the
+    /// other maps keep their indices.
+    #[wasm_bindgen(js_name = replaceMap)]
+    pub fn replace_map(
+        &mut self,
+        i: u32,
+        name: &str,
+        yaml_text: &str,
+        image_name: &str,
+        image: &[u8],
+    ) -> Result<(), JsError> {
+        self.inner
+            .replace_map(i as usize, name, yaml_text, image_name, image)
+            .map_err(err)
+    }
+
     /// Adds the last map of a bag's `nav_msgs/OccupancyGrid` topic
     /// (`topic` empty: `/map`, else the bag's only map topic), named as the
     /// bag. Returns its index.
@@ -117,6 +133,25 @@ impl MapMerge {
         to_json(&pair)
     }
 
+    /// Keeps a person's placement of maps `a` and `b` (map `b`'s frame at
+    /// `(x, y, theta)` in map `a`'s) as it is, not verified; returns the
+    /// pair's result as JSON (see `SavedMaps::keep_placement`).
+    #[wasm_bindgen(js_name = keepPlacement)]
+    pub fn keep_placement(
+        &mut self,
+        a: u32,
+        b: u32,
+        x: f64,
+        y: f64,
+        theta: f64,
+    ) -> Result<String, JsError> {
+        let pair = self
+            .inner
+            .keep_placement(a as usize, b as usize, Pose2::new(x, y, theta))
+            .map_err(err)?;
+        to_json(&pair)
+    }
+
     /// The report's `maps` and `merge` as JSON, as `merge` returned it,
     /// after any `refine`.
     #[wasm_bindgen(js_name = reportJson)]
@@ -140,5 +175,24 @@ impl MapMerge {
     #[wasm_bindgen(js_name = mergedYaml)]
     pub fn merged_yaml(&mut self, image: &str) -> Result<String, JsError> {
         self.inner.merged_yaml(image).map_err(err)
+    }
+
+    /// Group `group`'s merged map (its maps joined in the frame of its
+    /// first map; the report's `merge.groups[group]`) as a binary PGM.
+    #[wasm_bindgen(js_name = groupPgm)]
+    pub fn group_pgm(&mut self, group: u32) -> Result<Vec<u8>, JsError> {
+        self.inner.group_pgm(group as usize).map_err(err)
+    }
+
+    /// The same pixels as a PNG.
+    #[wasm_bindgen(js_name = groupPng)]
+    pub fn group_png(&mut self, group: u32) -> Result<Vec<u8>, JsError> {
+        self.inner.group_png(group as usize).map_err(err)
+    }
+
+    /// Group `group`'s map_server YAML naming `image`.
+    #[wasm_bindgen(js_name = groupYaml)]
+    pub fn group_yaml(&mut self, group: u32, image: &str) -> Result<String, JsError> {
+        self.inner.group_yaml(group as usize, image).map_err(err)
     }
 }

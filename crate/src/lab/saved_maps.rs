@@ -11,6 +11,8 @@ use crate::geom::Pose2;
 use crate::merge::saved::refine::{refine_pair, refuse_if_beaten};
 use crate::merge::saved::wallmap::WallMap;
 use crate::merge::saved::{merge_all, PairResult, SavedMerge, SavedMergeConfig};
+use crate::slam::export::yaml_text;
+use glam::DVec2;
 use serde::Serialize;
 
 /// The most maps merged at once.
@@ -23,7 +25,9 @@ pub struct SavedMaps {
     result: Option<SavedMerge>,
     /// The automatic merge's pairs, kept for Refine's check.
     automatic: Vec<PairResult>,
-    merged: Option<MergedMap>,
+    /// Each group's merged map, made once per result (group 0 is the
+    /// first map's: the merged map).
+    merged: Vec<Option<MergedMap>>,
 }
 
 /// Size, resolution and origin of one map (fields in the order the page
@@ -83,8 +87,32 @@ impl SavedMaps {
         }
         self.maps.push(map);
         self.result = None;
-        self.merged = None;
+        self.merged.clear();
         Ok(self.maps.len() - 1)
+    }
+
+    /// Reads a map in place of map `i` (a file opened again under the same
+    /// name, or an image read again at another resolution): the other maps
+    /// keep their indices, and the last merge is dropped.
+    pub fn replace_map(
+        &mut self,
+        i: usize,
+        name: &str,
+        yaml_text: &str,
+        image_name: &str,
+        image: &[u8],
+    ) -> Result<(), String> {
+        let n = self.maps.len();
+        if i >= n {
+            return Err(format!(
+                "{name}: there is no map {i} to replace among the {n} opened"
+            ));
+        }
+        let map = rosmap::load(name, yaml_text, image_name, image).map_err(|e| e.to_string())?;
+        self.maps[i] = map;
+        self.result = None;
+        self.merged.clear();
+        Ok(())
     }
 
     fn map(&self, i: usize) -> Result<&RosMap, String> {
@@ -129,7 +157,7 @@ impl SavedMaps {
         let report = result.report(&self.maps);
         self.automatic = result.pairs.clone();
         self.result = Some(result);
-        self.merged = None;
+        self.merged.clear();
         Ok(report)
     }
 
@@ -180,7 +208,54 @@ impl SavedMaps {
         let k = result
             .replace_pair(&self.maps, pair)
             .ok_or("refine: that pair was not judged")?;
-        self.merged = None;
+        self.merged.clear();
+        let report = result.report(&self.maps);
+        Ok(report["merge"]["pairs"][k].clone())
+    }
+
+    /// Keeps a person's placement of maps `a` and `b` (map `b`'s frame at
+    /// `pose` in map `a`'s, as [`SavedMaps::refine`] takes it) as it is,
+    /// not verified, after the tests refused it: the maps are joined there
+    /// and the report says `verified: false`. Returns the pair's result in
+    /// the report's `pairs[]` format (for `a > b` as `b`, `a`).
+    pub fn keep_placement(
+        &mut self,
+        a: usize,
+        b: usize,
+        pose: Pose2,
+    ) -> Result<serde_json::Value, String> {
+        let n = self.maps.len();
+        if a >= n || b >= n || a == b {
+            return Err(format!(
+                "keep placement: maps {a} and {b} are not a pair of the {n} maps opened"
+            ));
+        }
+        if !pose.is_finite() {
+            return Err(format!(
+                "keep placement: the pose must be finite numbers, got x = {}, y = {}, theta = {}",
+                pose.x, pose.y, pose.theta
+            ));
+        }
+        let result = self.result.as_mut().ok_or("keep placement: merge first")?;
+        let judged = result
+            .pairs
+            .iter()
+            .find(|p| (p.a, p.b) == (a, b) || (p.a, p.b) == (b, a))
+            .ok_or("keep placement: that pair was not judged")?;
+        let (a, b, pose) = if judged.a == a {
+            (a, b, pose)
+        } else {
+            (b, a, pose.inverse())
+        };
+        let refused = if judged.guess.is_some() && judged.verified {
+            judged.reason.clone()
+        } else {
+            String::new()
+        };
+        let k = result
+            .keep_placement(&self.maps, (a, b), pose, &refused)
+            .ok_or("keep placement: that pair was not judged")?;
+        self.merged.clear();
         let report = result.report(&self.maps);
         Ok(report["merge"]["pairs"][k].clone())
     }
@@ -192,33 +267,68 @@ impl SavedMaps {
         Ok(r.report(&self.maps))
     }
 
-    /// The merged map: the maps joined to the first, made once per result.
-    fn merged(&mut self) -> Result<&MergedMap, String> {
-        if self.merged.is_none() {
-            let r = self.result.as_ref().ok_or("merge first")?;
-            let joined: Vec<(&RosMap, Pose2)> = r
+    /// Group `group`'s merged map: its maps joined in the frame of its
+    /// first map, made once per result. Group 0 is the first map's, whose
+    /// frame is the merged frame.
+    fn merged(&mut self, group: usize) -> Result<&MergedMap, String> {
+        let r = self.result.as_ref().ok_or("merge first")?;
+        let g = r.groups.get(group).ok_or_else(|| {
+            format!(
+                "there is no group {} of maps: the merge found {}",
+                group + 1,
+                r.groups.len()
+            )
+        })?;
+        if self.merged.len() != r.groups.len() {
+            self.merged = vec![None; r.groups.len()];
+        }
+        if self.merged[group].is_none() {
+            let joined: Vec<(&RosMap, Pose2)> = g
                 .poses
                 .iter()
                 .zip(&self.maps)
                 .filter_map(|(p, m)| p.map(|p| (m, p)))
                 .collect();
-            self.merged = Some(rosmap::write::merge_maps(&joined).map_err(|e| e.to_string())?);
+            self.merged[group] =
+                Some(rosmap::write::merge_maps(&joined).map_err(|e| e.to_string())?);
         }
-        self.merged.as_ref().ok_or_else(|| "no merged map".into())
+        self.merged[group]
+            .as_ref()
+            .ok_or_else(|| "no merged map".into())
     }
 
-    /// The merged map as a binary PGM.
+    /// The merged map (the first map's group) as a binary PGM.
     pub fn merged_pgm(&mut self) -> Result<Vec<u8>, String> {
-        Ok(self.merged()?.pgm())
+        self.group_pgm(0)
     }
 
     /// The same pixels as a PNG.
     pub fn merged_png(&mut self) -> Result<Vec<u8>, String> {
-        self.merged()?.png().map_err(|e| e.to_string())
+        self.group_png(0)
     }
 
     /// The map_server YAML naming `image`.
     pub fn merged_yaml(&mut self, image: &str) -> Result<String, String> {
-        Ok(self.merged()?.yaml(image))
+        self.group_yaml(0, image)
+    }
+
+    /// Group `group`'s merged map as a binary PGM (its first map's frame).
+    pub fn group_pgm(&mut self, group: usize) -> Result<Vec<u8>, String> {
+        Ok(self.merged(group)?.pgm())
+    }
+
+    /// Group `group`'s merged map as a PNG.
+    pub fn group_png(&mut self, group: usize) -> Result<Vec<u8>, String> {
+        self.merged(group)?.png().map_err(|e| e.to_string())
+    }
+
+    /// Group `group`'s map_server YAML naming `image`, its origin rounded
+    /// to the micrometre (the sums that place the maps leave float noise:
+    /// `1.2000000000000002`).
+    pub fn group_yaml(&mut self, group: usize, image: &str) -> Result<String, String> {
+        let m = self.merged(group)?;
+        let tidy = |v: f64| (v * 1e6).round() / 1e6 + 0.0;
+        let origin = DVec2::new(tidy(m.origin.x), tidy(m.origin.y));
+        Ok(yaml_text(image, m.resolution, origin))
     }
 }

@@ -10,6 +10,13 @@
 // view shows the new verdict, transforms and downloads. The map is drawn by
 // the worker while it moves (one drawing in flight at a time), in a view
 // that stays still so the map stays under the pointer.
+//
+// A refused Refine keeps the person's placement on screen, with the
+// refined overlay that was judged outlined (dashed) and the reason, and
+// offers "Use my placement (not verified)": the maps are then joined
+// exactly there, and the verdict, the transforms, the downloads and the
+// JSON say it is not verified. "Place by hand" starts again from the last
+// placement of that pair.
 
 import { compose } from './overlay.js';
 
@@ -28,6 +35,7 @@ export const ADJUST_HTML = `
       <button type="button" id="real-adjust-start">Place by hand</button>
       <button type="button" id="real-refine" class="primary" disabled>Refine</button>
       <button type="button" id="real-adjust-cancel" disabled>Cancel</button>
+      <button type="button" id="real-keep" hidden title="Join the map where you put it, without the merge's tests">Use my placement (not verified)</button>
       <label class="real-turn"><input type="checkbox" id="real-turn"> drag turns it</label>
     </div>
     <p id="real-adjust-help" class="real-adjust-help" hidden>${HELP}</p>
@@ -45,6 +53,12 @@ export function turnAbout(pose, q, d) {
 export function middleOf(m) {
   const [x, y] = compose(m.origin, [(m.width * m.resolution) / 2, (m.height * m.resolution) / 2, 0]);
   return [x, y];
+}
+
+/** The inverse of pose `p` [x, y, θ]. */
+export function inverse([x, y, t]) {
+  const c = Math.cos(t), s = Math.sin(t);
+  return [-c * x - s * y, s * x - c * y, -t];
 }
 
 /** Map b's frame in map a's, b's image just right of a's, unturned. */
@@ -70,6 +84,8 @@ export class PlaceByHand {
     this.client = client;
     this.hooks = hooks;
     this.active = null; // {a, b, pose, pivot} while placing
+    this.kept = null; // {a, b, pose, judged, reason} after a refused refine
+    this.last = new Map(); // the last placement of each pair ("a|b" names): map b's frame in map a's
     this.view = null;
     this.drag = null;
     this.sending = false;
@@ -82,6 +98,7 @@ export class PlaceByHand {
     q('#real-adjust-start').addEventListener('click', said(() => this.start()));
     q('#real-adjust-cancel').addEventListener('click', said(() => this.stop()));
     q('#real-refine').addEventListener('click', said(() => this.refine()));
+    q('#real-keep').addEventListener('click', said(() => this.keep()));
     // The overlay canvas may be replaced (a restarted worker): listen on the view.
     this.root.addEventListener('pointerdown', (e) => this.down(e));
     this.root.addEventListener('pointermove', (e) => this.move(e));
@@ -99,7 +116,8 @@ export class PlaceByHand {
       ...pairs.map((p, i) => {
         const o = document.createElement('option');
         o.value = String(i);
-        o.textContent = `${p.b} onto ${p.a} (${p.status === 'merged' ? 'merged' : 'no merge'})`;
+        const state = p.verified === false ? 'placed by hand, not verified' : p.status === 'merged' ? 'merged' : 'not merged';
+        o.textContent = `${p.b} onto ${p.a} (${state})`;
         return o;
       }),
     );
@@ -114,7 +132,8 @@ export class PlaceByHand {
     q('#real-adjust-start').disabled = placing || !q('#real-pair').options.length;
     q('#real-pair').disabled = placing;
     q('#real-refine').disabled = !placing;
-    q('#real-adjust-cancel').disabled = !placing;
+    q('#real-adjust-cancel').disabled = !placing && !this.kept;
+    q('#real-keep').hidden = !this.kept;
     q('#real-adjust-help').hidden = !placing;
     q('#real-overlay').classList.toggle('placing', placing);
     q('#real-overlay').tabIndex = placing ? 0 : -1;
@@ -127,7 +146,9 @@ export class PlaceByHand {
     const byName = new Map(this.hooks.maps().map((m) => [m.name, m]));
     const a = byName.get(pair.a), b = byName.get(pair.b);
     if (!a || !b) return;
-    const pose = pair.status === 'merged' && pair.pose ? [...pair.pose] : beside(a, b);
+    const last = this.last.get(`${a.name}|${b.name}`);
+    const pose = last ? [...last] : pair.status === 'merged' && pair.pose ? [...pair.pose] : beside(a, b);
+    this.kept = null;
     this.active = { a, b, pose, pivot: middleOf(b) };
     this.root.querySelector('#real-refined').hidden = true;
     this.controls();
@@ -141,6 +162,7 @@ export class PlaceByHand {
 
   async stop() {
     this.active = null;
+    this.kept = null;
     this.drag = null;
     this.controls();
     this.hooks.changed();
@@ -240,17 +262,47 @@ export class PlaceByHand {
       this.controls();
     }
     this.active = null;
-    this.controls();
+    this.last.set(`${a.name}|${b.name}`, [...pose]);
     this.lastPair = out.pair;
-    const line = this.root.querySelector('#real-refined');
     const merged = out.pair.status === 'merged';
-    line.textContent = merged
+    // The pair comes back in the order the merge judged it: its pose is then a's frame in b's.
+    const judged = out.pair.pose && (out.pair.a === a.name ? out.pair.pose : inverse(out.pair.pose));
+    this.kept = merged ? null : { a, b, pose, judged, reason: out.pair.reason };
+    this.controls();
+    this.tell(merged
       ? `Refine of ${b.name} on ${a.name}: merged (confidence ${out.pair.confidence.toFixed(2)}): ${out.pair.reason}`
-      : `Refine of ${b.name} on ${a.name}: no merge, because ${out.pair.reason}`;
-    line.className = `real-verdict ${merged ? 'ok' : 'no'}`;
-    line.hidden = false;
+      : `Refine of ${b.name} on ${a.name}: refused, because ${out.pair.reason}. Your placement stays on screen; ` +
+        'the dashed outline is the refined overlay that was judged. Place it again, or use your placement as it is (not verified).', merged ? 'ok' : 'no');
     this.hooks.refined(out);
     this.hooks.say('', 'info');
+    this.hooks.changed();
+    if (this.kept) this.view = (await this.client.adjust(a.index, b.index, pose, true, judged)).view;
+  }
+
+  /** Joins the kept placement as it is, not verified. */
+  async keep() {
+    if (!this.kept) return;
+    const { a, b, pose } = this.kept;
+    this.hooks.busy(true, `joining ${b.name} where you put it…`);
+    let out;
+    try {
+      out = await this.client.keep(a.index, b.index, pose);
+    } finally {
+      this.hooks.busy(false, '');
+    }
+    this.kept = null;
+    this.controls();
+    this.lastPair = out.pair;
+    this.tell(`${b.name} joined to ${a.name} where you put it: not verified by the merge's tests.`, 'unverified');
+    this.hooks.refined(out);
+  }
+
+  /** The line under the pair row: what the last Refine or keep did. */
+  tell(text, kind) {
+    const line = this.root.querySelector('#real-refined');
+    line.textContent = text;
+    line.className = `real-verdict ${kind}`;
+    line.hidden = false;
   }
 
   /** For tests and the console. */
@@ -258,6 +310,7 @@ export class PlaceByHand {
     const a = this.active;
     return {
       placing: a ? { a: a.a.name, b: a.b.name, pose: [...a.pose], pivot: [...a.pivot] } : null,
+      kept: this.kept ? { a: this.kept.a.name, b: this.kept.b.name, pose: [...this.kept.pose], judged: this.kept.judged } : null,
       view: this.view,
       pair: this.lastPair ?? null,
     };

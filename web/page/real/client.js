@@ -58,14 +58,33 @@ export class SavedMapsClient extends WorkerClient {
     return this.request({ type: 'add', files, resolution, colours }, files.map((f) => f.bytes));
   }
 
-  /** Merges the maps read so far: `{report, files}` (files null on no_merge). */
+  /** Reads image-only map `name` again at `resolution`: `{map}` (its card's facts, as `add` gives them). */
+  reread(name, resolution) {
+    return this.request({ type: 'reread', name, resolution });
+  }
+
+  /** Images at an assumed resolution the last merge left alone, that merge at another: `{hints}` (scale-probe.js). */
+  scales() {
+    return this.request({ type: 'scales' });
+  }
+
+  /** Merges the maps read so far: `{report, files, groupFiles}` (each group's files, null for a map alone). */
   merge() {
     return this.request({ type: 'merge' });
   }
 
-  /** Shows map `b` (index) with its frame at `pose` in map `a`'s; `fit` fits the view anew: `{view}`. */
-  adjust(a, b, pose, fit = false) {
-    return this.request({ type: 'adjust', a, b, pose, fit });
+  /**
+   * Shows map `b` (index) with its frame at `pose` in map `a`'s; `fit` fits
+   * the view anew; `judged` (a pose) outlines where a refused refine put
+   * it: `{view}`.
+   */
+  adjust(a, b, pose, fit = false, judged = null) {
+    return this.request({ type: 'adjust', a, b, pose, fit, judged });
+  }
+
+  /** Joins map `b` to map `a` at `pose` as placed, not verified: `{pair, report, files}`. */
+  keep(a, b, pose) {
+    return this.request({ type: 'keep', a, b, pose });
   }
 
   /** Back to the merge's overlay: `{view}`. */
@@ -76,6 +95,11 @@ export class SavedMapsClient extends WorkerClient {
   /** Aligns map `b` on map `a` from `pose`: `{pair, report, files}`. */
   refine(a, b, pose) {
     return this.request({ type: 'refine', a, b, pose });
+  }
+
+  /** Shows group `group` of the last report in the overlay: `{view}`. */
+  showGroup(group) {
+    return this.request({ type: 'group', group });
   }
 
   /** Forgets every map. */

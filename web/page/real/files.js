@@ -27,7 +27,8 @@ export function yamlForImage(image, resolution) {
  * ArrayBuffer or Uint8Array); `imageOf(name, yamlText)` returns a YAML's
  * `image` field or throws a message naming the field; `resolution`: metres
  * per cell for lone images (a string as typed). Returns
- * `{maps: [{name, yaml, imageName, image}], errors: [text]}`.
+ * `{maps: [{name, yaml, imageName, image, assumed}], errors: [text]}`,
+ * `assumed` the resolution a lone image is read at (absent for a YAML's).
  */
 export function groupFiles(files, imageOf, resolution) {
   const images = new Map();
@@ -67,7 +68,7 @@ export function groupFiles(files, imageOf, resolution) {
       errors.push(`${name}: resolution: no YAML names this image, and '${resolution}' is not a positive resolution to read it at`);
       continue;
     }
-    maps.push({ name, yaml: yamlForImage(name, r), imageName: name, image: new Uint8Array(f.bytes) });
+    maps.push({ name, yaml: yamlForImage(name, r), imageName: name, image: new Uint8Array(f.bytes), assumed: r });
   }
   return { maps, errors };
 }

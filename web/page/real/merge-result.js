@@ -8,9 +8,10 @@
 // once, report.js has the words) and the downloads. Element ids start
 // with the view's prefix (`real`, `log`): `${p}-result`, `${p}-verdict`,
 // `${p}-transforms`, `${p}-pairs`, `${p}-alpha`, `${p}-overlay`,
-// `${p}-legend`, `${p}-downloads`.
+// `${p}-legend`, `${p}-downloads`, and `${p}-groups` (maps of several
+// buildings: one group of maps shown at a time, map-groups.js).
 
-import { transformRows, transformsJson, verdictText } from './report.js';
+import { joinedGroups, transformRows, transformsJson, unverifiedMaps, verdictText } from './report.js';
 
 /**
  * The Merge maps row (`#${p}-merge`, a busy dot, the stage line `#stage`,
@@ -35,6 +36,7 @@ export function resultHtml(p, { frames, title, overlay, extra = '' }) {
   return `
   <div id="${p}-result" class="real-result" hidden>
     <p id="${p}-verdict" class="real-verdict"></p>
+    <div id="${p}-groups" class="real-groups" hidden></div>
     <table id="${p}-transforms" class="summary-table"><caption>${frames}</caption></table>
     <table id="${p}-pairs" class="summary-table"><caption>Each pair's own verdict</caption></table>${extra}
     <div class="real-overlay-head">
@@ -44,6 +46,7 @@ export function resultHtml(p, { frames, title, overlay, extra = '' }) {
     </div>
     <canvas id="${p}-overlay" class="real-overlay" aria-label="${overlay}"></canvas>
     <p id="${p}-legend" class="real-legend"></p>
+    <p id="${p}-unverified" class="real-unverified-note" hidden>These files join a map where you placed it: the merge's tests did not verify it.</p>
     <div id="${p}-downloads" class="real-downloads">
       <button type="button" data-file="pgm">Merged map PGM</button>
       <button type="button" data-file="yaml">Merged map YAML</button>
@@ -56,37 +59,58 @@ export function resultHtml(p, { frames, title, overlay, extra = '' }) {
 /**
  * Fills the verdict and the two tables of a merge (`merge`: the report's
  * `merge`); `name(map)` is how a map is called in them, `what` the first
- * column's heading. Enables the downloads there are files for.
+ * column's heading; `group`: with maps of several buildings, the group
+ * (an entry of `merge.groups`) whose transforms the table shows, `groups`
+ * whether the view lists the groups (the verdict then names them). Enables
+ * the downloads there are files for.
  */
-export function showMerge(root, p, merge, hasFiles, { name = (m) => m, what = 'map' } = {}) {
+export function showMerge(root, p, merge, hasFiles, { name = (m) => m, what = 'map', group = null, groups = false } = {}) {
   const q = (s) => root.querySelector(s);
   q(`#${p}-result`).hidden = false;
   const v = q(`#${p}-verdict`);
-  v.textContent = verdictText(merge);
-  v.className = `real-verdict ${merge.status === 'merged' ? 'ok' : 'no'}`;
-  const rows = transformRows(merge).map((r) => [name(r.map), r.x, r.y, r.deg, r.args]);
-  for (const m of merge.unjoined) rows.push([name(m), '–', '–', '–', 'not joined']);
-  fillTable(q(`#${p}-transforms`), [what, 'x (m)', 'y (m)', 'θ (°)', 'static_transform_publisher'], rows);
+  v.textContent = verdictText(merge, name, groups);
+  const shown = group ? { ...merge, transforms: group.transforms } : merge;
+  const verified = (group ?? merge).verified !== false;
+  const joined = groups && joinedGroups(merge).length > 0;
+  v.className = `real-verdict ${!verified ? 'unverified' : merge.status === 'merged' || joined ? 'ok' : 'no'}`;
+  const unsure = unverifiedMaps(shown);
+  const rows = transformRows(shown).map((r) => [name(r.map) + (unsure.has(r.map) ? ' (placed by hand, not verified)' : ''), r.x, r.y, r.deg, r.args]);
+  const others = group ? (merge.groups ?? []).flatMap((g) => (g === group ? [] : g.maps)) : merge.unjoined;
+  for (const m of others) rows.push([name(m), '–', '–', '–', group ? 'in another group' : 'not joined']);
+  const table = q(`#${p}-transforms`);
+  const reference = shown.transforms[0]?.map;
+  table.querySelector('caption').textContent = reference === undefined
+    ? `No ${what} joined another`
+    : `Each ${what}'s frame in the frame of ${name(reference)} (the reference)${verified ? '' : ', with your placement, not verified'}`;
+  fillTable(table, [what, 'x (m)', 'y (m)', 'θ (°)', 'static_transform_publisher'], rows);
   fillTable(
     q(`#${p}-pairs`),
     ['pair', 'verdict', 'confidence', 'reason'],
-    merge.pairs.map((r) => [`${name(r.a)} + ${name(r.b)}`, r.status, r.confidence.toFixed(2), r.reason]),
+    merge.pairs.map((r) => [`${name(r.a)} + ${name(r.b)}`, r.status === 'merged' ? 'merged' : 'not merged', r.confidence.toFixed(2), r.reason]),
   );
   for (const b of root.querySelectorAll(`#${p}-downloads button`)) {
     b.disabled = b.dataset.file !== 'json' && !hasFiles;
+    b.textContent = b.textContent.replace(/ \(not verified\)$/, '') + (verified ? '' : ' (not verified)');
   }
+  const note = q(`#${p}-unverified`);
+  if (note) note.hidden = verified;
 }
 
-/** Downloads `kind` of a merge: the merged map's `pgm`, `yaml`, `png`, or the transforms' `json`. */
-export function saveMerge(download, report, files, kind) {
+/**
+ * Downloads `kind` of a merge: the merged map's `pgm`, `yaml`, `png`, or
+ * the transforms' `json`; `files.stem` names them (`merged`, or
+ * `merged-group-2` for a group), `group` the group the JSON is of.
+ */
+export function saveMerge(download, report, files, kind, group = -1) {
+  const stem = files?.stem ?? 'merged';
   if (kind === 'json' && report) {
-    download('transforms.json', transformsJson(report), 'application/json');
+    download(stem === 'merged' ? 'transforms.json' : `transforms-${stem.slice('merged-'.length)}.json`, transformsJson(report, group), 'application/json');
     return;
   }
   if (!files) return;
-  if (kind === 'pgm') download('merged.pgm', files.pgm, 'image/x-portable-graymap');
-  if (kind === 'png') download('merged.png', files.png, 'image/png');
-  if (kind === 'yaml') download('merged.yaml', files.yaml, 'application/yaml');
+  if (kind === 'pgm') download(`${stem}.pgm`, files.pgm, 'image/x-portable-graymap');
+  if (kind === 'png') download(`${stem}.png`, files.png, 'image/png');
+  if (kind === 'yaml') download(`${stem}.yaml`, files.yaml, 'application/yaml');
 }
 
 /**

@@ -6,16 +6,21 @@
 // into maps (files.js matches each YAML to its image), draws each map into
 // a small coloured picture for the page (preview.js), merges on request
 // (the whole merge runs here, so the page never waits on it), hands back
-// the report and the merged map's PGM, PNG and YAML, and draws the merged
-// overlay (overlay.js) into the page's canvas, which the page hands over
-// once. Messages in:
+// the report and each group's merged map as PGM, PNG and YAML (maps of
+// two buildings make two groups, each joined in its first map's frame),
+// and draws the merged overlay of the group shown (overlay.js) into the
+// page's canvas, which the page hands over once. Messages in:
 // `{id, type: 'add', files, resolution, colours}`, `{id, type: 'merge'}`,
 // `{id, type: 'canvas', canvas}`, `{id, type: 'draw', width, height, dpr,
-// alpha}`, `{id, type: 'clear'}`, and for placing a map by hand (the
+// alpha}`, `{id, type: 'group', group}` (the overlay shows that group of
+// the report's `merge.groups`), `{id, type: 'clear'}`, and for placing a map by hand (the
 // page's Refine, adjust.js): `{id, type: 'adjust', a, b, pose, fit}` (map
 // b's frame at `pose` in map a's: shown, the view kept still unless
 // `fit`), `{id, type: 'refine', a, b, pose}` (aligns from there, answers
-// `{pair, report, files}` as a merge does), `{id, type: 'endAdjust'}`;
+// `{pair, report, files}` as a merge does), `{id, type: 'keep', a, b,
+// pose}` (joins map b there as placed, not verified; answers as refine
+// does), `{id, type: 'endAdjust'}`; an `adjust` with `judged` (a pose)
+// also outlines, dashed, where a refused refine put map b;
 // out: `{id, ok, ...}` or `{id, ok: false, error}`, and
 // `{type: 'progress', text}` while merging. Draws answer with the view
 // used (`{view: {k, e, f, width, height, dpr}}`).
@@ -23,9 +28,11 @@
 import init, * as wasm from '../../pkg/slamlab.js';
 import { SavedMaps, mapImagePath } from '../../saved-maps.js';
 import { BagFile, bagKind } from '../../bag-file.js';
-import { groupFiles } from './files.js';
+import { groupFiles, yamlForImage } from './files.js';
+import { gridWarning } from './grid-look.js';
+import { probeScales } from './scale-probe.js';
 import { previewOf } from './preview.js';
-import { compose, drawPlaced, fitView } from './overlay.js';
+import { compose, drawPlaced, fitView, outline } from './overlay.js';
 
 const ready = init();
 /** The maps read so far (a SavedMaps), null before the first. */
@@ -34,6 +41,9 @@ let colourIndex = 0;
 /** What the overlay needs of each map read (by name), the last merge's placing, the canvas. */
 let pictures = new Map();
 let placed = [];
+/** The last report, and which of its groups the overlay shows. */
+let lastReport = null;
+let shownGroup = 0;
 let overlay = null;
 /** While a map is placed by hand: `{a, b, pose}` (indices) and the still view. */
 let adjusting = null;
@@ -62,7 +72,13 @@ function addBag(f) {
   }
 }
 
-/** Reads the picked files into maps (a bag's map too); the good ones load even if some are bad. */
+/**
+ * Reads the picked files into maps (a bag's map too); the good ones load
+ * even if some are bad. A map named as one already open replaces it, in
+ * its place and colour. Each map comes back with `assumed` (the
+ * resolution an image without YAML was read at, else null) and `warning`
+ * (an image that does not look like an occupancy grid).
+ */
 async function add({ files, resolution, colours }) {
   savedMaps ??= SavedMaps.open(wasm);
   const bags = files.filter(isBag);
@@ -70,10 +86,15 @@ async function add({ files, resolution, colours }) {
   const added = [];
   const transfer = [];
   const reads = [
-    ...maps.map((m) => [m.imageName, () => savedMaps.addMap(m.name, m.yaml, m.imageName, m.image)]),
-    ...bags.map((f) => [f.name, () => addBag(f)]),
+    ...maps.map((m) => [m, () => {
+      const old = pictures.get(m.name);
+      if (!old) return savedMaps.addMap(m.name, m.yaml, m.imageName, m.image);
+      savedMaps.replaceMap(old.index, m.name, m.yaml, m.imageName, m.image);
+      return old.index;
+    }]),
+    ...bags.map((f) => [{ name: f.name, imageName: f.name }, () => addBag(f)]),
   ];
-  for (const [imageName, read] of reads) {
+  for (const [m, read] of reads) {
     let index;
     try {
       index = read();
@@ -81,14 +102,38 @@ async function add({ files, resolution, colours }) {
       errors.push(message(e));
       continue;
     }
-    const info = savedMaps.mapInfo(index);
-    const colour = colours[colourIndex++ % colours.length];
-    const { thumb, ...preview } = await previewOf(savedMaps.mapPixels(index), info.width, info.height, colour);
-    pictures.set(info.name, { ...info, index, preview });
-    transfer.push(thumb);
-    added.push({ ...info, index, imageName, colour, thumb });
+    const old = pictures.get(m.name);
+    const colour = old?.colour ?? colours[colourIndex++ % colours.length];
+    const source = m.assumed ? { image: m.image, imageName: m.imageName } : null;
+    const warning = m.image ? await gridWarning(m.imageName, m.image) : '';
+    const files = m.image ? { yaml: m.yaml, image: m.image, imageName: m.imageName } : null;
+    const out = await picture(index, colour, { imageName: m.imageName, assumed: m.assumed ?? null, warning, source, read: files });
+    transfer.push(out.thumb);
+    added.push({ ...out, replaced: !!old });
   }
   return { result: { added, errors }, transfer };
+}
+
+/** Map `index`'s picture for the overlay (kept by name) and its card's facts (with the thumbnail). */
+async function picture(index, colour, extra) {
+  const info = savedMaps.mapInfo(index);
+  const { thumb, ...preview } = await previewOf(savedMaps.mapPixels(index), info.width, info.height, colour);
+  pictures.set(info.name, { ...info, index, preview, colour, source: extra.source, read: extra.read });
+  return { ...info, index, colour, thumb, imageName: extra.imageName, assumed: extra.assumed, warning: extra.warning };
+}
+
+/** Reads an image opened without YAML again at `resolution` (m per cell), in its place. */
+async function reread({ name, resolution }) {
+  const p = pictures.get(name);
+  if (!p?.source) throw new Error(`${name}: only an image opened without a YAML is read at a resolution you give`);
+  const r = Number(resolution);
+  if (!(Number.isFinite(r) && r > 0)) throw new Error(`${name}: resolution: '${resolution}' is not a positive number of metres per cell`);
+  const yaml = yamlForImage(p.source.imageName, r);
+  savedMaps.replaceMap(p.index, name, yaml, p.source.imageName, p.source.image);
+  const warning = await gridWarning(p.source.imageName, p.source.image);
+  const read = { yaml, image: p.source.image, imageName: p.source.imageName };
+  const out = await picture(p.index, p.colour, { imageName: p.source.imageName, assumed: r, warning, source: p.source, read });
+  return { result: { map: out }, transfer: [out.thumb] };
 }
 
 /** Merges every map read so far; the merged map's files come with the report. */
@@ -98,6 +143,17 @@ function merge(id) {
   adjusting = null; // a new merge ends any placing by hand
   view = null;
   return withFiles(report, t0);
+}
+
+/** Joins map b to map a as the page placed it, not verified; the report follows it. */
+function keep({ a, b, pose }) {
+  const t0 = performance.now();
+  const pair = savedMaps.keepPlacement(a, b, pose);
+  const out = withFiles(savedMaps.report(), t0);
+  adjusting = null;
+  view = null;
+  out.result.pair = pair;
+  return out;
 }
 
 /** Aligns map b on map a again from the page's guess; the report follows it. */
@@ -111,22 +167,44 @@ function refine({ a, b, pose }) {
   return out;
 }
 
-/** The report with the merged map's files (when merged) and the overlay's placing. */
+/** The files of a group of two or more maps: PGM, PNG and YAML naming `stem`.pgm. */
+function filesOfGroup(k, stem) {
+  const pgm = savedMaps.groupPgm(k);
+  const png = savedMaps.groupPng(k);
+  return { pgm, png, yaml: savedMaps.groupYaml(k, `${stem}.pgm`), stem };
+}
+
+/**
+ * The report with each group's merged map (`groups[k]`, null for a map
+ * alone; `files` the first joined group's, as before groups) and the
+ * overlay's placing.
+ */
 function withFiles(report, t0) {
   const t1 = performance.now();
-  let files = null;
   const transfer = [];
-  if (report.merge.status === 'merged') {
-    const pgm = savedMaps.mergedPgm();
-    const png = savedMaps.mergedPng();
-    files = { pgm, png, yaml: savedMaps.mergedYaml('merged.pgm') };
-    transfer.push(pgm.buffer, png.buffer);
-  }
+  const groups = report.merge.groups ?? [];
+  const joined = groups.filter((g) => g.maps.length > 1).length;
+  let n = 0;
+  const files = groups.map((g, k) => {
+    if (g.maps.length < 2) return null;
+    n += 1;
+    const stem = joined > 1 ? `merged-group-${n}` : 'merged';
+    const f = filesOfGroup(k, g.verified === false ? `${stem}-not-verified` : stem);
+    if (g.verified === false) f.yaml = `# Joined where a person placed a map by hand: not verified by the merge's tests.\n${f.yaml}`;
+    transfer.push(f.pgm.buffer, f.png.buffer);
+    return f;
+  });
   report.timings_ms = { merge: t1 - t0, write: performance.now() - t1 };
-  placed = report.merge.transforms
-    .filter((t) => pictures.has(t.map))
-    .map((t) => ({ map: pictures.get(t.map), pose: t.pose }));
-  return { result: { report, files }, transfer };
+  lastReport = report;
+  shownGroup = Math.max(0, files.findIndex((f) => f));
+  place();
+  return { result: { report, files: files.find((f) => f) ?? null, groupFiles: files }, transfer };
+}
+
+/** The overlay's placing: the shown group's maps in its first map's frame. */
+function place() {
+  const transforms = lastReport?.merge.groups?.[shownGroup]?.transforms ?? lastReport?.merge.transforms ?? [];
+  placed = transforms.filter((t) => pictures.has(t.map)).map((t) => ({ map: pictures.get(t.map), pose: t.pose }));
 }
 
 self.onmessage = async ({ data }) => {
@@ -144,11 +222,23 @@ self.onmessage = async ({ data }) => {
     } else if (type === 'refine') {
       if (!savedMaps) throw new Error('open two or more maps first');
       out = refine(data);
+    } else if (type === 'reread') {
+      if (!savedMaps) throw new Error('open two or more maps first');
+      out = await reread(data);
+    } else if (type === 'scales') {
+      out = { result: { hints: lastReport ? probeScales(wasm, SavedMaps, pictures, lastReport, yamlForImage) : [] }, transfer: [] };
+    } else if (type === 'keep') {
+      if (!savedMaps) throw new Error('open two or more maps first');
+      out = keep(data);
+    } else if (type === 'group') {
+      shownGroup = data.group;
+      place();
+      out = { result: { view: draw(lastSize) }, transfer: [] };
     } else if (type === 'draw') {
       out = { result: { view: draw(data) }, transfer: [] };
     } else if (type === 'adjust') {
       if (data.fit || !adjusting) view = null;
-      adjusting = { a: data.a, b: data.b, pose: data.pose };
+      adjusting = { a: data.a, b: data.b, pose: data.pose, judged: data.judged ?? null };
       out = { result: { view: draw(lastSize) }, transfer: [] };
     } else if (type === 'endAdjust') {
       adjusting = null;
@@ -160,6 +250,7 @@ self.onmessage = async ({ data }) => {
       colourIndex = 0;
       pictures = new Map();
       placed = [];
+      lastReport = null;
       adjusting = null;
       view = null;
       out = { result: {}, transfer: [] };
@@ -188,7 +279,8 @@ function draw(size) {
   if (!adjusting) return drawPlaced(overlay, lastSize, placed);
   const a = pictureOf(adjusting.a), b = pictureOf(adjusting.b);
   const shown = [{ map: a, pose: [0, 0, 0] }, { map: b, pose: adjusting.pose }];
-  view = drawPlaced(overlay, lastSize, shown, view ?? fitView(shown, lastSize, 0.15));
+  const fitted = adjusting.judged ? [...shown, { map: b, pose: adjusting.judged }] : shown;
+  view = drawPlaced(overlay, lastSize, shown, view ?? fitView(fitted, lastSize, 0.15));
   const [x, y] = compose(compose(adjusting.pose, b.origin), [(b.width * b.resolution) / 2, (b.height * b.resolution) / 2, 0]);
   const ctx = overlay.getContext('2d');
   const px = view.k * x + view.e, py = view.f - view.k * y, r = 9 * size.dpr;
@@ -202,5 +294,35 @@ function draw(size) {
   ctx.moveTo(px, py - 1.6 * r);
   ctx.lineTo(px, py + 1.6 * r);
   ctx.stroke();
+  if (adjusting.judged) outlineAt(ctx, b, adjusting.judged, size.dpr);
   return view;
+}
+
+/** The convex hull of points [x, y] (Andrew's monotone chain), counter-clockwise. */
+function hull(points) {
+  const p = [...points].sort((u, v) => u[0] - v[0] || u[1] - v[1]);
+  const cross = (o, u, v) => (u[0] - o[0]) * (v[1] - o[1]) - (u[1] - o[1]) * (v[0] - o[0]);
+  const half = (list) => {
+    const out = [];
+    for (const q of list) {
+      while (out.length > 1 && cross(out[out.length - 2], out[out.length - 1], q) <= 0) out.pop();
+      out.push(q);
+    }
+    out.pop();
+    return out;
+  };
+  return [...half(p), ...half([...p].reverse())];
+}
+
+/** A dashed outline round map `b`'s known cells with its frame at `pose`: where a refused refine put it. */
+function outlineAt(ctx, b, pose, dpr) {
+  const corners = hull(outline(b, pose));
+  ctx.setLineDash([8 * dpr, 6 * dpr]);
+  ctx.lineWidth = 2.5 * dpr;
+  ctx.strokeStyle = '#c2410c';
+  ctx.beginPath();
+  corners.forEach(([x, y], i) => (i ? ctx.lineTo : ctx.moveTo).call(ctx, view.k * x + view.e, view.f - view.k * y));
+  ctx.closePath();
+  ctx.stroke();
+  ctx.setLineDash([]);
 }

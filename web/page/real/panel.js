@@ -7,13 +7,18 @@
 // confidence, each map's transform (metres, degrees, and the arguments of
 // ROS's static_transform_publisher) and each pair's verdict, sees the
 // joined maps overlaid in their colours, and downloads the merged map (PGM
-// + YAML + PNG) and the transforms (JSON); a pair the merge declined can be
-// placed by hand and refined (adjust.js). The reading, drawing and merging
+// + YAML + PNG) and the transforms (JSON); maps of several buildings form
+// groups, each with its own transforms, overlay and downloads
+// (map-groups.js); a pair the merge declined can be placed by hand and
+// refined (adjust.js). The reading, drawing and merging
 // run in a Web Worker (merge-worker.js), so the page stays responsive; the
 // lab's own scenario and runs behind this view are never touched.
 
 import { ADJUST_HTML, PlaceByHand } from './adjust.js';
+import { mapCard } from './card.js';
+import { scaleHintText } from './scale-probe.js';
 import { SavedMapsClient } from './client.js';
+import { MapGroupsView, showsGroups } from './map-groups.js';
 import { OverlayCanvas, mergeHtml, saveMerge, showMerge, swatch } from './merge-result.js';
 
 /** One colour per map (up to 16), told apart on white. */
@@ -61,6 +66,9 @@ export class SavedMapsView {
     this.maps = [];
     this.report = null;
     this.files = null;
+    /** Each group's merged map files (null for a map alone), and the group shown. */
+    this.groupFiles = [];
+    this.group = -1;
     this.busy = false;
     this.queue = Promise.resolve();
     this.client = new SavedMapsClient((text) => this.progress(text));
@@ -70,7 +78,7 @@ export class SavedMapsView {
       report: () => this.report,
       refined: (out) => {
         this.report = out.report;
-        this.files = out.files;
+        this.groupFiles = out.groupFiles ?? [];
         this.showResult();
       },
       say: (text, kind) => this.say(text, kind),
@@ -85,6 +93,10 @@ export class SavedMapsView {
     root.innerHTML = HTML;
     this.adjust.wire();
     const q = (s) => root.querySelector(s);
+    this.groups = new MapGroupsView(q('#real-groups'), {
+      select: (k) => this.showGroup(k),
+      colour: (name) => this.maps.find((m) => m.name === name)?.colour ?? '#111',
+    });
     this.opener.addEventListener('click', () => this.toggle(true));
     q('.real-close').addEventListener('click', () => this.toggle(false));
     root.addEventListener('keydown', (e) => {
@@ -147,13 +159,59 @@ export class SavedMapsView {
         this.setBusy(false, '');
       }
       performance.mark('real-added');
-      this.maps.push(...out.added);
+      const replaced = this.place(out.added);
       if (out.added.length) this.dropResult();
-      if (out.errors.length) this.say(`Not opened: ${out.errors.join(' · ')}`, 'error');
-      else this.say(`Opened ${out.added.map((m) => m.name).join(', ')}.`, 'ok');
+      const again = replaced.length ? ` Opened again, in place of the one open: ${replaced.join(', ')}.` : '';
+      const one = this.maps.length === 1
+        ? ` One map is open: open one more (or several) to merge it with, the map of another robot or another run of the same building.`
+        : '';
+      if (out.errors.length) this.say(`Not opened: ${out.errors.join(' · ')}${again}${one}`, 'error');
+      else this.say(`Opened ${out.added.map((m) => m.name).join(', ')}.${again}${one}`, one ? 'info' : 'ok');
       this.refresh();
       performance.mark('real-listed');
       if (out.added.length && this.maps.length >= 2) {
+        await nextFrame();
+        await this.merge();
+      }
+    });
+  }
+
+  /** Puts maps the worker read into the list: a map named as one open takes its place. Returns the names replaced. */
+  place(added) {
+    const replaced = [];
+    for (const m of added) {
+      const at = this.maps.findIndex((o) => o.name === m.name);
+      if (at < 0) {
+        this.maps.push(m);
+        continue;
+      }
+      this.maps[at] = m;
+      replaced.push(m.name);
+    }
+    return replaced;
+  }
+
+  /**
+   * Reads image-only map `name` again at `resolution`, with every image
+   * read at the same assumed resolution (opened together, most likely
+   * from one robot), and merges again.
+   */
+  reread(name, resolution) {
+    return this.enqueue(async () => {
+      const assumed = this.maps.find((m) => m.name === name)?.assumed;
+      const names = this.maps.filter((m) => m.name === name || (assumed && m.assumed === assumed)).map((m) => m.name);
+      this.setBusy(true, `reading ${names.join(', ')} again at ${resolution} m per cell…`);
+      const read = [];
+      try {
+        for (const n of names) read.push((await this.client.reread(n, resolution)).map);
+      } finally {
+        this.setBusy(false, '');
+      }
+      this.place(read);
+      this.dropResult();
+      this.say(`Read ${names.join(', ')} again at ${read[0].resolution} m per cell.`, 'ok');
+      this.refresh(true);
+      if (this.maps.length >= 2) {
         await nextFrame();
         await this.merge();
       }
@@ -173,7 +231,7 @@ export class SavedMapsView {
       this.say('Open two or more maps to merge them.', 'warn');
       return;
     }
-    if (this.adjust.active) await this.adjust.stop();
+    if (this.adjust.active || this.adjust.kept) await this.adjust.stop();
     const n = this.maps.length;
     const t0 = performance.now();
     // Nothing ticks or animates while it runs: the page's main thread stays
@@ -187,12 +245,20 @@ export class SavedMapsView {
     }
     performance.mark('real-merged');
     this.report = out.report;
-    this.files = out.files;
+    this.groupFiles = out.groupFiles ?? [];
     this.mergeMs = performance.now() - t0;
     this.stage(`merged in ${(this.mergeMs / 1000).toFixed(2)} s (the merge itself ${(out.report.timings_ms.merge / 1000).toFixed(2)} s)`);
     await nextFrame();
     this.showResult();
     performance.mark('real-shown');
+    if (this.maps.some((m) => m.assumed)) this.scaleHints(out.report);
+  }
+
+  /** After a merge with images at an assumed resolution: says which merge at another (measured). */
+  async scaleHints(report) {
+    const { hints } = await this.client.scales();
+    if (this.report !== report || !hints.length) return;
+    this.say(hints.map(scaleHintText).join(' '), 'warn');
   }
 
   progress(text) {
@@ -219,27 +285,63 @@ export class SavedMapsView {
 
   dropResult() {
     this.adjust.active = null;
+    this.adjust.kept = null;
     this.report = null;
     this.files = null;
+    this.groupFiles = [];
+    this.group = -1;
+    this.groups?.hide();
     this.root.querySelector('#real-result').hidden = true;
     this.stage('');
   }
 
-  /** The map cards and the state of the buttons. */
-  refresh() {
+  /** The map cards and the state of the buttons (`cards`: build the list again). */
+  refresh(cards = false) {
     const q = (s) => this.root.querySelector(s);
     q('#real-merge').disabled = this.busy || this.maps.length < 2;
     q('#real-clear').disabled = this.busy || this.maps.length === 0;
     const list = q('#real-maps');
-    if (list.childElementCount === this.maps.length) return;
-    list.replaceChildren(...this.maps.map((m) => (m.card ??= card(m))));
+    const shown = [...list.children];
+    if (!cards && shown.length === this.maps.length && this.maps.every((m, i) => m.card === shown[i])) return;
+    list.replaceChildren(...this.maps.map((m) => (m.card ??= mapCard(m, (name, r) => this.reread(name, r)))));
   }
 
   showResult() {
-    showMerge(this.root, 'real', this.report.merge, !!this.files);
+    this.group = this.groups.show(this.report.merge);
+    this.showTables();
     this.adjust.show(this.report);
     // The overlay in a task of its own, after the tables are laid out.
     nextFrame().then(() => this.drawOverlay());
+  }
+
+  /** The verdict, the tables and the downloads of the group shown (all maps when one group). */
+  showTables() {
+    this.files = this.groupFiles[this.group] ?? null;
+    const group = showsGroups(this.report.merge) ? this.report.merge.groups[this.group] : null;
+    showMerge(this.root, 'real', this.report.merge, !!this.files, { group, groups: true });
+  }
+
+  /** Shows group `k`: its transforms, its downloads and its overlay. */
+  async showGroup(k) {
+    this.group = k;
+    this.showTables();
+    await this.client.showGroup(k);
+    this.drawOverlay();
+  }
+
+  /** "Merged overlay", or with groups listed "Merged overlay of group 2: c + d" (its downloads below it). */
+  overlayTitle() {
+    const merge = this.report?.merge;
+    if (!merge || !showsGroups(merge)) return 'Merged overlay';
+    const joined = merge.groups.filter((g) => g.maps.length > 1);
+    const g = merge.groups[this.group];
+    return g ? `Merged overlay of group ${joined.indexOf(g) + 1}: ${g.maps.join(' + ')}` : 'Merged overlay';
+  }
+
+  /** The maps placed in the overlay: the group shown, else every joined map. */
+  placedTransforms() {
+    const merge = this.report.merge;
+    return (showsGroups(merge) ? merge.groups[this.group]?.transforms : null) ?? merge.transforms;
   }
 
   /** The joined maps in the first map's frame, each in its colour: drawn by the worker (merge-result.js). */
@@ -248,7 +350,7 @@ export class SavedMapsView {
     this.overlay.draw(
       (e) => this.say(e.message, 'error'),
       (r) => {
-        if (this.adjust.active && r?.view) this.adjust.view = r.view;
+        if ((this.adjust.active || this.adjust.kept) && r?.view) this.adjust.view = r.view;
       },
     );
     this.legend();
@@ -261,15 +363,23 @@ export class SavedMapsView {
 
   legend() {
     const legend = this.root.querySelector('#real-legend');
-    const placing = this.adjust.active;
-    this.root.querySelector('#real-overlay-title').textContent = placing ? `Placing ${placing.b.name} by hand` : 'Merged overlay';
+    const placing = this.adjust.active, kept = this.adjust.kept;
+    this.root.querySelector('#real-overlay-title').textContent = placing
+      ? `Placing ${placing.b.name} by hand`
+      : kept ? `Your placement of ${kept.b.name} (refused by Refine)`
+        : this.report?.merge.verified === false ? 'Merged overlay (your placement, not verified)' : this.overlayTitle();
     if (placing) {
       legend.replaceChildren(swatch(placing.a.colour, placing.a.name), swatch(placing.b.colour, `${placing.b.name} (drag it)`));
       return;
     }
+    if (kept) {
+      legend.replaceChildren(swatch(kept.a.colour, kept.a.name), swatch(kept.b.colour, `${kept.b.name} where you put it`),
+        kept.judged ? swatch('#c2410c', 'dashed: the refined overlay that was judged and refused') : '');
+      return;
+    }
     if (!this.report) return;
     const byName = new Map(this.maps.map((m) => [m.name, m]));
-    const placed = this.report.merge.transforms.filter((t) => byName.has(t.map)).map((t) => ({ map: byName.get(t.map) }));
+    const placed = this.placedTransforms().filter((t) => byName.has(t.map)).map((t) => ({ map: byName.get(t.map) }));
     legend.replaceChildren(
       ...placed.map(({ map }) => swatch(map.colour, map.name)),
       placed.length > 1 ? 'Walls of two maps that fall on each other show dark.' : '',
@@ -277,7 +387,7 @@ export class SavedMapsView {
   }
 
   save(kind) {
-    saveMerge(this.download, this.report, this.files, kind);
+    saveMerge(this.download, this.report, this.files, kind, showsGroups(this.report.merge) ? this.group : -1);
   }
 
   /** For tests and the console: what the view holds. */
@@ -285,6 +395,7 @@ export class SavedMapsView {
     return {
       maps: this.maps.map(({ name, width, height, resolution, origin }) => ({ name, width, height, resolution, origin })),
       report: this.report,
+      group: this.group,
       mergeMs: this.mergeMs,
       busy: this.busy,
       adjust: this.adjust.snapshot(),
@@ -295,24 +406,4 @@ export class SavedMapsView {
 /** Resolves after the next frame has been drawn (work split into short tasks). */
 export function nextFrame() {
   return new Promise((resolve) => requestAnimationFrame(() => setTimeout(resolve, 0)));
-}
-
-/** One opened map: its picture, name, size and resolution. */
-function card(m) {
-  const div = document.createElement('figure');
-  div.className = 'real-card';
-  div.style.borderColor = m.colour;
-  // The worker made the thumbnail at its shown size (a large canvas shrunk
-  // by CSS would be shrunk again at every repaint of the page).
-  const c = document.createElement('canvas');
-  c.width = m.thumb.width;
-  c.height = m.thumb.height;
-  c.getContext('bitmaprenderer').transferFromImageBitmap(m.thumb);
-  c.setAttribute('aria-label', `${m.name}, drawn in its colour`);
-  const cap = document.createElement('figcaption');
-  const o = m.origin.map((v) => Number(v.toFixed(3)));
-  cap.innerHTML = `<b style="color:${m.colour}"></b><br>${m.width} × ${m.height} cells · ${m.resolution} m · origin [${o.join(', ')}]`;
-  cap.querySelector('b').textContent = m.imageName === m.name ? m.name : `${m.name} + ${m.imageName}`;
-  div.append(c, cap);
-  return div;
 }

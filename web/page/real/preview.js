@@ -2,7 +2,9 @@
 // to at most MAX_SIDE pixels a side (a block shows a wall if any of its
 // cells is one, else free if any is free, else unknown), walls in the
 // map's colour, free space in a pale wash of it, unknown transparent, so
-// that maps laid over each other show whose wall is whose.
+// that maps laid over each other show whose wall is whose. The card's
+// thumbnail is cropped to the box round the known pixels (a map saved in a
+// large image of unknown shows as what it knows).
 
 export const MAX_SIDE = 1024;
 
@@ -52,11 +54,21 @@ export async function previewOf(grey, width, height, colour) {
   }
   if (!rows.length) rows.push([0, 0, w], [h - 1, 0, w]);
   const bitmap = await createImageBitmap(new ImageData(rgba, w, h));
-  const k = Math.min(1, THUMB[0] / w, THUMB[1] / h);
-  const thumb = await createImageBitmap(bitmap, {
-    resizeWidth: Math.max(1, Math.round(w * k)),
-    resizeHeight: Math.max(1, Math.round(h * k)),
+  // The card shows what the map knows: the box round its known pixels, not the unknown around it.
+  const [x0, y0, cw, ch] = knownBox(rows, w, h);
+  const k = Math.min(1, THUMB[0] / cw, THUMB[1] / ch);
+  const thumb = await createImageBitmap(bitmap, x0, y0, cw, ch, {
+    resizeWidth: Math.max(1, Math.round(cw * k)),
+    resizeHeight: Math.max(1, Math.round(ch * k)),
     resizeQuality: 'high',
   });
   return { bitmap, thumb, width: w, height: h, step, rows };
+}
+
+/** `[x, y, width, height]` of the box round the known pixels (`rows` as previewOf makes them), a margin of one pixel. */
+export function knownBox(rows, w, h) {
+  const top = Math.max(0, rows[0][0] - 1), bottom = Math.min(h, rows[rows.length - 1][0] + 2);
+  const left = Math.max(0, Math.min(...rows.map((r) => r[1])) - 1);
+  const right = Math.min(w, Math.max(...rows.map((r) => r[2])) + 1);
+  return [left, top, Math.max(1, right - left), Math.max(1, bottom - top)];
 }

@@ -19,7 +19,22 @@
 //! when its verdict is "merged", weighted by its confidence, and the maps
 //! are joined along the maximum spanning tree from the first map, as the
 //! lab joins three or more robots. The first map's frame is the merged
-//! frame. A transform is reported as the pose of a map's own frame (the
+//! frame.
+//!
+//! A person may also keep a placement of their own that the tests refused
+//! ([`SavedMerge::keep_placement`]): the pair then joins at exactly that
+//! pose, marked *not verified* (`verified: false` on the pair, on every
+//! group it joins and on the merge), with the refusal kept in its reason,
+//! and with the least confidence, so the spanning tree takes any verified
+//! chain first.
+//!
+//! Maps of two buildings opened together join into several *groups*
+//! ([`crate::merge::graph::groups`]): each group is a connected part of the
+//! graph of merged pairs, joined along its own spanning tree from its
+//! lowest-numbered map, whose frame is that group's frame. The first group
+//! is always the first map's, exactly as the merged frame above; a map no
+//! merged pair reaches is a group of its own, with the reason of its
+//! best-supported pair. A transform is reported as the pose of a map's own frame (the
 //! frame its YAML `origin` is written in) in the first map's frame:
 //! the search works in image frames (the image's lower-left corner), so a
 //! pair's image-frame overlay `P` becomes `origin_A ⊕ P ⊕ origin_B⁻¹`.
@@ -37,7 +52,7 @@ use self::search::{propose, RefineConfig, SearchConfig};
 use self::wallmap::WallMap;
 use crate::formats::rosmap::RosMap;
 use crate::geom::Pose2;
-use crate::merge::graph::{spanning_tree, PairEdge};
+use crate::merge::graph::{groups, spanning_tree, Joined, PairEdge};
 use crate::merge::MergeStatus;
 use glam::DVec2;
 use serde_json::json;
@@ -70,6 +85,9 @@ pub struct PairResult {
     /// The person's guess this pair was refined from (B's map frame in
     /// A's), `None` for the automatic merge.
     pub guess: Option<Pose2>,
+    /// `false` for a placement a person kept although the tests refused
+    /// it ([`SavedMerge::keep_placement`]).
+    pub verified: bool,
 }
 
 impl PairResult {
@@ -86,6 +104,7 @@ impl PairResult {
             rival_support_m: 0.0,
             overlays: 0,
             guess: None,
+            verified: true,
         }
     }
 }
@@ -98,18 +117,22 @@ pub fn agreement_reason(
     cfg: &SavedMergeConfig,
     others: &str,
 ) -> String {
-    let ratio = if rival_support_m > 0.0 {
-        e.support_m / rival_support_m
-    } else {
-        f64::INFINITY
-    };
     let others = if others.is_empty() {
         String::new()
     } else {
         format!(" {others}")
     };
+    // With no rival at all the ratio would be infinite: say so in words.
+    let rival = if rival_support_m > 0.0 {
+        format!(
+            "{:.1} times that of any other overlay{others}",
+            e.support_m / rival_support_m
+        )
+    } else {
+        format!("and no other overlay{others} has any")
+    };
     format!(
-        "the maps agree: {:.1} m of wall of each on the other's within {:.2} m, acceptance index {:.2} ({} points agree, {} in the band, {} in free space), {:.1} m of net support, {:.1} times that of any other overlay{others}",
+        "the maps agree: {:.1} m of wall of each on the other's within {:.2} m, acceptance index {:.2} ({} points agree, {} in the band, {} in free space), {:.1} m of net support, {rival}",
         e.agree_m,
         cfg.evidence.agree_m,
         e.index,
@@ -117,7 +140,6 @@ pub fn agreement_reason(
         e.band[0] + e.band[1],
         e.disagree[0] + e.disagree[1],
         e.support_m,
-        ratio
     )
 }
 
@@ -131,6 +153,68 @@ pub struct SavedMerge {
     pub poses: Vec<Option<Pose2>>,
     pub unjoined: Vec<usize>,
     pub pairs: Vec<PairResult>,
+    /// Every connected group of maps (the first map's first).
+    pub groups: Vec<MapGroup>,
+    /// `false` when a pair joining the first map's group is a placement
+    /// kept by hand, not verified.
+    pub verified: bool,
+}
+
+/// The confidence of a kept placement: above 0 (so it joins), below any
+/// verified pair's.
+pub const KEPT_CONFIDENCE: f64 = 1e-6;
+
+/// One group of maps joined to each other and to no map outside it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MapGroup {
+    /// Its maps, in the order they were opened.
+    pub maps: Vec<usize>,
+    /// Each map's frame in the frame of the group's first map (`None` for
+    /// maps of other groups).
+    pub poses: Vec<Option<Pose2>>,
+    /// The weakest confidence of the pairs that join it (0 for one map).
+    pub confidence: f64,
+    /// Why a map stands alone (groups of one map only): the reason of the
+    /// pair with the most net support among its pairs.
+    pub reason: Option<String>,
+    /// `false` when a pair joining it is a placement kept by hand.
+    pub verified: bool,
+}
+
+impl MapGroup {
+    fn new(tree: Joined, edges: &[(PairEdge, bool)], pairs: &[PairResult]) -> MapGroup {
+        let verified = tree
+            .edges_used
+            .iter()
+            .all(|&k| edges.get(k).is_none_or(|e| e.1));
+        let maps: Vec<usize> = (0..tree.poses.len())
+            .filter(|&i| tree.poses[i].is_some())
+            .collect();
+        let confidence = tree
+            .edges_used
+            .iter()
+            .filter_map(|&k| edges.get(k).map(|e| e.0.confidence))
+            .reduce(f64::min)
+            .unwrap_or(0.0);
+        let reason = match maps.as_slice() {
+            [only] => pairs
+                .iter()
+                .filter(|p| p.a == *only || p.b == *only)
+                .max_by(|p, q| {
+                    let s = |r: &PairResult| r.evidence.map_or(f64::MIN, |e| e.support_m);
+                    s(p).total_cmp(&s(q))
+                })
+                .map(|p| p.reason.clone()),
+            _ => None,
+        };
+        MapGroup {
+            maps,
+            poses: tree.poses,
+            confidence,
+            reason,
+            verified,
+        }
+    }
 }
 
 /// Searches and judges one pair (maps A and B, prepared as `wa`, `wb`).
@@ -233,19 +317,28 @@ pub fn merge_all(
 /// Joins `maps` along the most confident spanning tree of the merged
 /// `pairs` (see the module doc) and words the verdict.
 pub fn join(maps: &[RosMap], pairs: Vec<PairResult>) -> SavedMerge {
-    let edges: Vec<PairEdge> = pairs
+    let marked: Vec<(PairEdge, bool)> = pairs
         .iter()
         .filter(|p| p.status == MergeStatus::Merged)
         .filter_map(|p| {
-            p.pose.map(|pose| PairEdge {
-                a: p.a,
-                b: p.b,
-                pose,
-                confidence: p.confidence,
+            p.pose.map(|pose| {
+                let edge = PairEdge {
+                    a: p.a,
+                    b: p.b,
+                    pose,
+                    confidence: p.confidence,
+                };
+                (edge, p.verified)
             })
         })
         .collect();
+    let edges: Vec<PairEdge> = marked.iter().map(|e| e.0).collect();
     let joined = spanning_tree(maps.len(), &edges);
+    let verified = joined.edges_used.iter().all(|&k| marked[k].1);
+    let map_groups = groups(maps.len(), &edges)
+        .into_iter()
+        .map(|tree| MapGroup::new(tree, &marked, &pairs))
+        .collect();
     let unjoined = joined.unjoined();
     let used: Vec<&PairEdge> = joined.edges_used.iter().map(|&k| &edges[k]).collect();
     let confidence = used
@@ -297,6 +390,8 @@ pub fn join(maps: &[RosMap], pairs: Vec<PairResult>) -> SavedMerge {
         poses: joined.poses,
         unjoined,
         pairs,
+        groups: map_groups,
+        verified,
     }
 }
 
@@ -313,10 +408,60 @@ impl SavedMerge {
         *self = join(maps, pairs);
         Some(k)
     }
+
+    /// Keeps a person's placement of the pair `a`, `b` (in the order the
+    /// merge judged it): map `b`'s frame at `pose` in map `a`'s, joined as
+    /// it is, not verified. `refused` is why the tests refused it (the
+    /// refine's reason). Returns the pair's index, `None` when no such pair
+    /// was judged.
+    pub fn keep_placement(
+        &mut self,
+        maps: &[RosMap],
+        (a, b): (usize, usize),
+        pose: Pose2,
+        refused: &str,
+    ) -> Option<usize> {
+        let mut pair = PairResult::unjudged(a, b);
+        pair.status = MergeStatus::Merged;
+        pair.confidence = KEPT_CONFIDENCE;
+        pair.pose = Some(pose);
+        pair.guess = Some(pose);
+        pair.verified = false;
+        pair.reason = if refused.is_empty() {
+            "placed by hand and kept as placed, not verified".to_string()
+        } else {
+            format!(
+                "placed by hand and kept as placed, not verified (the tests refused it: {refused})"
+            )
+        };
+        self.replace_pair(maps, pair)
+    }
 }
 
 fn pose_json(p: &Pose2) -> serde_json::Value {
     json!([p.x, p.y, p.theta])
+}
+
+/// One group as the report gives it: its maps, each one's frame in the
+/// group's first map's frame, the weakest confidence joining it and, for a
+/// map alone, why.
+fn group_json<'a>(g: &MapGroup, name: &dyn Fn(usize) -> &'a str) -> serde_json::Value {
+    let transforms: Vec<_> = g
+        .poses
+        .iter()
+        .enumerate()
+        .filter_map(|(i, p)| p.map(|p| json!({ "map": name(i), "pose": pose_json(&p) })))
+        .collect();
+    let mut out = json!({
+        "maps": g.maps.iter().map(|&i| name(i)).collect::<Vec<_>>(),
+        "transforms": transforms,
+        "confidence": g.confidence,
+        "verified": g.verified,
+    });
+    if let Some(r) = &g.reason {
+        out["reason"] = json!(r);
+    }
+    out
 }
 
 fn status_name(s: MergeStatus) -> &'static str {
@@ -355,6 +500,9 @@ impl SavedMerge {
                 if let Some(g) = p.guess {
                     pair["guess"] = pose_json(&g);
                 }
+                if !p.verified {
+                    pair["verified"] = json!(false);
+                }
                 pair
             })
             .collect();
@@ -364,11 +512,13 @@ impl SavedMerge {
             })).collect::<Vec<_>>(),
             "merge": {
                 "status": status_name(self.status),
+                "verified": self.verified,
                 "reason": self.reason,
                 "confidence": self.confidence,
                 "transforms": transforms,
                 "unjoined": self.unjoined.iter().map(|&i| name(i)).collect::<Vec<_>>(),
                 "pairs": pairs,
+                "groups": self.groups.iter().map(|g| group_json(g, &name)).collect::<Vec<_>>(),
             },
         })
     }
