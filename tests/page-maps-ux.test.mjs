@@ -22,8 +22,8 @@
 // and merges them at the truth; an image alone read at 0.1 beside a YAML
 // map at 0.05 is said to merge at 0.05 (measured), and does when changed.
 // A file opened again replaces the one open.
-// The Oxford graf photograph (../shared/data/images, Mikolajczyk and
-// Schmid) opened as a map is warned about with its grey levels measured.
+// A photograph (tests/data/chelsea.png, the cat of scikit-image's sample
+// images) opened as a map is warned about with its grey levels measured.
 // One map open says to open another; a card shows the known part of its
 // map, not the unknown around it.
 //
@@ -376,15 +376,14 @@ test('your maps: a file opened again under the same name replaces the one open, 
 });
 
 test('your maps: a photograph opened as a map is warned about, with the figures measured', { timeout: 300000 }, async () => {
-  const data = process.env.SLAMLAB_DATA ?? path.join(ROOT, '..', 'shared', 'data');
-  const photo = path.join(data, 'images/oxford/graf/img1.png');
+  const photo = path.join(ROOT, 'tests', 'data', 'chelsea.png');
   const a = building('photo', 7, 0.9);
   const { context, page, problems } = await newPage(env.browser, { width: 1366, height: 768 });
   await openView(page);
   await page.setInputFiles('#real-files', [a.files[0], a.files[1], photo]);
   await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().report, null, { timeout: 120000 });
-  const warning = await page.locator('.real-card[data-map="img1.png"] .real-card-warning').innerText();
-  const m = /^img1\.png does not look like an occupancy grid \(a photograph\?\): it uses (\d+) grey levels, and its three commonest hold only (\d+) % of its pixels/.exec(warning);
+  const warning = await page.locator('.real-card[data-map="chelsea.png"] .real-card-warning').innerText();
+  const m = /^chelsea\.png does not look like an occupancy grid \(a photograph\?\): it uses (\d+) grey levels, and its three commonest hold only (\d+) % of its pixels/.exec(warning);
   assert.ok(m, warning);
   assert.ok(Number(m[1]) > 100 && Number(m[2]) < 20, warning);
   assert.equal(await page.locator('.real-card[data-map="photo-west.yaml"] .real-card-warning').count(), 0, 'a map is not warned about');
