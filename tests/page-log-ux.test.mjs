@@ -8,8 +8,13 @@
 // the map is dragged with the mouse to an early moment: its label reads
 // that moment's time, the map shown is the one the SLAM had then (fewer
 // walls than at the end, asked of the session), and no loop closure found
-// later is drawn (no orange pixel on the canvas). Start over runs the
-// log from its first scan without opening it again.
+// later is drawn (no orange pixel on the canvas); the map is cut to what
+// was seen. Start over runs the log from its first scan without opening it
+// again. Then the views: the log's map zooms about the pointer with the
+// wheel (the transform checked numerically), pans by a drag, resets, and
+// each layer hides (pixel counts); two fingers pinch it (touch events sent
+// through the DevTools protocol); the merged maps of the log cut in two
+// zoom and reset, and a robot unticked leaves no pixel of its colour.
 //
 // Needs the wasm build in web/pkg (`./build.sh build`). Run alone with
 //   node --test tests/page-log-ux.test.mjs
@@ -306,5 +311,45 @@ test('your log: the merged maps zoom with the wheel and reset; a robot unticked 
   await page.waitForTimeout(400);
   assert.equal(await pixelsNear(page, '#log-overlay', RED, 40), red, 'hall-2 shown again');
   assert.deepEqual(problems, [], 'no console errors or page errors');
+  await context.close();
+});
+
+test('your log: a pinch of two fingers zooms the map about their midpoint', { timeout: 120000 }, async () => {
+  const file = path.join(tmp, 'ring-pinch.log');
+  writeFileSync(file, ringLog({ laps: 1, perLap: 140 }).text);
+  const context = await env.browser.newContext({ viewport: { width: 1366, height: 768 }, hasTouch: true });
+  const page = await context.newPage();
+  const problems = [];
+  page.on('pageerror', (e) => problems.push(e.message));
+  await page.goto(env.baseUrl);
+  await waitReady(page);
+  await page.getByRole('button', { name: 'Your log…' }).click();
+  await page.waitForSelector('#logview:not([hidden])');
+  await page.setInputFiles('#log-file', file);
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().records === 141, null, { timeout: 60000 });
+  await page.getByRole('button', { name: 'Step', exact: true }).click();
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().done === 5);
+  await page.locator('.log-controls').evaluate((e) => e.scrollIntoView({ block: 'start' }));
+  const box = await page.locator('#log-canvas').boundingBox();
+  const mid = [Math.round(box.x + box.width / 2), Math.round(box.y + box.height / 2)];
+
+  // Two fingers 40 px apart spread to 120 px apart, in ten moves, about `mid`.
+  const cdp = await context.newCDPSession(page);
+  const fingers = (half) => [
+    { x: mid[0] - half, y: mid[1], id: 1 },
+    { x: mid[0] + half, y: mid[1], id: 2 },
+  ];
+  await cdp.send('Input.dispatchTouchEvent', { type: 'touchStart', touchPoints: fingers(20) });
+  for (let i = 1; i <= 10; i++) await cdp.send('Input.dispatchTouchEvent', { type: 'touchMove', touchPoints: fingers(20 + 4 * i) });
+  await cdp.send('Input.dispatchTouchEvent', { type: 'touchEnd', touchPoints: [] });
+  await page.waitForFunction(() => window.slamlab.logView.snapshot().view.k > 2.9);
+  const z = (await logState(page)).view;
+  assert.ok(Math.abs(z.k - 3) < 1e-9, `pinched to ${z.k}×`);
+  for (const i of [0, 1]) {
+    const local = mid[i] - [box.x, box.y][i];
+    const under = (local - [z.x, z.y][i]) / z.k;
+    assert.ok(Math.abs(under - local) < 1e-6, `the point between the fingers moved: ${under} ≠ ${local}`);
+  }
+  assert.deepEqual(problems, []);
   await context.close();
 });
