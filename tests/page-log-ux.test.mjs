@@ -25,6 +25,7 @@ import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { ARTIFACTS, ROOT, newPage, useBrowser, waitReady } from './support/browser.mjs';
 import { ringLog } from './support/synthetic-log.mjs';
+import { centredFrame, floorPlan, mapImage, mapYaml } from './support/synthetic-maps.mjs';
 
 const env = useBrowser();
 const tmp = mkdtempSync(path.join(tmpdir(), 'slamlab-page-log-ux-'));
@@ -351,5 +352,63 @@ test('your log: a pinch of two fingers zooms the map about their midpoint', { ti
     assert.ok(Math.abs(under - local) < 1e-6, `the point between the fingers moved: ${under} ≠ ${local}`);
   }
   assert.deepEqual(problems, []);
+  await context.close();
+});
+
+test('your maps: the merged overlay fills the screen, zooms about the pointer, resets; a map unticked is hidden', { timeout: 180000 }, async () => {
+  // Two maps of one 30 x 20 m floor: A sees its west part, B its east part turned by 0.9 rad.
+  const plan = floorPlan(30, 20, 7);
+  const files = [
+    ['ux-a.yaml', mapYaml('ux-a.pgm', [-2, 1, 0])],
+    ['ux-a.pgm', mapImage(plan, [-0.5, -0.5, 0], 640, 440, ([x]) => x <= 19.5)],
+    ['ux-b.yaml', mapYaml('ux-b.pgm')],
+    ['ux-b.pgm', mapImage(plan, centredFrame(18, 10, 0.9, 640, 640), 640, 640, ([x]) => x >= 9)],
+  ].map(([name, data]) => {
+    writeFileSync(path.join(tmp, name), data);
+    return path.join(tmp, name);
+  });
+  const { context, page, problems } = await newPage(env.browser, { width: 1920, height: 1080 });
+  await page.goto(env.baseUrl);
+  await waitReady(page);
+  await page.getByRole('button', { name: 'Your maps…' }).click();
+  await page.waitForSelector('#real:not([hidden])');
+  await page.setInputFiles('#real-files', files);
+  await page.waitForFunction(() => window.slamlab.savedMaps.snapshot().report, null, { timeout: 120000 });
+  assert.match(await page.locator('#real-verdict').innerText(), /^Merged/);
+  await page.locator('#real-overlay').scrollIntoViewIfNeeded();
+  await page.waitForTimeout(400);
+  const box = await page.locator('#real-overlay').boundingBox();
+  assert.ok(box.width >= 1800 && box.height >= 800, `the overlay fills the screen: ${box.width} x ${box.height} px`);
+  const zoomOf = () => page.evaluate(() => window.slamlab.savedMaps.overlay.zoom.toJSON());
+  const RED = [0xd6, 0x27, 0x28]; // the second map's colour
+  const red = async () => pixelsNear(page, '#real-overlay', RED, 40);
+  const fitted = await red();
+  assert.ok(fitted > 1000, `${fitted} pixels of the second map`);
+
+  const c = [Math.round(box.x + 0.5 * box.width), Math.round(box.y + 0.5 * box.height)];
+  await page.mouse.move(...c);
+  await page.mouse.wheel(0, -500);
+  await page.waitForFunction(() => window.slamlab.savedMaps.overlay.zoom.k > 1);
+  const z = await zoomOf();
+  assert.ok(Math.abs(z.k - Math.exp(1)) < 1e-9, `zoomed by ${z.k}`);
+  for (const i of [0, 1]) {
+    const local = c[i] - [box.x, box.y][i];
+    assert.ok(Math.abs((local - [z.x, z.y][i]) / z.k - local) < 1e-6, 'the point under the pointer stays');
+  }
+  await page.waitForTimeout(400);
+  const zoomed = await red();
+  assert.ok(zoomed > fitted * 1.2, `the second map drawn larger: ${zoomed} pixels, ${fitted} fitted`);
+  await page.locator('#real-view-reset').click();
+  await page.waitForTimeout(400);
+  assert.deepEqual(await zoomOf(), { k: 1, x: 0, y: 0 });
+  assert.equal(await red(), fitted, 'the fitted overlay again');
+
+  await page.getByLabel('ux-b.yaml', { exact: true }).uncheck();
+  await page.waitForTimeout(400);
+  assert.equal(await red(), 0, 'the second map hidden');
+  await page.getByLabel('ux-b.yaml', { exact: true }).check();
+  await page.waitForTimeout(400);
+  assert.equal(await red(), fitted, 'the second map shown again');
+  assert.deepEqual(problems, [], 'no console errors or page errors');
   await context.close();
 });

@@ -43,14 +43,15 @@ export class LogMergeView {
       b.addEventListener('click', () => saveMerge(this.download, this.report, this.files, b.dataset.file));
     }
     this.overlay.watch(() => this.draw());
-    // The user's zoom and pan (zoom.js), and Reset view beside the opacity.
-    this.zoom = new Zoom();
+    // The user's zoom and pan (zoom.js), Reset view beside the opacity, and
+    // the robots unticked in the legend: they go with each drawing.
+    this.zoom = this.overlay.zoom = new Zoom();
+    this.overlay.hidden = () => [...this.root.querySelectorAll('#log-legend input:not(:checked)')].map((c) => c.dataset.robot);
     const reset = Object.assign(document.createElement('button'), { type: 'button', id: 'log-merge-reset', textContent: 'Reset view', disabled: true });
     this.root.querySelector('#log-alpha').after(reset);
     const changed = () => {
       reset.disabled = this.zoom.isIdentity();
-      const hidden = [...this.root.querySelectorAll('#log-legend input:not(:checked)')].map((c) => c.dataset.robot);
-      this.overlay.client.request({ type: 'mergeZoom', zoom: this.zoom.toJSON(), hidden }).then(() => this.draw());
+      this.draw();
     };
     this.root.querySelector('#log-legend').addEventListener('change', changed);
     reset.addEventListener('click', () => {

@@ -39,7 +39,6 @@
 // within STEP_BUDGET_MS of work.
 // Messages in: `{id, type: 'canvas' | 'mergeCanvas' | 'open' | 'cut' |
 // 'pick' | 'step' | 'seek' | 'redraw' | 'highlight' | 'finish' | 'merge' |
-// 'mergeZoom' |
 // 'drawMerge' | 'clear', ...}`; out: `{id, ok, ...}` or `{id, ok: false,
 // error}`, and `{type: 'progress', text}` while merging, `{type:
 // 'progress', reading}` while a bag is read.
@@ -85,9 +84,6 @@ let nextLog = 1;
 let robots = [];
 let canvas = null;
 let mergeCanvas = null;
-/** The user's zoom of the merged maps (zoom.js's `{k, x, y}`), or null, and the robots whose maps and paths are hidden there. */
-let mergeZoom = null;
-let mergeHidden = [];
 let merged = null;
 
 function message(e) {
@@ -473,18 +469,13 @@ const handlers = {
     draw(data.size);
     return {};
   },
-  mergeZoom: (data) => {
-    mergeZoom = data.zoom;
-    mergeHidden = data.hidden ?? [];
-    return {};
-  },
   drawMerge: (data) => {
     if (mergeCanvas && merged?.placed) {
-      // Fitted to every joined map, so hiding one does not move the others.
-      const size = { ...data, zoom: mergeZoom };
-      const shown = (x) => !mergeHidden.includes(x.name);
-      drawPlaced(mergeCanvas, size, merged.placed.filter(shown), fitView(merged.placed, size));
-      drawMergedPaths(mergeCanvas, size, merged.placed, merged.paths.filter(shown));
+      // `data.zoom`: the user's zoom (zoom.js); `data.hidden`: the robots
+      // unticked. Fitted to every joined map, so hiding one moves no other.
+      const shown = (x) => !data.hidden?.includes(x.name);
+      drawPlaced(mergeCanvas, data, merged.placed.filter(shown), fitView(merged.placed, data));
+      drawMergedPaths(mergeCanvas, data, merged.placed, merged.paths.filter(shown));
     }
     return {};
   },

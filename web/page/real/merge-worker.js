@@ -125,7 +125,7 @@ function withFiles(report, t0) {
   report.timings_ms = { merge: t1 - t0, write: performance.now() - t1 };
   placed = report.merge.transforms
     .filter((t) => pictures.has(t.map))
-    .map((t) => ({ map: pictures.get(t.map), pose: t.pose }));
+    .map((t) => ({ map: pictures.get(t.map), pose: t.pose, name: t.map }));
   return { result: { report, files }, transfer };
 }
 
@@ -185,7 +185,11 @@ function pictureOf(i) {
 function draw(size) {
   if (!overlay || !size) return null;
   lastSize = { width: size.width, height: size.height, dpr: size.dpr, alpha: size.alpha };
-  if (!adjusting) return drawPlaced(overlay, lastSize, placed);
+  if (!adjusting) {
+    // The user's zoom over the fit of every joined map (hiding one moves none).
+    const shown = placed.filter((p) => !size.hidden?.includes(p.name));
+    return drawPlaced(overlay, { ...lastSize, zoom: size.zoom }, shown, fitView(placed, lastSize));
+  }
   const a = pictureOf(adjusting.a), b = pictureOf(adjusting.b);
   const shown = [{ map: a, pose: [0, 0, 0] }, { map: b, pose: adjusting.pose }];
   view = drawPlaced(overlay, lastSize, shown, view ?? fitView(shown, lastSize, 0.15));

@@ -81,11 +81,11 @@ function wheelPixels(e) {
 /**
  * Lets the user zoom and pan `element` (a canvas): the wheel zooms about
  * the pointer, one pointer dragging pans, two pinch. `changed()` is called
- * after each change. `canDrag(event)` may refuse a drag (the canvas uses
- * drags for something else then, as placing a map does). Returns a
- * function that removes the listeners.
+ * after each change. While `active()` is false the canvas is left alone
+ * (it uses the wheel and drags for something else then, as placing a map
+ * by hand does). Returns a function that removes the listeners.
  */
-export function attachZoom(element, zoom, changed, { canDrag = () => true } = {}) {
+export function attachZoom(element, zoom, changed, { active = () => true } = {}) {
   const dpr = () => window.devicePixelRatio || 1;
   const at = (e) => {
     const r = element.getBoundingClientRect();
@@ -93,13 +93,14 @@ export function attachZoom(element, zoom, changed, { canDrag = () => true } = {}
   };
   const pointers = new Map();
   const wheel = (e) => {
+    if (!active()) return;
     e.preventDefault();
     const [cx, cy] = at(e);
     zoom.zoomAt(cx, cy, Math.exp(-wheelPixels(e) * 0.002));
     changed();
   };
   const down = (e) => {
-    if (e.button !== 0 || !canDrag(e)) return;
+    if (e.button !== 0 || !active()) return;
     element.setPointerCapture?.(e.pointerId);
     pointers.set(e.pointerId, at(e));
     element.classList.add('panning');
