@@ -16,6 +16,9 @@
 // through the DevTools protocol); the merged maps of the log cut in two
 // zoom and reset, and a robot unticked leaves no pixel of its colour.
 //
+// Screenshots land in test-artifacts/ (issue55-scrubbed-replay.png and
+// issue55-zoomed-overlay.png are the pictures docs/ keeps).
+//
 // Needs the wasm build in web/pkg (`./build.sh build`). Run alone with
 //   node --test tests/page-log-ux.test.mjs
 import { test } from 'node:test';
@@ -23,7 +26,7 @@ import assert from 'node:assert/strict';
 import { mkdtempSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
-import { ARTIFACTS, ROOT, newPage, useBrowser, waitReady } from './support/browser.mjs';
+import { ARTIFACTS, newPage, useBrowser, waitReady } from './support/browser.mjs';
 import { ringLog } from './support/synthetic-log.mjs';
 import { centredFrame, floorPlan, mapImage, mapYaml } from './support/synthetic-maps.mjs';
 
@@ -151,7 +154,7 @@ test('your log: a replay played in × real time, scrubbed back with the mouse to
   const backOrange = await pixelsNear(page, '#log-canvas', ORANGE);
   assert.equal(backOrange, 0, 'no loop closure drawn before it was found');
   await page.screenshot({ path: path.join(ARTIFACTS, 'page-log-scrubbed.png') });
-  await page.screenshot({ path: path.join(ROOT, 'docs/issue55-scrubbed-replay.png') });
+  await page.screenshot({ path: path.join(ARTIFACTS, 'issue55-scrubbed-replay.png') });
 
   // Back to the end: the settled map and its closures again.
   await dragTimeline(page, 1);
@@ -295,7 +298,7 @@ test('your log: the merged maps zoom with the wheel and reset; a robot unticked 
   }
   await page.waitForTimeout(400);
   const zoomed = await dark();
-  await page.screenshot({ path: path.join(ROOT, 'docs/issue55-zoomed-overlay.png') });
+  await page.screenshot({ path: path.join(ARTIFACTS, 'issue55-zoomed-overlay.png') });
   assert.ok(zoomed > fitted * 1.3, `walls drawn larger: ${zoomed} dark pixels, ${fitted} fitted`);
   await page.locator('#log-merge-reset').click();
   await page.waitForFunction(() => window.slamlab.logView.snapshot().mergeView.k === 1);
