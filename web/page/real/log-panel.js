@@ -155,7 +155,7 @@ export class LogView {
     q('#log-step').addEventListener('click', () => this.stepOnce());
     this.controls = new MapControls(this.root, q('#log-canvas'), () => this.redraw());
     this.timeline = new Timeline(this.root, { seek: (t) => this.seek(t), again: () => this.enqueue(() => this.again()) });
-    q('#log-speed').addEventListener('input', () => this.showSpeed());
+    q('#log-speed').addEventListener('input', () => this.showSpeed(this.timeline.pace(false)));
     q('#log-merge').addEventListener('click', () => this.enqueue(() => this.merge()));
     for (const b of this.root.querySelectorAll('#log-map-downloads button')) {
       b.addEventListener('click', () => this.save(b.dataset.file));
@@ -201,8 +201,10 @@ export class LogView {
     return this.queue;
   }
 
-  showSpeed() {
-    this.root.querySelector('#log-speed-value').textContent = `${this.speed()}× real time`;
+  /** The speed asked for, and while playing slower than that (the SLAM cannot keep up) how fast it goes. */
+  showSpeed(pace = null) {
+    const slow = pace !== null && pace < 0.8 * this.speed() ? ` (replaying at ${pace.toFixed(pace < 10 ? 1 : 0)}×)` : '';
+    this.root.querySelector('#log-speed-value').textContent = `${this.speed()}× real time${slow}`;
   }
 
   speed() {
@@ -477,6 +479,7 @@ export class LogView {
     q('#log-clear').disabled = !s.records || this.merging;
     q('#log-merge').disabled = robots.length < 2 || this.merging;
     this.timeline.show(robots, !!this.lookingBack, s.records > 0 && !this.merging);
+    this.showSpeed(this.timeline.pace(this.playing && !s.finished));
     q('#log-name').textContent = s.name ? `${s.name}: ${s.records} laser records` : '';
     const closures = `${s.closures} loop closure${s.closures === 1 ? '' : 's'}`;
     const many = robots.length > 1 ? ` · ${robots.length} robots` : '';

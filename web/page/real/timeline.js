@@ -26,6 +26,9 @@ export const TIMELINE_HTML = `
     <button type="button" id="log-again" title="Replay the logs from their first scan, without opening them again">Start over</button>
   </div>`;
 
+/** How long a stretch of play Timeline.pace measures (ms). */
+const PACE_WINDOW_MS = 2000;
+
 /** A time in seconds as a person reads it: "42.5 s", "3 min 07 s". */
 export function clock(t) {
   if (!(t >= 0)) return '0.0 s';
@@ -96,6 +99,22 @@ export class Timeline {
       : `${clock(shown)} of ${clock(total)}${this.moment !== null ? ` · looking back (replayed to ${clock(this.live)})` : ''}`;
     const filled = total > 0 ? (100 * this.live) / total : 0;
     this.input.style.setProperty('--replayed', `${filled.toFixed(2)}%`);
+  }
+
+  /**
+   * How fast the replay's live end has moved against the wall clock over
+   * the last PACE_WINDOW_MS while `playing` (× real time), or null (not
+   * playing, or not long enough to tell).
+   */
+  pace(playing) {
+    if (!playing) {
+      this.samples = [];
+      return null;
+    }
+    const now = performance.now();
+    this.samples = [...(this.samples ?? []).filter(([t]) => now - t < PACE_WINDOW_MS), [now, this.live]];
+    const [t0, l0] = this.samples[0];
+    return now - t0 > PACE_WINDOW_MS / 2 ? (this.live - l0) / ((now - t0) / 1000) : null;
   }
 
   /** For tests and the console: the moment shown (s) or null at the live end, and the times. */
