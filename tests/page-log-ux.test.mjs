@@ -176,6 +176,20 @@ test('your log: a replay played in × real time, scrubbed back with the mouse to
   assert.equal(await page.locator('#log-time-value').innerText(), '1 min 10 s of 1 min 10 s');
   assert.ok((await pixelsNear(page, '#log-canvas', ORANGE)) > 30, 'the closures are drawn again');
 
+  // One click on the track (no drag) looks back too, and the label says when.
+  const track = await page.locator('#log-time').boundingBox();
+  await page.mouse.click(track.x + track.width / 2, track.y + track.height / 2);
+  await page.waitForFunction(() => {
+    const s = window.slamlab.logView.snapshot();
+    return !s.busy && s.robots[0].at !== null;
+  });
+  const clicked = (await logState(page)).timeline.moment;
+  assert.ok(Math.abs(clicked - 35) < 3, `clicked to ${clicked} s`);
+  assert.equal(
+    await page.locator('#log-time-value').innerText(),
+    `${clicked.toFixed(1)} s of 1 min 10 s · looking back (replayed to 1 min 10 s)`,
+  );
+
   // Start over: from the first scan, without opening the file again.
   await page.getByRole('button', { name: 'Start over' }).click();
   await page.waitForFunction(() => {

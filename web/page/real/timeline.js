@@ -82,7 +82,8 @@ export class Timeline {
   show(robots, lookingBack, can) {
     this.duration = Math.max(0, ...robots.map((r) => r.duration));
     this.live = Math.max(0, ...robots.map((r) => r.time));
-    if (!lookingBack) this.moment = null;
+    // A moment asked for and not yet shown stays (the view refreshes as it pauses for it).
+    if (!lookingBack && !this.running) this.moment = null;
     this.input.max = String(this.duration);
     this.input.disabled = !(this.live > 0);
     this.button.disabled = !can;
