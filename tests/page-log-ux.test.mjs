@@ -49,27 +49,33 @@ function watchLongTasks(page) {
 /**
  * How many pixels of the element `selector` as shown on screen are near
  * the colour `rgb` (each channel within `tol`): a screenshot of it decoded
- * in the page (the log canvas belongs to a worker, so its pixels cannot be
- * read back directly).
+ * and counted in a Web Worker of the page (the log canvas belongs to a
+ * worker, so its pixels cannot be read back directly; and the counting
+ * must not be a long task of the page's main thread, which the tests watch).
  */
 async function pixelsNear(page, selector, rgb, tol = 40) {
   const png = (await page.locator(selector).screenshot()).toString('base64');
-  return page.evaluate(
-    async ({ png, rgb, tol }) => {
-      const blob = await (await fetch(`data:image/png;base64,${png}`)).blob();
-      const bitmap = await createImageBitmap(blob);
-      const c = new OffscreenCanvas(bitmap.width, bitmap.height);
-      const ctx = c.getContext('2d');
+  return page.evaluate(({ png, rgb, tol }) => {
+    const src = `onmessage = async ({ data: { png, rgb, tol } }) => {
+      const bitmap = await createImageBitmap(await (await fetch('data:image/png;base64,' + png)).blob());
+      const ctx = new OffscreenCanvas(bitmap.width, bitmap.height).getContext('2d');
       ctx.drawImage(bitmap, 0, 0);
       const d = ctx.getImageData(0, 0, bitmap.width, bitmap.height).data;
       let n = 0;
       for (let i = 0; i < d.length; i += 4) {
         if (Math.abs(d[i] - rgb[0]) <= tol && Math.abs(d[i + 1] - rgb[1]) <= tol && Math.abs(d[i + 2] - rgb[2]) <= tol) n++;
       }
-      return n;
-    },
-    { png, rgb, tol },
-  );
+      postMessage(n);
+    };`;
+    const worker = new Worker(URL.createObjectURL(new Blob([src], { type: 'text/javascript' })));
+    return new Promise((resolve) => {
+      worker.onmessage = (e) => {
+        worker.terminate();
+        resolve(e.data);
+      };
+      worker.postMessage({ png, rgb, tol });
+    });
+  }, { png, rgb, tol });
 }
 
 /** Presses the mouse on the timeline's thumb (at its value) and drags it to `fraction` of the track. */
@@ -162,6 +168,8 @@ test('your log: a replay played in × real time, scrubbed back with the mouse to
   );
   assert.equal(r.atClosures, 0, 'no loop was closed by then');
   assert.ok(r.atWalls > 50 && r.atWalls * 2 < endWalls, `${r.atWalls} wall cells then, ${endWalls} at the end`);
+  const LIGHT = [0x9c, 0xc0, 0xe8]; // the track's replayed part after the moment shown
+  assert.ok((await pixelsNear(page, '#log-time', LIGHT, 12)) > 200, 'the track shows what was replayed after the moment');
   const backOrange = await pixelsNear(page, '#log-canvas', ORANGE);
   assert.equal(backOrange, 0, 'no loop closure drawn before it was found');
   await page.screenshot({ path: path.join(ARTIFACTS, 'page-log-scrubbed.png') });
@@ -175,6 +183,8 @@ test('your log: a replay played in × real time, scrubbed back with the mouse to
   });
   assert.equal(await page.locator('#log-time-value').innerText(), '1 min 10 s of 1 min 10 s');
   assert.ok((await pixelsNear(page, '#log-canvas', ORANGE)) > 30, 'the closures are drawn again');
+  const light = await pixelsNear(page, '#log-time', [0x9c, 0xc0, 0xe8], 12);
+  assert.ok(light < 20, `at the live end, nothing replayed lies after it (${light} pixels: the thumb's edge)`);
 
   // One click on the track (no drag) looks back too, and the label says when.
   const track = await page.locator('#log-time').boundingBox();

@@ -362,6 +362,8 @@ export class LogView {
       const out = await this.client.request({ type: 'seek', t, size: this.size() });
       this.state.robots = out.robots;
       this.lookingBack = out.robots.some((r) => r.at !== null);
+    } catch (e) {
+      this.say(e.message, 'error');
     } finally {
       this.busy = false;
     }

@@ -15,8 +15,16 @@
 export const TIMELINE_HTML = `
   <style>
     .log-timeline { display: flex; align-items: center; gap: 10px; width: 100%; margin: 0 0 8px; }
-    .log-timeline input { flex: 1; accent-color: var(--accent); height: 18px;
-      background: linear-gradient(to right, #9cc0e8 var(--replayed, 0%), transparent var(--replayed, 0%)) center / 100% 6px no-repeat; }
+    /* The track: dark up to the moment shown, light up to the live end (what was replayed), grey after. */
+    #log-time { flex: 1; -webkit-appearance: none; appearance: none; background: transparent; height: 18px; margin: 0; }
+    #log-time:disabled { opacity: 0.5; }
+    #log-time::-webkit-slider-runnable-track { height: 6px; border-radius: 3px; background: var(--track); }
+    #log-time::-moz-range-track { height: 6px; border-radius: 3px; background: var(--track); }
+    #log-time::-webkit-slider-thumb { -webkit-appearance: none; width: 16px; height: 16px; margin-top: -5px;
+      border-radius: 50%; background: #1f5fa8; border: 2px solid #fff; box-shadow: 0 0 0 1px #1f5fa8; }
+    #log-time::-moz-range-thumb { width: 12px; height: 12px; border-radius: 50%; background: #1f5fa8; border: 2px solid #fff; }
+    #log-time { --track: linear-gradient(to right, #1f5fa8 var(--shown, 0%), #9cc0e8 var(--shown, 0%),
+      #9cc0e8 var(--replayed, 0%), #d9d9d4 var(--replayed, 0%)); }
     .log-timeline output { font-size: 13px; color: var(--muted); min-width: 16em; font-variant-numeric: tabular-nums; }
   </style>
   <div class="log-timeline" role="group" aria-label="Timeline">
@@ -98,8 +106,9 @@ export class Timeline {
     this.label.textContent = !total
       ? ''
       : `${clock(shown)} of ${clock(total)}${this.moment !== null ? ` · looking back (replayed to ${clock(this.live)})` : ''}`;
-    const filled = total > 0 ? (100 * this.live) / total : 0;
-    this.input.style.setProperty('--replayed', `${filled.toFixed(2)}%`);
+    const share = (t) => `${(total > 0 ? (100 * t) / total : 0).toFixed(2)}%`;
+    this.input.style.setProperty('--replayed', share(this.live));
+    this.input.style.setProperty('--shown', share(shown));
   }
 
   /**
