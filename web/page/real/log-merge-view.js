@@ -4,7 +4,8 @@
 // robot's frame in the first robot's frame (metres, degrees, and the
 // arguments of ROS's static_transform_publisher), each pair's verdict, the
 // joined maps and the robots' paths overlaid in their colours (drawn by
-// the log worker) and the downloads: the merged map as PGM + YAML + PNG
+// the log worker; zoomed and panned with zoom.js, Reset view, a robot
+// unticked in the legend hidden) and the downloads: the merged map as PGM + YAML + PNG
 // and the transforms as JSON. The merge itself runs in the log worker (log-merge.js).
 
 import { nextFrame } from './panel.js';

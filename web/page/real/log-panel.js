@@ -9,7 +9,8 @@
 // watching the map grow, the odometry's path beside SLAM's and the loop
 // closures drawn as they are found; a timeline under the map (timeline.js)
 // looks back at any moment replayed, drawn as the SLAM had it then, and
-// Start over replays them again without opening the files; at the end
+// Start over replays them again without opening the files; the map zooms
+// and pans and its layers can be hidden (map-controls.js); at the end
 // the map is offered as ROS map_server PGM + YAML and PNG. The replay and
 // all drawing run in a Web Worker (log-worker.js, log-draw.js): the page
 // only sends requests and shows the counts, so it stays responsive. A bag
