@@ -124,7 +124,7 @@ async function picksShown(page, name) {
 
 /** Plays at the top speed until every robot has replayed all its scans. */
 async function playToEnd(page) {
-  await page.locator('#log-speed').fill('40');
+  await page.locator('#log-speed').fill('100');
   await page.getByRole('button', { name: 'Play' }).click();
   await page.waitForFunction(() => window.slamlab.logView.snapshot().finished, null, { timeout: 600000, polling: 250 });
 }

@@ -126,6 +126,20 @@ export class LogReplay {
     return JSON.parse(this.raw.relationScoreJson());
   }
 
+  /** Each scan's time (s, the log's clock) of the stretch replayed, replayed or not (Float64Array). */
+  times() {
+    return this.raw.times();
+  }
+
+  /**
+   * The replay as it was once `k` scans were replayed (1 to `done`), in
+   * the shape of `view()`: the first `k` scans at the poses the SLAM had
+   * for them then, and the loop closures found by then.
+   */
+  viewAt(k) {
+    return JSON.parse(this.raw.viewAtJson(k));
+  }
+
   // --- The results (after finish) ----------------------------------------------------
 
   /** The run-log report as an object; `timings` (ms, object or JSON text) becomes its `timings_ms`. */
@@ -158,6 +172,11 @@ export class LogReplay {
   /** Draws the live map; false before the first scan (nothing drawn). */
   drawLive() {
     return this.raw.drawLive();
+  }
+
+  /** Draws, as the live map, the first `k` scans' map at the poses they had once scan `k` was replayed. */
+  drawAt(k) {
+    this.raw.drawAt(k);
   }
 
   /** The live map's `{width, height, resolution_m, origin_m, occupied_cells, scans, dropped_updates}`; throws before `drawLive`. */

@@ -131,6 +131,29 @@ impl LogReplay {
         self.inner.draw_live()
     }
 
+    /// Each scan's time (s, the log's clock) of the stretch replayed,
+    /// replayed or not: a timeline.
+    pub fn times(&self) -> Vec<f64> {
+        self.inner.times()
+    }
+
+    /// The replay as it was once `k` scans were replayed (JSON, as
+    /// `viewJson`): the first `k` scans at the poses the SLAM had for them
+    /// then, and the loop closures found by then. Throws unless
+    /// `1 <= k <=` the scans replayed.
+    #[wasm_bindgen(js_name = viewAtJson)]
+    pub fn view_at_json(&self, k: u32) -> Result<String, JsError> {
+        to_json(&self.inner.view_at(k as usize).map_err(err)?)
+    }
+
+    /// Draws the map of the first `k` scans at the poses they had once
+    /// scan `k` was replayed, as the live map (`liveInfoJson`,
+    /// `livePixels`). Throws unless `1 <= k <=` the scans replayed.
+    #[wasm_bindgen(js_name = drawAt)]
+    pub fn draw_at(&mut self, k: u32) -> Result<(), JsError> {
+        self.inner.draw_at(k as usize).map_err(err)
+    }
+
     /// Size, resolution and origin of the live map (`MapInfo` JSON).
     #[wasm_bindgen(js_name = liveInfoJson)]
     pub fn live_info_json(&self) -> Result<String, JsError> {

@@ -11,6 +11,27 @@
 //! and the live map ([`LogReplay::draw_live`]); at the end it draws the map
 //! at the final poses and writes the report of `docs/interfaces.md`
 //! ("Real laser logs: run-log").
+//!
+//! Every map it hands out is cut to what the scans saw, plus
+//! [`CROP_MARGIN_M`] around it ([`OccupancyGrid::cropped_to_known`]): the
+//! grid grows by the laser's full reach around every pose, so uncut it
+//! would carry a wide band of unknown cells no beam ever touched.
+//!
+//! ## Looking back at an earlier moment
+//!
+//! A page that lets the user drag a timeline back to scan `k` must show
+//! what the SLAM believed *then*: the map of scans `0..k` drawn at the
+//! poses they had after scan `k`, and the loop closures found by then —
+//! not today's poses cut short. Between two loop closures the pose graph
+//! only grows (a new key node is appended, the others keep their values);
+//! only an accepted closure (and the settling at the end) moves nodes that
+//! were there before. So the session keeps one *version* of the key nodes
+//! per such move: the nodes as they were just before it, and the number of
+//! scans replayed when it happened. Scan `j`'s pose at moment `k` is then
+//! its key's node in the first version that ends after `k` (or in the
+//! graph now, past the last move), composed with the scan's pose relative
+//! to its key, which never changes. The versions cost one copy of the key
+//! nodes per loop closure ([`LogReplay::view_at`], [`LogReplay::draw_at`]).
 
 use crate::formats::bag::recording::{BagLog, Picked};
 use crate::formats::carmen::{parse_bytes, LogError};
@@ -62,8 +83,24 @@ pub struct LogReplay {
     next: usize,
     map: Option<OccupancyGrid>,
     /// The map of the scans replayed so far at their current poses, drawn
-    /// by [`LogReplay::draw_live`].
+    /// by [`LogReplay::draw_live`] (or at an earlier moment's poses, by
+    /// [`LogReplay::draw_at`]).
     live: Option<OccupancyGrid>,
+    /// The key nodes before each move of the graph, oldest first
+    /// ("Looking back at an earlier moment" above).
+    versions: Vec<NodeVersion>,
+    /// The key nodes as they are now, kept in step with the graph.
+    nodes_now: Vec<Pose2>,
+    /// For each loop closure, how many scans were replayed when it was
+    /// accepted.
+    closed_after: Vec<usize>,
+}
+
+/// The pose graph's key nodes as they were for every moment (scans
+/// replayed) before `until`.
+struct NodeVersion {
+    until: usize,
+    nodes: Vec<Pose2>,
 }
 
 /// The replay so far, for a page that animates it.
@@ -156,6 +193,15 @@ pub struct LogReport {
     pub timings_ms: serde_json::Value,
 }
 
+/// The unknown margin (m) kept around the known cells of a log's map.
+pub const CROP_MARGIN_M: f64 = 1.0;
+
+/// `grid` cut to its known cells plus [`CROP_MARGIN_M`].
+fn cropped(grid: OccupancyGrid) -> OccupancyGrid {
+    let margin = (CROP_MARGIN_M / grid.resolution_m()).ceil() as usize;
+    grid.cropped_to_known(margin)
+}
+
 /// What the report's `frame` says.
 pub const FRAME: &str =
     "log: the log's own odometry frame (the first scan replayed is placed at its odometry pose)";
@@ -204,6 +250,9 @@ impl LogReplay {
             next: 0,
             map: None,
             live: None,
+            versions: Vec::new(),
+            nodes_now: Vec::new(),
+            closed_after: Vec::new(),
         }
     }
 
@@ -274,11 +323,32 @@ impl LogReplay {
         let mut done = 0;
         while done < n && self.from + self.next <= self.to {
             let scan = &self.scans[self.from + self.next];
+            let closures = self.slam.closures.len();
             self.slam.add_scan(scan);
             self.next += 1;
             done += 1;
+            let closed = self.slam.closures.len() - closures;
+            if closed > 0 {
+                self.keep_version();
+                self.closed_after
+                    .extend(std::iter::repeat_n(self.next, closed));
+            } else {
+                let have = self.nodes_now.len();
+                let added = self.slam.graph.nodes.get(have..).unwrap_or_default();
+                self.nodes_now.extend_from_slice(added);
+            }
         }
         self.remaining()
+    }
+
+    /// Keeps the key nodes as they were before the graph moved (a loop
+    /// closure, the settling at the end), for moments before now.
+    fn keep_version(&mut self) {
+        let before = std::mem::replace(&mut self.nodes_now, self.slam.graph.nodes.clone());
+        self.versions.push(NodeVersion {
+            until: self.next,
+            nodes: before,
+        });
     }
 
     /// The laser records replayed so far (a page draws the map as it grows
@@ -294,9 +364,13 @@ impl LogReplay {
     /// Settles the pose graph and draws the map at the final poses.
     pub fn finish(&mut self) -> Result<(), String> {
         self.step(usize::MAX);
+        if self.map.is_some() {
+            return Ok(());
+        }
         self.slam.finish()?;
+        self.keep_version();
         let scans = &self.scans[self.from..=self.to];
-        self.map = Some(self.slam.build_map(scans));
+        self.map = Some(cropped(self.slam.build_map(scans)));
         Ok(())
     }
 
@@ -497,8 +571,104 @@ impl LogReplay {
         if scans.is_empty() {
             return false;
         }
-        self.live = Some(self.slam.build_map(scans));
+        self.live = Some(cropped(self.slam.build_map(scans)));
         true
+    }
+
+    /// Each scan's time (s, the log's clock) of the stretch replayed
+    /// (`from..=to`), replayed or not: a page's timeline.
+    pub fn times(&self) -> Vec<f64> {
+        self.scans
+            .get(self.from..=self.to)
+            .unwrap_or_default()
+            .iter()
+            .map(|s| s.time)
+            .collect()
+    }
+
+    /// The key nodes as the SLAM had them once `k` scans were replayed.
+    fn nodes_at(&self, k: usize) -> &[Pose2] {
+        match self.versions.iter().find(|v| v.until > k) {
+            Some(v) => &v.nodes,
+            None => &self.slam.graph.nodes,
+        }
+    }
+
+    /// Checks that `k` scans have been replayed (a moment to look back at).
+    fn moment(&self, k: usize) -> Result<usize, String> {
+        let done = self.replayed().len();
+        if k == 0 || k > done {
+            return Err(format!(
+                "moment {k}: only scans 1 to {done} have been replayed"
+            ));
+        }
+        Ok(k)
+    }
+
+    /// The poses of the first `k` scans as the SLAM had them once scan `k`
+    /// was replayed (`k` from 1 to the scans replayed).
+    pub fn poses_at(&self, k: usize) -> Result<Vec<Pose2>, String> {
+        let k = self.moment(k)?;
+        let nodes = self.nodes_at(k);
+        self.slam.scans[..k]
+            .iter()
+            .map(|s| {
+                nodes
+                    .get(s.key)
+                    .map(|n| n.compose(&s.relative))
+                    .ok_or_else(|| format!("scan {}: its key {} is missing", s.index, s.key))
+            })
+            .collect()
+    }
+
+    /// The replay as it was once `k` scans were replayed: the paths of the
+    /// first `k` scans at the poses they had then and the loop closures
+    /// found by then, between their keys' poses then.
+    pub fn view_at(&self, k: usize) -> Result<ReplayView, String> {
+        let poses = self.poses_at(k)?;
+        let nodes = self.nodes_at(k);
+        let node = |i: usize| nodes.get(i).copied().unwrap_or_default();
+        let closures = self
+            .slam
+            .closures
+            .iter()
+            .zip(&self.closed_after)
+            .filter(|(_, at)| **at <= k)
+            .map(|(c, _)| {
+                let (a, b) = (node(c.from_key), node(c.to_key));
+                ClosureView {
+                    segment: [a.x, a.y, b.x, b.y],
+                    from_scan: c.from_scan,
+                    to_scan: c.to_scan,
+                    score: c.score,
+                }
+            })
+            .collect();
+        let odometry = if self.has_odometry() {
+            self.slam.scans[..k]
+                .iter()
+                .flat_map(|s| [s.odometry.x, s.odometry.y, s.odometry.theta])
+                .collect()
+        } else {
+            Vec::new()
+        };
+        Ok(ReplayView {
+            done: k,
+            total: self.replayed().len() + self.remaining(),
+            odometry,
+            poses: poses.iter().flat_map(|p| [p.x, p.y, p.theta]).collect(),
+            closures,
+        })
+    }
+
+    /// Draws the map of the first `k` scans at the poses they had once
+    /// scan `k` was replayed, as the live map (read with
+    /// [`LogReplay::live_info`] and [`LogReplay::live_pixels`]).
+    pub fn draw_at(&mut self, k: usize) -> Result<(), String> {
+        let poses = self.poses_at(k)?;
+        let scans = &self.scans[self.from..self.from + k];
+        self.live = Some(cropped(self.slam.build_map_at(scans, &poses)));
+        Ok(())
     }
 
     fn live(&self) -> Result<&OccupancyGrid, String> {
@@ -533,4 +703,181 @@ fn truth_at(truth: &[(f64, Pose2)], t: f64) -> Option<Pose2> {
         a.y + u * (b.y - a.y),
         wrap_angle(a.theta + u * wrap_angle(b.theta - a.theta)),
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Walls `[x1, y1, x2, y2]` of a ring corridor: an outer 16 × 10 m box
+    /// round an inner block with notches, so places along it differ.
+    fn ring_walls() -> Vec<[f64; 4]> {
+        let poly = |pts: &[[f64; 2]]| -> Vec<[f64; 4]> {
+            (0..pts.len())
+                .map(|i| {
+                    let (a, b) = (pts[i], pts[(i + 1) % pts.len()]);
+                    [a[0], a[1], b[0], b[1]]
+                })
+                .collect()
+        };
+        let mut walls = poly(&[[-8.0, -5.0], [8.0, -5.0], [8.0, 5.0], [-8.0, 5.0]]);
+        walls.extend(poly(&[
+            [-5.0, -2.0],
+            [-1.0, -2.0],
+            [-1.0, -2.6],
+            [1.0, -2.6],
+            [1.0, -2.0],
+            [5.0, -2.0],
+            [5.0, 2.0],
+            [2.0, 2.0],
+            [2.0, 2.5],
+            [-3.0, 2.5],
+            [-3.0, 2.0],
+            [-5.0, 2.0],
+        ]));
+        walls.extend([
+            [6.6, -5.0, 6.6, -4.2],
+            [-8.0, 0.3, -7.3, 0.3],
+            [0.0, 5.0, 0.0, 4.3],
+        ]);
+        walls
+    }
+
+    /// The range from `(x, y)` along heading `a` to the nearest wall, or 80.
+    fn ray(walls: &[[f64; 4]], x: f64, y: f64, a: f64) -> f64 {
+        let (dx, dy) = (a.cos(), a.sin());
+        let mut best = 80.0f64;
+        for w in walls {
+            let (ex, ey) = (w[2] - w[0], w[3] - w[1]);
+            let (wx, wy) = (w[0] - x, w[1] - y);
+            let cross = dx * ey - dy * ex;
+            if cross.abs() < 1e-12 {
+                continue;
+            }
+            let along = (wx * ey - wy * ex) / cross;
+            let on = (wx * dy - wy * dx) / cross;
+            if along > 0.0 && (0.0..=1.0).contains(&on) {
+                best = best.min(along);
+            }
+        }
+        best
+    }
+
+    /// A CARMEN log of two laps round the ring, 140 scans a lap, 0.25 s
+    /// apart, its odometry turning 0.004 rad a step too far, so the second
+    /// lap meets the first displaced and a loop closure mends it.
+    fn ring_log() -> String {
+        let walls = ring_walls();
+        let pose_at = |s: f64| {
+            let u = 2.0 * std::f64::consts::PI * s.fract();
+            let (x, y) = (6.5 * u.cos(), 3.5 * u.sin());
+            (x, y, (3.5 * u.cos()).atan2(-6.5 * u.sin()))
+        };
+        let mut lines = Vec::new();
+        let mut odo = pose_at(0.0);
+        let mut last = odo;
+        for i in 0..=280 {
+            let p = pose_at(i as f64 / 140.0);
+            if i > 0 {
+                let (c, s) = (last.2.cos(), last.2.sin());
+                let (dx, dy) = (p.0 - last.0, p.1 - last.1);
+                let (fwd, side) = (c * dx + s * dy, -s * dx + c * dy);
+                let turn = wrap_angle(p.2 - last.2) + 0.004;
+                let (oc, os) = (odo.2.cos(), odo.2.sin());
+                odo = (
+                    odo.0 + oc * fwd - os * side,
+                    odo.1 + os * fwd + oc * side,
+                    odo.2 + turn,
+                );
+            }
+            last = p;
+            let ranges: Vec<String> = (0..=180)
+                .map(|b| {
+                    let a = p.2 + (b as f64 - 90.0).to_radians();
+                    format!("{:.3}", ray(&walls, p.0, p.1, a))
+                })
+                .collect();
+            let pose = format!("{:.5} {:.5} {:.5}", odo.0, odo.1, odo.2);
+            let t = 1000.0 + 0.25 * i as f64;
+            lines.push(format!(
+                "FLASER 181 {} {pose} {pose} {t:.3} sim {t:.3}",
+                ranges.join(" ")
+            ));
+        }
+        lines.join("\n")
+    }
+
+    /// Scrubbing back to scan `k` shows the trajectory exactly as the SLAM
+    /// had it then: before a loop closure moved the first lap, after it
+    /// with the move, and the map of scans `0..k` only.
+    #[test]
+    fn a_moment_looked_back_at_is_the_trajectory_the_slam_had_then() {
+        let mut replay = LogReplay::new(ring_log().as_bytes()).unwrap();
+        assert_eq!(replay.times().len(), 281);
+        assert_eq!(replay.times()[4] - replay.times()[0], 1.0);
+        let mut seen = vec![Vec::new()];
+        let mut closures_seen = vec![0];
+        while replay.step(1) > 0 {
+            seen.push(replay.slam.poses());
+            closures_seen.push(replay.slam.closures.len());
+        }
+        seen.push(replay.slam.poses());
+        closures_seen.push(replay.slam.closures.len());
+        let first = closures_seen.iter().position(|&c| c > 0);
+        let first = first.expect("the second lap closes a loop");
+        assert!(first > 100, "the first closure at scan {first}");
+        replay.finish().unwrap();
+
+        // Every moment before the end: the poses exactly as they were then.
+        for k in 1..281 {
+            let then = replay.poses_at(k).unwrap();
+            assert_eq!(then, seen[k], "the trajectory at scan {k}");
+            let view = replay.view_at(k).unwrap();
+            assert_eq!(
+                view.closures.len(),
+                closures_seen[k],
+                "closures at scan {k}"
+            );
+            assert_eq!(view.poses.len(), 3 * k);
+        }
+        // The closure moved the first lap: just before it, a scan of the
+        // first lap sat elsewhere than where the settled graph has it.
+        let before = replay.poses_at(first - 1).unwrap();
+        let end = replay.poses_at(281).unwrap();
+        let moved = before
+            .iter()
+            .zip(&end)
+            .map(|(a, b)| (a.position() - b.position()).length())
+            .fold(0.0, f64::max);
+        assert!(moved > 0.05, "the closure moved the path by {moved} m");
+        assert_eq!(end, replay.slam.poses(), "the end is the settled graph");
+
+        // The map of the first 40 scans holds a fraction of the walls.
+        replay.draw_at(40).unwrap();
+        let early = replay.live_info().unwrap().occupied_cells;
+        replay.draw_at(281).unwrap();
+        let all = replay.live_info().unwrap().occupied_cells;
+        assert!(
+            early * 3 < all,
+            "{early} walls at scan 40, {all} at the end"
+        );
+        assert!(early > 50, "{early} walls at scan 40");
+        assert!(replay.poses_at(0).is_err());
+
+        // The map is cut to what was seen plus 1 m: the ring's outer wall
+        // (16 x 10 m) and a margin of 20 cells, not the laser's 20 m+ of
+        // reach around every pose.
+        let map = replay.map().unwrap();
+        let (w, h) = (map.width() as f64 * 0.05, map.height() as f64 * 0.05);
+        assert!(
+            (17.0..=19.0).contains(&w) && (11.0..=13.0).contains(&h),
+            "{w} x {h} m"
+        );
+        let origin = map.origin_m();
+        assert!(origin.x > -9.5 && origin.y > -6.5, "origin {origin}");
+        let Err(e) = replay.view_at(282) else {
+            panic!("a moment past the replay")
+        };
+        assert!(e.contains("1 to 281"), "{e}");
+    }
 }

@@ -342,6 +342,51 @@ impl OccupancyGrid {
         self.cells.iter().filter(|&&c| c > OCCUPIED_UNITS).count()
     }
 
+    /// The grid cut down to its known cells — every cell a beam has
+    /// touched, wall or free — plus `margin` cells on each side (within
+    /// the grid): a map of what was seen rather than of the room the grid
+    /// grew to hold. Cells keep their places in the frame (the origin
+    /// moves with the cut). A grid with nothing known, or with the surface
+    /// layer ([`GridConfig::surface_points`]), comes back whole.
+    pub fn cropped_to_known(&self, margin: usize) -> OccupancyGrid {
+        let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
+        for (y, row) in self.cells.chunks_exact(self.width.max(1)).enumerate() {
+            let known = row.iter().position(|&c| c != 0);
+            if let Some(first) = known {
+                let last = row.iter().rposition(|&c| c != 0).unwrap_or(first);
+                x0 = x0.min(first);
+                x1 = x1.max(last);
+                y0 = y0.min(y);
+                y1 = y1.max(y);
+            }
+        }
+        if x0 == usize::MAX || self.config.surface_points {
+            return self.clone();
+        }
+        let (x0, y0) = (x0.saturating_sub(margin), y0.saturating_sub(margin));
+        let x1 = (x1 + margin).min(self.width - 1);
+        let y1 = (y1 + margin).min(self.height - 1);
+        let (w, h) = (x1 + 1 - x0, y1 + 1 - y0);
+        let mut cells = Vec::with_capacity(w * h);
+        for y in y0..=y1 {
+            let start = y * self.width + x0;
+            cells.extend_from_slice(&self.cells[start..start + w]);
+        }
+        OccupancyGrid {
+            config: self.config.clone(),
+            cells,
+            surface: SurfaceBlocks::default(),
+            width: w,
+            height: h,
+            origin_cell: [
+                self.origin_cell[0] + x0 as i64,
+                self.origin_cell[1] + y0 as i64,
+            ],
+            dropped_updates: self.dropped_updates,
+            scans: self.scans,
+        }
+    }
+
     /// Grows the grid to cover the box `lo..hi` (odometry frame) plus
     /// a margin. Returns false, changing nothing, if that would exceed
     /// `max_cells`.

@@ -11,10 +11,13 @@
 // fainter), and the robot's current pose. A robot's
 // poses and map share one frame (the log's odometry frame, the first scan
 // at its odometry pose); its tile fits the map's known cells and the
-// paths.
+// paths, then the user's view (zoom.js: zoomed and moved, the same for
+// every tile) is applied. The user may hide SLAM's path, the odometry's
+// and the loop closures (the request's `layers`).
 
 import { clearCanvas, fitBox } from './fit.js';
 import { outline } from './overlay.js';
+import { applyView } from './zoom.js';
 
 /** The colour of the worst relations (the page's legend uses it too). */
 export const WORST_COLOUR = '#e6007e';
@@ -64,11 +67,13 @@ function bounds(picture, view, truth) {
 /**
  * Draws one robot's replay into the tile `rect` ([left, top, width,
  * height] device pixels) of `ctx`: `robot.picture`, `robot.view`, its
- * SLAM path in `robot.colour`, its name when `label`.
+ * SLAM path in `robot.colour`, its name when `label`; `view`: the user's
+ * zoom ({k, x, y}, or null); `layers`: `{slam, odometry, closures}`, false
+ * hides one.
  */
-function drawRobot(ctx, rect, dpr, robot, label) {
-  const { picture, view, truth } = robot;
-  const box = view ? bounds(picture, view, truth) : [0, 0, 0, 0];
+function drawRobot(ctx, rect, { dpr, view, layers = {} }, robot, label) {
+  const { picture, view: replay, truth } = robot;
+  const box = replay ? bounds(picture, replay, truth) : [0, 0, 0, 0];
   if (!(box[2] > box[0])) {
     // Nothing replayed yet: the tile's name only.
     if (label) drawName(ctx, rect, dpr, robot);
@@ -78,7 +83,7 @@ function drawRobot(ctx, rect, dpr, robot, label) {
   ctx.beginPath();
   ctx.rect(...rect);
   ctx.clip();
-  const k = fitBox(ctx, box, rect, 10 * dpr);
+  const k = fitBox(ctx, box, rect, 10 * dpr) * applyView(ctx, view);
   if (picture) {
     const { info, bitmap } = picture;
     const r = info.resolution_m;
@@ -92,7 +97,7 @@ function drawRobot(ctx, rect, dpr, robot, label) {
   ctx.lineWidth = (1.5 * dpr) / k;
   ctx.setLineDash([(6 * dpr) / k, (4 * dpr) / k]);
   ctx.strokeStyle = '#7a7a7a';
-  path(ctx, view.odometry);
+  if (layers.odometry !== false) path(ctx, replay.odometry);
   if (truth?.poses.length) {
     ctx.setLineDash([0.1 / k, (5 * dpr) / k]);
     ctx.lineCap = 'round';
@@ -104,13 +109,13 @@ function drawRobot(ctx, rect, dpr, robot, label) {
   ctx.setLineDash([]);
   ctx.lineWidth = (2 * dpr) / k;
   ctx.strokeStyle = robot.colour;
-  path(ctx, view.poses);
-  drawClosures(ctx, view.closures, k, dpr);
-  if (robot.relations?.worst.length) drawWorst(ctx, view.poses, robot.relations.worst, robot.highlight ?? -1, k, dpr);
-  const n = view.poses.length;
+  if (layers.slam !== false) path(ctx, replay.poses);
+  if (layers.closures !== false) drawClosures(ctx, replay.closures, k, dpr);
+  if (robot.relations?.worst.length) drawWorst(ctx, replay.poses, robot.relations.worst, robot.highlight ?? -1, k, dpr);
+  const n = replay.poses.length;
   if (n) {
     ctx.beginPath();
-    ctx.arc(view.poses[n - 3], view.poses[n - 2], (5 * dpr) / k, 0, 2 * Math.PI);
+    ctx.arc(replay.poses[n - 3], replay.poses[n - 2], (5 * dpr) / k, 0, 2 * Math.PI);
     ctx.fillStyle = '#c81414';
     ctx.fill();
   }
@@ -244,7 +249,8 @@ function label(ctx, taken, text, x, y, dpr, strong) {
  * device pixels): one robot fills it; several share it in a grid of tiles,
  * each in its own frame (they are not joined until the merge), named.
  */
-export function drawReplays(canvas, { width, height, dpr }, robots) {
+export function drawReplays(canvas, size, robots) {
+  const { width, height, dpr } = size;
   const ctx = clearCanvas(canvas, width, height, '#e6e6e1');
   const n = robots.length;
   if (!n) return;
@@ -256,17 +262,18 @@ export function drawReplays(canvas, { width, height, dpr }, robots) {
   for (const [i, robot] of robots.entries()) {
     const rect = [(i % across) * w, Math.floor(i / across) * h, w, h];
     if (n > 1) ctx.strokeRect(...rect);
-    drawRobot(ctx, rect, dpr, robot, n > 1);
+    drawRobot(ctx, rect, size, robot, n > 1);
   }
 }
 
 /**
  * Draws `paths` ([{colour, flat}], log-merge.js's `mergedPaths`) over the
  * merged maps that overlay.js's `drawPlaced` drew into `canvas`: the same
- * box (the joined maps' known cells) fitted the same way, so the paths
- * fall on their maps; each path in its robot's colour, its start a dot.
+ * box (the joined maps' known cells) fitted the same way, and the same
+ * `zoom`, so the paths fall on their maps; each path in its robot's
+ * colour, its start a dot.
  */
-export function drawMergedPaths(canvas, { width, height, dpr }, placed, paths) {
+export function drawMergedPaths(canvas, { width, height, dpr, zoom = null }, placed, paths) {
   if (!placed.length) return;
   const b = [Infinity, Infinity, -Infinity, -Infinity];
   for (const { map, pose } of placed) {
@@ -276,7 +283,7 @@ export function drawMergedPaths(canvas, { width, height, dpr }, placed, paths) {
   }
   const ctx = canvas.getContext('2d');
   ctx.save();
-  const k = fitBox(ctx, b, [0, 0, width, height], 8 * dpr);
+  const k = fitBox(ctx, b, [0, 0, width, height], 8 * dpr) * applyView(ctx, zoom);
   ctx.lineJoin = 'round';
   ctx.lineWidth = (2 * dpr) / k;
   for (const { colour, flat } of paths) {

@@ -92,7 +92,7 @@ export async function placedMaps({ savedMaps, report }, robots) {
     const info = savedMaps.mapInfo(i);
     const { thumb, ...preview } = await previewOf(savedMaps.mapPixels(i), info.width, info.height, robots[i].colour);
     thumb.close();
-    placed.push({ map: { ...info, preview }, pose: t.pose });
+    placed.push({ map: { ...info, preview }, pose: t.pose, name: robots[i].name });
   }
   return placed;
 }
@@ -108,7 +108,7 @@ export function mergedPaths(report, robots) {
     const r = robots.find((x) => `${x.name}.yaml` === t.map);
     if (!r?.report) continue;
     const to = compose(t.pose, inverse(r.report.scans[0].pose));
-    out.push({ colour: r.colour, flat: r.report.scans.flatMap((s) => compose(to, s.pose)) });
+    out.push({ name: r.name, colour: r.colour, flat: r.report.scans.flatMap((s) => compose(to, s.pose)) });
   }
   return out;
 }

@@ -4,9 +4,13 @@
 // A view over the lab, like "Your maps": the user opens a log (.log, .clf,
 // gzip or not) or a ROS bag (a ROS 1 .bag, an .mcap, a rosbag2 .db3 or
 // folder), by the picker or a drop, and replays it through the lab's log SLAM
-// (scan matching, pose graph, loop closures) with Play, Pause, Step and a
-// speed (scans per step), watching the map grow, the odometry's path
-// beside SLAM's and the loop closures drawn as they are found; at the end
+// (scan matching, pose graph, loop closures) with Play, Pause, Step (five
+// scans) and a speed in × real time (the log's seconds per second),
+// watching the map grow, the odometry's path beside SLAM's and the loop
+// closures drawn as they are found; a timeline under the map (timeline.js)
+// looks back at any moment replayed, drawn as the SLAM had it then, and
+// Start over replays them again without opening the files; the map zooms
+// and pans and its layers can be hidden (map-controls.js); at the end
 // the map is offered as ROS map_server PGM + YAML and PNG. The replay and
 // all drawing run in a Web Worker (log-worker.js, log-draw.js): the page
 // only sends requests and shows the counts, so it stays responsive. A bag
@@ -32,7 +36,14 @@ import { LogMergeView, MERGE_HTML } from './log-merge-view.js';
 import { WORST_COLOUR } from './log-draw.js';
 import { MAP_COLOURS } from './panel.js';
 import { RELATIONS_HTML, RelationsView } from './relations-view.js';
+import { MapControls, MAP_CONTROLS_HTML } from './map-controls.js';
+import { Timeline, TIMELINE_HTML } from './timeline.js';
 import { ErrorPlot } from './truth-plot.js';
+
+/** Scans a press of Step replays. */
+const STEP_SCANS = 5;
+/** The longest wall-clock time one play step accounts for (s): a replay slower than asked does not run behind its clock. */
+const MAX_TICK_S = 0.25;
 
 const HTML = `
   <div class="real-head">
@@ -69,13 +80,14 @@ const HTML = `
   <div class="real-merge-row log-controls" role="group" aria-label="Replay">
     <button type="button" id="log-play" class="primary">Play</button>
     <button type="button" id="log-pause">Pause</button>
-    <button type="button" id="log-step" title="One step of as many scans as the speed says">Step</button>
+    <button type="button" id="log-step" title="The next ${STEP_SCANS} scans">Step</button>
     <label for="log-speed">Speed</label>
-    <input id="log-speed" type="range" min="1" max="40" value="5" aria-label="Scans per step">
-    <output id="log-speed-value" for="log-speed">5 scans a step</output>
+    <input id="log-speed" type="range" min="1" max="100" value="10" aria-label="Speed, times real time">
+    <output id="log-speed-value" for="log-speed">10× real time</output>
     <span id="log-progress" class="real-stage" aria-live="polite"></span>
   </div>
-  <canvas id="log-canvas" class="real-overlay" aria-label="The map as it grows, the odometry and SLAM paths, and the loop closures"></canvas>
+  ${MAP_CONTROLS_HTML}
+  <canvas id="log-canvas" class="real-overlay" aria-label="The map as it grows, the odometry and SLAM paths, and the loop closures"></canvas>${TIMELINE_HTML}
   <p class="real-legend"><span id="log-odom-key" class="real-swatch" style="--c:#7a7a7a">odometry</span>
     <span class="real-swatch" style="--c:#1f77b4">SLAM (in the robot's colour)</span>
     <span class="real-swatch" style="--c:#e07b00">loop closure</span>
@@ -142,7 +154,9 @@ export class LogView {
     q('#log-play').addEventListener('click', () => this.play());
     q('#log-pause').addEventListener('click', () => this.pause());
     q('#log-step').addEventListener('click', () => this.stepOnce());
-    q('#log-speed').addEventListener('input', () => this.showSpeed());
+    this.controls = new MapControls(this.root, q('#log-canvas'), () => this.redraw());
+    this.timeline = new Timeline(this.root, { seek: (t) => this.seek(t), again: () => this.enqueue(() => this.again()) });
+    q('#log-speed').addEventListener('input', () => this.showSpeed(this.timeline.pace(false)));
     q('#log-merge').addEventListener('click', () => this.enqueue(() => this.merge()));
     for (const b of this.root.querySelectorAll('#log-map-downloads button')) {
       b.addEventListener('click', () => this.save(b.dataset.file));
@@ -188,9 +202,10 @@ export class LogView {
     return this.queue;
   }
 
-  showSpeed() {
-    const n = this.speed();
-    this.root.querySelector('#log-speed-value').textContent = `${n} scan${n > 1 ? 's' : ''} a step`;
+  /** The speed asked for, and while playing slower than that (the SLAM cannot keep up) how fast it goes. */
+  showSpeed(pace = null) {
+    const slow = pace !== null && pace < 0.8 * this.speed() ? ` (replaying at ${pace.toFixed(pace < 10 ? 1 : 0)}×)` : '';
+    this.root.querySelector('#log-speed-value').textContent = `${this.speed()}× real time${slow}`;
   }
 
   speed() {
@@ -216,6 +231,7 @@ export class LogView {
       width: Math.max(1, Math.round(canvas.clientWidth * dpr)),
       height: Math.max(1, Math.round(canvas.clientHeight * dpr)),
       dpr,
+      ...this.controls.request(),
     };
   }
 
@@ -304,12 +320,28 @@ export class LogView {
     await this.client.request({ type: 'step', n: 0, size: this.size() }).catch(() => {});
   }
 
-  /** One step of `speed` scans of every robot; at the end, settles the graphs and offers the maps. */
-  async advance() {
+  /**
+   * One step of every robot: `STEP_SCANS` scans, or while playing the
+   * scans up to the log's clock (`this.until`, s from each robot's first
+   * scan), which runs at the speed (× real time) since the last step; at
+   * the end, settles the graphs and offers the maps.
+   */
+  async advance(playing) {
     if (this.busy || !this.state.records || this.state.finished) return;
     this.busy = true;
     try {
-      const out = await this.client.request({ type: 'step', n: this.speed(), size: this.size() });
+      let ask = { n: STEP_SCANS };
+      if (playing) {
+        const now = performance.now();
+        const live = this.timeline.live;
+        const ahead = this.speed() * MAX_TICK_S;
+        const clock = Math.min(this.until ?? live, live + ahead);
+        this.until = clock + this.speed() * Math.min(MAX_TICK_S, (now - this.tick) / 1000);
+        this.tick = now;
+        ask = { until: this.until };
+      }
+      const out = await this.client.request({ type: 'step', ...ask, size: this.size() });
+      this.lookingBack = false;
       Object.assign(this.state, out);
       if (out.left === 0) await this.finish();
     } catch (e) {
@@ -319,6 +351,36 @@ export class LogView {
       this.busy = false;
     }
     this.refresh();
+  }
+
+  /** Shows every robot at `t` s after its first scan (timeline.js). */
+  async seek(t) {
+    if (!this.state.records) return;
+    this.pause();
+    while (this.busy) await new Promise((r) => setTimeout(r, 20));
+    this.busy = true;
+    try {
+      const out = await this.client.request({ type: 'seek', t, size: this.size() });
+      this.state.robots = out.robots;
+      this.lookingBack = out.robots.some((r) => r.at !== null);
+    } catch (e) {
+      this.say(e.message, 'error');
+    } finally {
+      this.busy = false;
+    }
+    this.refresh();
+  }
+
+  /** Replays every log again from its first scan (the files are not read again), and plays. */
+  async again() {
+    if (!this.state.records) return;
+    await this.idle();
+    const out = await this.client.request({ type: 'cut', cut: this.cut(), colours: MAP_COLOURS });
+    this.restart(out);
+    this.lookingBack = false;
+    this.refresh();
+    await this.client.request({ type: 'step', n: 0, size: this.size() });
+    this.play();
   }
 
   async finish() {
@@ -368,11 +430,14 @@ export class LogView {
   play() {
     if (!this.state.records || this.state.finished || this.merging) return;
     this.playing = true;
+    this.tick = performance.now();
+    this.until = null;
     const loop = async () => {
       if (!this.playing) return;
-      await this.advance();
-      // The next step in a fresh task, after the page has drawn.
-      if (this.playing) setTimeout(loop, 0);
+      await this.advance(true);
+      // The next step in a fresh task, after the page has drawn; the
+      // log's clock moves on meanwhile.
+      if (this.playing) setTimeout(loop, 15);
     };
     loop();
     this.refresh();
@@ -395,8 +460,8 @@ export class LogView {
   }
 
   redraw() {
-    if (!this.state.records || this.root.hidden) return;
-    this.client.request({ type: 'redraw', size: this.size() }).catch((e) => this.say(e.message, 'error'));
+    if (!this.state.records || this.root.hidden) return Promise.resolve();
+    return this.client.request({ type: 'redraw', size: this.size() }).catch((e) => this.say(e.message, 'error'));
   }
 
   say(text, kind) {
@@ -416,6 +481,8 @@ export class LogView {
     q('#log-step').disabled = !can || this.playing;
     q('#log-clear').disabled = !s.records || this.merging;
     q('#log-merge').disabled = robots.length < 2 || this.merging;
+    this.timeline.show(robots, !!this.lookingBack, s.records > 0 && !this.merging);
+    this.showSpeed(this.timeline.pace(this.playing && !s.finished));
     q('#log-name').textContent = s.name ? `${s.name}: ${s.records} laser records` : '';
     const closures = `${s.closures} loop closure${s.closures === 1 ? '' : 's'}`;
     const many = robots.length > 1 ? ` · ${robots.length} robots` : '';
@@ -482,6 +549,10 @@ export class LogView {
       merging: !!this.merging,
       summary: this.summary ?? null,
       merge: this.merged.report,
+      timeline: this.timeline.snapshot(),
+      view: this.controls.zoom.toJSON(),
+      mergeView: this.merged.zoom?.toJSON() ?? null,
+      layers: this.controls.layers(),
     };
   }
 }

@@ -29,8 +29,16 @@
 // replayed so far against it (at most every RELATIONS_EVERY_MS while
 // playing); the worst relations are drawn on the robot's tile, and
 // `highlight` picks one of them to draw stronger.
+// The page's timeline (timeline.js) looks back at any moment of what has
+// been replayed: `seek` draws each robot as its SLAM had it then (the map
+// of the scans up to that moment at the poses they had then, the paths
+// and the loop closures found by then; web/log-replay.js's `viewAt` and
+// `drawAt`), until the next step returns to the live end. Play asks for
+// the scans `until` a time of the log's clock (s from each robot's first
+// scan; the page runs that clock at its speed in × real time), replayed
+// within STEP_BUDGET_MS of work.
 // Messages in: `{id, type: 'canvas' | 'mergeCanvas' | 'open' | 'cut' |
-// 'pick' | 'step' | 'redraw' | 'highlight' | 'finish' | 'merge' |
+// 'pick' | 'step' | 'seek' | 'redraw' | 'highlight' | 'finish' | 'merge' |
 // 'drawMerge' | 'clear', ...}`; out: `{id, ok, ...}` or `{id, ok: false,
 // error}`, and `{type: 'progress', text}` while merging, `{type:
 // 'progress', reading}` while a bag is read.
@@ -42,10 +50,12 @@ import { readBag, sortFiles } from './bag-read.js';
 import { drawMergedPaths, drawReplays, mapPicture } from './log-draw.js';
 import { mergedPaths, mergeRobots, placedMaps, stretches } from './log-merge.js';
 import { firstScanTime, matchRelations, relationFigures, relationsText, setRelations, splitRelations } from './log-relations.js';
-import { drawPlaced } from './overlay.js';
+import { drawPlaced, fitView } from './overlay.js';
 
 const ready = init();
 const MAP_EVERY_MS = 400;
+/** The most work one step `until` a time does (ms) before it answers. */
+const STEP_BUDGET_MS = 150;
 /** How often a playing replay is scored against its relations. */
 const RELATIONS_EVERY_MS = 300;
 /** The most robots at once (the merge's limit). */
@@ -64,10 +74,12 @@ let logs = [];
 let nextLog = 1;
 /**
  * `{name, log, logId, from, to, whole, colour, replay, picture, view, truth,
- * showTruth, mapAt, finished, summary, relations, relationsAt, highlight}`
- * (`whole`: it replays all of its log; `relations`: log-relations.js's
- * `relationFigures`; `highlight`: which of its worst relations to draw
- * stronger, or -1).
+ * showTruth, mapAt, finished, summary, relations, relationsAt, highlight,
+ * times, at, atView, atPicture}` (`whole`: it replays all of its log;
+ * `relations`: log-relations.js's `relationFigures`; `highlight`: which of
+ * its worst relations to draw stronger, or -1; `times`: each scan's time,
+ * s from its first; `at`: the moment looked back at, in scans, or null at
+ * the live end, drawn from `atView` and `atPicture`).
  */
 let robots = [];
 let canvas = null;
@@ -146,9 +158,12 @@ function robotOf(log, name, colour, from, to) {
     throw e;
   }
   const showTruth = !!log.bag && !log.truthHidden;
+  const clock = replay.times();
+  const times = clock.map((t) => t - clock[0]);
   return {
     name, log: log.name, logId: log.id, from, to, colour, replay, showTruth, truth: null, picture: null, view: null, mapAt: -Infinity, finished: false,
     whole: from === 0 && to >= log.records - 1, relations: null, relationsAt: -Infinity, highlight: -1,
+    times, start: clock[0] ?? 0, at: null, atView: null, atPicture: null,
   };
 }
 
@@ -156,9 +171,11 @@ function robotOf(log, name, colour, from, to) {
 function describe() {
   return {
     records: logs.reduce((s, l) => s + l.records, 0),
-    robots: robots.map(({ name, log, logId, from, to, whole, colour, finished, summary, view, truth, relations }) => ({
+    robots: robots.map(({ name, log, logId, from, to, whole, colour, finished, summary, view, truth, relations, times, at, atView, atPicture }) => ({
       name, log, logId, from, to, whole, colour, finished, summary: summary ?? null,
       done: view?.done ?? 0, total: to - from + 1, closures: view?.closures.length ?? 0,
+      time: view?.done ? times[view.done - 1] : 0, duration: times[times.length - 1] ?? 0,
+      at, atTime: at ? times[at - 1] : null, atClosures: at ? atView.closures.length : null, atWalls: at ? atPicture.info.occupied_cells : null,
       truth: truth ? { ate_m: truth.ate_m, errors: truth.errors } : null,
       relations,
     })),
@@ -312,14 +329,76 @@ async function refreshMap(robot, force) {
   robot.drawnDone = done;
 }
 
-function draw(size) {
-  if (canvas) drawReplays(canvas, size, robots);
+/** Each robot as drawn: at the moment looked back at, or at the live end. */
+function shown(r) {
+  if (r.at === null) return r;
+  const truth = r.truth && cutTruth(r.truth, r.start + r.times[r.at - 1]);
+  return { ...r, view: r.atView, picture: r.atPicture, truth };
 }
 
-async function step({ n, size }) {
-  let left = 0;
+/** A truth view (`{poses, errors}`) cut to the poses at or before log time `until`. */
+function cutTruth(truth, until) {
+  let n = 0;
+  while (2 * n < truth.errors.length && truth.errors[2 * n] <= until) n++;
+  return { ...truth, poses: truth.poses.slice(0, 3 * n), errors: truth.errors.slice(0, 2 * n) };
+}
+
+function draw(size) {
+  if (canvas) drawReplays(canvas, size, robots.map(shown));
+}
+
+/** How many scans of `times` (s from the first) lie at or before `t`. */
+function scansUntil(times, t) {
+  let [lo, hi] = [0, times.length];
+  while (lo < hi) {
+    const mid = (lo + hi) >> 1;
+    if (times[mid] <= t + 1e-9) lo = mid + 1;
+    else hi = mid;
+  }
+  return lo;
+}
+
+/**
+ * Shows every robot at `t` s after its first scan (each drawn as its SLAM
+ * had it once its last scan at or before `t` was replayed), or at its live
+ * end when it has not replayed that far.
+ */
+async function seek({ t, size }) {
   for (const r of robots) {
-    const rest = r.replay.step(n);
+    const done = r.view?.done ?? 0;
+    const k = Math.max(1, scansUntil(r.times, t));
+    if (!done || k >= done) {
+      r.at = null;
+      continue;
+    }
+    if (r.at === k) continue;
+    r.atView = r.replay.viewAt(k);
+    r.replay.drawAt(k);
+    r.atPicture = await mapPicture(r.replay.livePixels(), r.replay.liveInfo());
+    r.at = k;
+  }
+  draw(size);
+  return describe();
+}
+
+/**
+ * Replays `robot`'s scans up to `until` s after its first, one at a time,
+ * while performance.now() is before `deadline`; returns how many scans of
+ * its stretch are left.
+ */
+function stepUntil(robot, until, deadline) {
+  const n = scansUntil(robot.times, until) - (robot.view?.done ?? 0);
+  let rest = robot.replay.step(0);
+  for (let i = 0; i < n && rest > 0 && performance.now() < deadline; i++) rest = robot.replay.step(1);
+  return rest;
+}
+
+async function step({ n, until, size }) {
+  let left = 0;
+  const deadline = performance.now() + STEP_BUDGET_MS;
+  for (const r of robots) {
+    r.at = null;
+    const rest = until === undefined ? r.replay.step(n) : stepUntil(r, until, deadline);
     left += rest;
     r.view = r.replay.view();
     r.truth = r.showTruth ? r.replay.truth() : null;
@@ -380,6 +459,7 @@ const handlers = {
   cut: (data) => (logs.length ? layout(data.cut, data.colours) : describe()),
   pick: (data) => pick(data),
   step: async (data) => step(data),
+  seek: async (data) => seek(data),
   redraw: (data) => {
     draw(data.size);
     return {};
@@ -391,8 +471,11 @@ const handlers = {
   },
   drawMerge: (data) => {
     if (mergeCanvas && merged?.placed) {
-      drawPlaced(mergeCanvas, data, merged.placed);
-      drawMergedPaths(mergeCanvas, data, merged.placed, merged.paths);
+      // `data.zoom`: the user's zoom (zoom.js); `data.hidden`: the robots
+      // unticked. Fitted to every joined map, so hiding one moves no other.
+      const shown = (x) => !data.hidden?.includes(x.name);
+      drawPlaced(mergeCanvas, data, merged.placed.filter(shown), fitView(merged.placed, data));
+      drawMergedPaths(mergeCanvas, data, merged.placed, merged.paths.filter(shown));
     }
     return {};
   },

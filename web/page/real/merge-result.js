@@ -150,6 +150,9 @@ export class OverlayCanvas {
       height: Math.max(1, Math.round(canvas.clientHeight * dpr)),
       dpr,
       alpha: this.root.querySelector(`#${this.p}-alpha`).value / 100,
+      // The user's zoom (zoom.js) and the maps unticked, when the view offers them.
+      zoom: this.zoom?.toJSON() ?? null,
+      hidden: this.hidden?.() ?? [],
     };
     this.drawing = true;
     this.client

@@ -204,7 +204,7 @@ function withFiles(report, t0) {
 /** The overlay's placing: the shown group's maps in its first map's frame. */
 function place() {
   const transforms = lastReport?.merge.groups?.[shownGroup]?.transforms ?? lastReport?.merge.transforms ?? [];
-  placed = transforms.filter((t) => pictures.has(t.map)).map((t) => ({ map: pictures.get(t.map), pose: t.pose }));
+  placed = transforms.filter((t) => pictures.has(t.map)).map((t) => ({ map: pictures.get(t.map), pose: t.pose, name: t.map }));
 }
 
 self.onmessage = async ({ data }) => {
@@ -276,7 +276,11 @@ function pictureOf(i) {
 function draw(size) {
   if (!overlay || !size) return null;
   lastSize = { width: size.width, height: size.height, dpr: size.dpr, alpha: size.alpha };
-  if (!adjusting) return drawPlaced(overlay, lastSize, placed);
+  if (!adjusting) {
+    // The user's zoom over the fit of every joined map (hiding one moves none).
+    const shown = placed.filter((p) => !size.hidden?.includes(p.name));
+    return drawPlaced(overlay, { ...lastSize, zoom: size.zoom }, shown, fitView(placed, lastSize));
+  }
   const a = pictureOf(adjusting.a), b = pictureOf(adjusting.b);
   const shown = [{ map: a, pose: [0, 0, 0] }, { map: b, pose: adjusting.pose }];
   const fitted = adjusting.judged ? [...shown, { map: b, pose: adjusting.judged }] : shown;

@@ -13,6 +13,7 @@
 // that agree show dark and a wall only one map has keeps its colour.
 
 import { clearCanvas } from './fit.js';
+import { applyView } from './zoom.js';
 
 /** `a ∘ b` for poses [x, y, theta]. */
 export function compose([ax, ay, at], [bx, by, bt]) {
@@ -94,19 +95,21 @@ export function fitView(placed, { width, height, dpr }, spare = 0) {
  * common frame) into `canvas` (an OffscreenCanvas of the merge worker,
  * `width` x `height` device pixels, `dpr` of them a CSS pixel); `alpha`
  * the maps' opacity. `view` (from `fitView`) keeps the view still while a
- * map is dragged; without it the maps are fitted in. Returns the view used.
+ * map is dragged; without it the maps are fitted in. `zoom` ({k, x, y},
+ * zoom.js) is the user's zoom and pan over that view. Returns the view used.
  */
-export function drawPlaced(canvas, { width, height, dpr, alpha }, placed, view = null) {
+export function drawPlaced(canvas, { width, height, dpr, alpha, zoom = null }, placed, view = null) {
   const ctx = clearCanvas(canvas, width, height, '#fff');
   if (!placed.length) return null;
   const v = view && view.width === width && view.height === height ? view : fitView(placed, { width, height, dpr });
   ctx.setTransform(v.k, 0, 0, -v.k, v.e, v.f);
+  const z = applyView(ctx, zoom);
   ctx.globalAlpha = alpha;
   // Multiplied colours: where two maps' walls fall on each other they show dark.
   ctx.globalCompositeOperation = 'multiply';
   for (const { map, pose } of placed) drawMap(ctx, map, pose);
   ctx.globalCompositeOperation = 'source-over';
   ctx.globalAlpha = 1;
-  scaleBar(ctx, v.k, height, dpr);
+  scaleBar(ctx, v.k * z, height, dpr);
   return v;
 }

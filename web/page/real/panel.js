@@ -20,6 +20,7 @@ import { scaleHintText } from './scale-probe.js';
 import { SavedMapsClient } from './client.js';
 import { MapGroupsView, showsGroups } from './map-groups.js';
 import { OverlayCanvas, mergeHtml, saveMerge, showMerge, swatch } from './merge-result.js';
+import { attachZoom, Zoom } from './zoom.js';
 
 /** One colour per map (up to 16), told apart on white. */
 export const MAP_COLOURS = [
@@ -124,7 +125,30 @@ export class SavedMapsView {
       b.addEventListener('click', () => this.save(b.dataset.file));
     }
     this.overlay.watch(() => this.drawOverlay());
+    this.zoomable(q('#real-overlay'));
     this.refresh();
+  }
+
+  /**
+   * The merged overlay zooms with the wheel or a pinch and pans by a drag
+   * (zoom.js), but not while a map is placed by hand (its drags move the
+   * map); Reset view fits it again; a map unticked in the legend is hidden.
+   */
+  zoomable(canvas) {
+    const zoom = (this.overlay.zoom = new Zoom());
+    const reset = Object.assign(document.createElement('button'), { type: 'button', id: 'real-view-reset', textContent: 'Reset view', disabled: true });
+    this.root.querySelector('#real-alpha').after(reset);
+    const changed = () => {
+      reset.disabled = zoom.isIdentity();
+      this.drawOverlay();
+    };
+    reset.addEventListener('click', () => {
+      zoom.reset();
+      changed();
+    });
+    attachZoom(canvas, zoom, changed, { active: () => !this.adjust.active });
+    this.overlay.hidden = () => [...this.root.querySelectorAll('#real-legend input:not(:checked)')].map((c) => c.dataset.map);
+    this.root.querySelector('#real-legend').addEventListener('change', () => this.drawOverlay());
   }
 
   toggle(open) {
@@ -380,9 +404,18 @@ export class SavedMapsView {
     if (!this.report) return;
     const byName = new Map(this.maps.map((m) => [m.name, m]));
     const placed = this.placedTransforms().filter((t) => byName.has(t.map)).map((t) => ({ map: byName.get(t.map) }));
+    const hidden = this.overlay.hidden?.() ?? [];
     legend.replaceChildren(
-      ...placed.map(({ map }) => swatch(map.colour, map.name)),
-      placed.length > 1 ? 'Walls of two maps that fall on each other show dark.' : '',
+      ...placed.map(({ map }) => {
+        const label = document.createElement('label');
+        label.className = 'real-swatch';
+        label.style.setProperty('--c', map.colour);
+        const box = Object.assign(document.createElement('input'), { type: 'checkbox', checked: !hidden.includes(map.name) });
+        box.dataset.map = map.name;
+        label.append(box, ` ${map.name}`);
+        return label;
+      }),
+      placed.length > 1 ? 'Walls of two maps that fall on each other show dark. Untick a map to hide it.' : '',
     );
   }
 

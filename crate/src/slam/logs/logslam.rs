@@ -749,16 +749,23 @@ impl LogSlam {
     /// fits in [`MAP_MAX_CELLS`] ([`map_resolution`]): a campus toured
     /// outdoors is mapped whole at 10 cm rather than cut off at 5 cm.
     pub fn build_map(&self, scans: &[LogScan]) -> OccupancyGrid {
+        self.build_map_at(scans, &self.poses())
+    }
+
+    /// Draws the occupancy grid of `scans` as [`LogSlam::build_map`] does,
+    /// but at `poses` (one per scan, in the same order): the trajectory as
+    /// the SLAM had it at an earlier moment of the replay. Draws as many
+    /// scans as both lists hold.
+    pub fn build_map_at(&self, scans: &[LogScan], poses: &[Pose2]) -> OccupancyGrid {
         let reach = self.config.match_range_m.max(self.config.free_range_m);
-        let count = self.scans.len().min(scans.len());
-        let positions = (0..count).map(|k| self.scan_pose(k).position());
+        let count = poses.len().min(scans.len());
+        let positions = poses[..count].iter().map(|p| p.position());
         let config = GridConfig {
             resolution_m: map_resolution(self.config.resolution_m, positions, reach, MAP_MAX_CELLS),
             max_cells: MAP_MAX_CELLS,
             ..GridConfig::default()
         };
-        let poses = (0..count).map(|k| self.scan_pose(k));
-        OccupancyGrid::drawn_at(config, poses, |grid, k, pose| {
+        OccupancyGrid::drawn_at(config, poses[..count].iter().copied(), |grid, k, pose| {
             let scan = &scans[k];
             let c = pose.position();
             grid.ensure_contains(c - reach, c + reach);
