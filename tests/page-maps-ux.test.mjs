@@ -196,7 +196,7 @@ test('your maps: maps of two buildings merge into two groups, each with its tran
   await page.locator('#real-verdict').evaluate((e) => e.scrollIntoView({ block: 'start' }));
   await tabs.nth(1).click();
   await page.waitForTimeout(300);
-  await page.screenshot({ path: path.join(ROOT, 'docs/issue55-two-building-groups.png') });
+  await page.screenshot({ path: path.join(ARTIFACTS, 'issue55-two-building-groups.png') });
   assert.deepEqual(problems, [], 'no console errors or page errors');
   await context.close();
 });
@@ -275,7 +275,7 @@ test('your maps: a refused Refine keeps your placement, shows what was judged, a
   assert.ok(close(snap.adjust.kept.pose, mine));
   await page.locator('#real-adjust').evaluate((e) => e.scrollIntoView({ block: 'start' }));
   await page.waitForTimeout(300);
-  await page.screenshot({ path: path.join(ROOT, 'docs/issue55-kept-placement.png') });
+  await page.screenshot({ path: path.join(ARTIFACTS, 'issue55-kept-placement.png') });
 
   // Use my placement: joined exactly there, not verified everywhere it shows.
   await page.getByRole('button', { name: 'Use my placement (not verified)' }).click();
