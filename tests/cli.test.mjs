@@ -125,7 +125,8 @@ test('frames writes one PNG per captured frame and an index', () => {
   assert.equal(r.code, 0, r.stderr);
   const index = JSON.parse(readFileSync(path.join(out, 'index.json'), 'utf8'));
   assert.equal(index.scenario, 'thesis');
-  assert.deepEqual(index.camera, { width: 320, height: 240, hfov_deg: 60 });
+  // The camera as the scenario gives it, and its capture period (s).
+  assert.deepEqual(index.camera, { width: 320, height: 240, hfov_deg: 60, period_s: 1 });
   // Two robots, a frame at t = 0, 1, ..., 5 s each.
   assert.equal(index.frames.length, 12);
   const thesis = JSON.parse(readFileSync(path.join(root, 'scenarios/thesis.json'), 'utf8'));
