@@ -129,6 +129,20 @@ pub struct ClosureView {
     pub score: f64,
 }
 
+impl ClosureView {
+    /// Closure `c` drawn between its keys' poses in `nodes`.
+    fn between(c: &ClosureInfo, nodes: &[Pose2]) -> ClosureView {
+        let node = |k: usize| nodes.get(k).copied().unwrap_or_default();
+        let (a, b) = (node(c.from_key), node(c.to_key));
+        ClosureView {
+            segment: [a.x, a.y, b.x, b.y],
+            from_scan: c.from_scan,
+            to_scan: c.to_scan,
+            score: c.score,
+        }
+    }
+}
+
 /// One scan of the report.
 #[derive(Serialize)]
 pub struct ScanReport {
@@ -536,19 +550,10 @@ impl LogReplay {
         let flat = |poses: &mut dyn Iterator<Item = Pose2>| -> Vec<f64> {
             poses.flat_map(|p| [p.x, p.y, p.theta]).collect()
         };
-        let node = |k: usize| slam.graph.nodes.get(k).copied().unwrap_or_default();
         let closures = slam
             .closures
             .iter()
-            .map(|c| {
-                let (a, b) = (node(c.from_key), node(c.to_key));
-                ClosureView {
-                    segment: [a.x, a.y, b.x, b.y],
-                    from_scan: c.from_scan,
-                    to_scan: c.to_scan,
-                    score: c.score,
-                }
-            })
+            .map(|c| ClosureView::between(c, &slam.graph.nodes))
             .collect();
         ReplayView {
             done: self.replayed().len(),
@@ -627,22 +632,13 @@ impl LogReplay {
     pub fn view_at(&self, k: usize) -> Result<ReplayView, String> {
         let poses = self.poses_at(k)?;
         let nodes = self.nodes_at(k);
-        let node = |i: usize| nodes.get(i).copied().unwrap_or_default();
         let closures = self
             .slam
             .closures
             .iter()
             .zip(&self.closed_after)
             .filter(|(_, at)| **at <= k)
-            .map(|(c, _)| {
-                let (a, b) = (node(c.from_key), node(c.to_key));
-                ClosureView {
-                    segment: [a.x, a.y, b.x, b.y],
-                    from_scan: c.from_scan,
-                    to_scan: c.to_scan,
-                    score: c.score,
-                }
-            })
+            .map(|(c, _)| ClosureView::between(c, nodes))
             .collect();
         let odometry = if self.has_odometry() {
             self.slam.scans[..k]
