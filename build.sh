@@ -112,7 +112,7 @@ cmd_test() {
   cmd_build
   log "command-line and browser end-to-end tests (node --test)"
   mkdir -p test-artifacts
-  node --test --test-concurrency=1 tests/imports.test.mjs tests/lab.test.mjs tests/cli.test.mjs tests/maps.test.mjs tests/bag-maps.test.mjs tests/run-log.test.mjs tests/bag-inputs.test.mjs tests/log-merge.test.mjs tests/reports.test.mjs tests/crowd.test.mjs tests/exercises.test.mjs tests/page.test.mjs tests/page-real.test.mjs tests/page-groups.test.mjs tests/classroom.test.mjs tests/page-lab-ux.test.mjs tests/page-maps-ux.test.mjs tests/page-log-ux.test.mjs
+  node --test --test-concurrency=1 tests/imports.test.mjs tests/lab.test.mjs tests/cli.test.mjs tests/maps.test.mjs tests/bag-maps.test.mjs tests/run-log.test.mjs tests/bag-inputs.test.mjs tests/log-merge.test.mjs tests/reports.test.mjs tests/crowd.test.mjs tests/exercises.test.mjs tests/page.test.mjs tests/page-real.test.mjs tests/page-groups.test.mjs tests/classroom.test.mjs tests/page-lab-ux.test.mjs tests/page-maps-ux.test.mjs tests/page-log-ux.test.mjs tests/page-log-groups.test.mjs
 }
 
 # The real-data suite reads third-party data from ../shared/data (or

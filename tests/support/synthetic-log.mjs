@@ -4,7 +4,8 @@
 // cast exactly against the walls, its odometry turned by a small heading
 // bias per step so that it drifts and the second lap meets the first one
 // displaced — the case a loop closure mends. A second world (a hall with
-// pillars) makes a log that shares nothing with the ring.
+// pillars) makes a log that shares nothing with the ring, and a third (a
+// six-sided room, 'lab') one that shares nothing with either.
 
 /** Wall segments [[x, y], [x, y]] of the ring. */
 export const RING = (() => {
@@ -62,6 +63,30 @@ function hallPose(s) {
 }
 
 /**
+ * A third world, like neither of the others and like itself under no
+ * turn: a six-sided room (13 x 8.5 m) with two slanted corners, a pillar
+ * off its middle, a small one in two corners each and a short slanted
+ * wall under the ceiling's side, driven round on an ellipse.
+ */
+export const LAB = (() => {
+  const poly = (pts) => pts.map((p, i) => [p, pts[(i + 1) % pts.length]]);
+  return [
+    ...poly([[-7, -4], [6, -4], [6, 1], [3, 4.5], [-4, 4.5], [-7, 2]]),
+    ...poly([[-1, -0.5], [0.2, -0.5], [0.2, 0.5], [-1, 0.5]]),
+    ...poly([[4.5, -3], [5, -3], [5, -2.5], [4.5, -2.5]]),
+    ...poly([[-6, -3.2], [-5.5, -3.2], [-5.5, -2.7], [-6, -2.7]]),
+    [[-2, 3.6], [-0.5, 4.2]],
+  ];
+})();
+
+function labPose(s) {
+  const u = 2 * Math.PI * (s % 1);
+  return [-0.5 + 4 * Math.cos(u), 0.2 + 2.5 * Math.sin(u), Math.atan2(2.5 * Math.cos(u), -4 * Math.sin(u))];
+}
+
+const WORLDS = { ring: [RING, ringPose], hall: [HALL, hallPose], lab: [LAB, labPose] };
+
+/**
  * The log's text: `laps` laps of `perLap` scans round the ring (`world:
  * 'ring'`) or the hall (`'hall'`), FLASER records (181 beams, 80 m "no
  * return") with ODOM records before them, odometry with a heading bias of
@@ -69,7 +94,7 @@ function hallPose(s) {
  * of laser record i, in the frame of the odometry's first pose).
  */
 export function ringLog({ laps = 2, perLap = 140, bias = 0.004, world = 'ring' } = {}) {
-  const [walls, pathPose] = world === 'hall' ? [HALL, hallPose] : [RING, ringPose];
+  const [walls, pathPose] = WORLDS[world] ?? WORLDS.ring;
   const out = [`# a ${world} driven round, made by tests/support/synthetic-log.mjs`];
   const truth = [];
   let odo = null;

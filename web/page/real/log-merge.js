@@ -56,11 +56,31 @@ export function robotMap({ name, report, replay }) {
 }
 
 /**
+ * Each group's merged map (the report's `merge.groups[k]`, in the frame of
+ * its first robot): `{pgm, png, yaml, stem}` for a group of two or more
+ * robots, null for a robot alone. With one group its files are `merged.*`,
+ * with several `merged-group-N.*` (N counting the groups of two or more).
+ */
+export function groupFiles(savedMaps, merge) {
+  const groups = merge.groups ?? [];
+  const several = groups.filter((g) => g.maps.length > 1).length > 1;
+  let n = 0;
+  return groups.map((g, k) => {
+    if (g.maps.length < 2) return null;
+    n += 1;
+    const stem = several ? `merged-group-${n}` : 'merged';
+    return { pgm: savedMaps.groupPgm(k), png: savedMaps.groupPng(k), yaml: savedMaps.groupYaml(k, `${stem}.pgm`), stem };
+  });
+}
+
+/**
  * Merges the finished robots' maps as saved maps (web/saved-maps.js on the
  * wasm-bindgen module `wasm`); `progress(text)` after each pair. Returns
- * `{savedMaps, report, files}`: the maps merged (a SavedMaps), the
- * merge-maps report (with `timings_ms.merge`), and the merged map's PGM,
- * PNG and YAML (null on no_merge). The caller frees `savedMaps`.
+ * `{savedMaps, report, files, groupFiles}`: the maps merged (a SavedMaps),
+ * the merge-maps report (with `timings_ms.merge`), each group's merged map
+ * (`groupFiles`) and the first group's (`files`, null when no robot joined
+ * another). Robots of two buildings make two groups, each joined in the
+ * frame of its first robot. The caller frees `savedMaps`.
  */
 export function mergeRobots(wasm, robots, progress = () => {}) {
   const savedMaps = SavedMaps.open(wasm);
@@ -72,21 +92,32 @@ export function mergeRobots(wasm, robots, progress = () => {}) {
     const t0 = performance.now();
     const report = savedMaps.mergeWithProgress(progress);
     report.timings_ms = { merge: performance.now() - t0 };
-    let files = null;
-    if (report.merge.status === 'merged') {
-      files = { pgm: savedMaps.mergedPgm(), png: savedMaps.mergedPng(), yaml: savedMaps.mergedYaml('merged.pgm') };
-    }
-    return { savedMaps, report, files };
+    const files = groupFiles(savedMaps, report.merge);
+    return { savedMaps, report, files: files.find((f) => f) ?? null, groupFiles: files };
   } catch (e) {
     savedMaps.free();
     throw e;
   }
 }
 
-/** The joined maps for the overlay (overlay.js's `drawPlaced`): `[{map, pose}]`, each map in its robot's colour. */
+/**
+ * Every joined robot's map placed in its group's frame: the transforms of
+ * each group of two or more robots (a robot is in one group), or the
+ * report's own transforms when it lists no groups.
+ */
+export function joinedTransforms(merge) {
+  const groups = (merge.groups ?? []).filter((g) => g.maps.length > 1);
+  return groups.length ? groups.flatMap((g) => g.transforms) : merge.transforms;
+}
+
+/**
+ * The joined maps for the overlay (overlay.js's `drawPlaced`): `[{map,
+ * pose, name}]`, each joined robot's map in its group's frame and in its
+ * robot's colour.
+ */
 export async function placedMaps({ savedMaps, report }, robots) {
   const placed = [];
-  for (const t of report.merge.transforms) {
+  for (const t of joinedTransforms(report.merge)) {
     const i = robots.findIndex((r) => `${r.name}.yaml` === t.map);
     if (i < 0) continue;
     const info = savedMaps.mapInfo(i);
@@ -98,13 +129,14 @@ export async function placedMaps({ savedMaps, report }, robots) {
 }
 
 /**
- * Each joined robot's SLAM path in the merged frame (the first robot's):
- * `[{colour, flat: [x, y, theta, ...]}]`, every pose p of the replay's
- * final poses (the log's frame) as merge ∘ s⁻¹ ∘ p, s the robot's first.
+ * Each joined robot's SLAM path in its group's frame (its first robot's):
+ * `[{name, colour, flat: [x, y, theta, ...]}]`, every pose p of the
+ * replay's final poses (the log's frame) as merge ∘ s⁻¹ ∘ p, s the
+ * robot's first.
  */
 export function mergedPaths(report, robots) {
   const out = [];
-  for (const t of report.merge.transforms) {
+  for (const t of joinedTransforms(report.merge)) {
     const r = robots.find((x) => `${x.name}.yaml` === t.map);
     if (!r?.report) continue;
     const to = compose(t.pose, inverse(r.report.scans[0].pose));

@@ -415,7 +415,7 @@ export class LogView {
       const out = await this.client.request({ type: 'merge' });
       this.mergeMs = performance.now() - t0;
       this.merged.stage(`merged in ${(this.mergeMs / 1000).toFixed(2)} s`);
-      await this.merged.show(out.report, out.files, this.state.robots);
+      await this.merged.show(out.report, out.files, this.state.robots, out.groupFiles);
     } finally {
       this.setBusy(false);
     }

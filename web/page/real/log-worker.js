@@ -23,7 +23,9 @@
 // SLAM's and each loop closure. At the end it settles each pose graph and
 // hands back each map as PGM, PNG and YAML; then `merge` joins the robots'
 // maps (log-merge.js: the saved-maps merge of `merge-maps`, each map in its
-// robot's own frame) and draws the joined maps into a second canvas.
+// robot's own frame), hands back each group's merged map (robots of two
+// buildings make two groups) and draws the joined maps of the group shown
+// (`group`) into a second canvas.
 // A benchmark's `.relations` file opened with a log (log-relations.js)
 // is parsed by each of its robots' replays, which score the scans
 // replayed so far against it (at most every RELATIONS_EVERY_MS while
@@ -39,7 +41,7 @@
 // within STEP_BUDGET_MS of work.
 // Messages in: `{id, type: 'canvas' | 'mergeCanvas' | 'open' | 'cut' |
 // 'pick' | 'step' | 'seek' | 'redraw' | 'highlight' | 'finish' | 'merge' |
-// 'drawMerge' | 'clear', ...}`; out: `{id, ok, ...}` or `{id, ok: false,
+// 'group' | 'drawMerge' | 'clear', ...}`; out: `{id, ok, ...}` or `{id, ok: false,
 // error}`, and `{type: 'progress', text}` while merging, `{type:
 // 'progress', reading}` while a bag is read.
 
@@ -443,8 +445,17 @@ async function merge(id) {
   merged = mergeRobots(wasm, robots, (text) => postMessage({ type: 'progress', id, text }));
   merged.placed = await placedMaps(merged, robots);
   merged.paths = mergedPaths(merged.report, robots);
-  const { report, files } = merged;
-  return { result: { report, files }, transfer: files ? [files.pgm.buffer, files.png.buffer] : [] };
+  const { report, files, groupFiles } = merged;
+  merged.group = Math.max(0, groupFiles.findIndex((f) => f));
+  const transfer = groupFiles.flatMap((f) => (f ? [f.pgm.buffer, f.png.buffer] : []));
+  return { result: { report, files, groupFiles }, transfer };
+}
+
+/** The robots the overlay shows: those of the group shown (robots of two buildings make two groups). */
+function shownRobots() {
+  const merge = merged.report.merge;
+  const transforms = merge.groups?.[merged.group]?.transforms ?? merge.transforms;
+  return new Set(transforms.map((t) => t.map.replace(/\.yaml$/, '')));
 }
 
 const handlers = {
@@ -472,11 +483,18 @@ const handlers = {
   drawMerge: (data) => {
     if (mergeCanvas && merged?.placed) {
       // `data.zoom`: the user's zoom (zoom.js); `data.hidden`: the robots
-      // unticked. Fitted to every joined map, so hiding one moves no other.
-      const shown = (x) => !data.hidden?.includes(x.name);
-      drawPlaced(mergeCanvas, data, merged.placed.filter(shown), fitView(merged.placed, data));
-      drawMergedPaths(mergeCanvas, data, merged.placed, merged.paths.filter(shown));
+      // unticked. Fitted to every map of the group shown, so hiding one
+      // moves no other.
+      const group = shownRobots();
+      const placed = merged.placed.filter((x) => group.has(x.name));
+      const shown = (x) => group.has(x.name) && !data.hidden?.includes(x.name);
+      drawPlaced(mergeCanvas, data, placed.filter(shown), fitView(placed, data));
+      drawMergedPaths(mergeCanvas, data, placed, merged.paths.filter(shown));
     }
+    return {};
+  },
+  group: (data) => {
+    if (merged) merged.group = data.group;
     return {};
   },
   clear: () => {

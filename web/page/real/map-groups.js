@@ -1,4 +1,5 @@
-// Groups of maps in "Your maps" (web/page/real/panel.js).
+// Groups of maps in "Your maps" (web/page/real/panel.js) and of the
+// robots' maps in "Your log" (web/page/real/log-merge-view.js).
 //
 // Maps of two buildings opened together cannot all be joined: the merge
 // then finds groups of maps that share walls among themselves and with no
@@ -28,9 +29,13 @@ function el(tag, attrs = {}, ...children) {
 }
 
 export class MapGroupsView {
-  /** `box`: the `#real-groups` element; `select(k)`: shows group `k`; `colour(name)`: a map's colour. */
-  constructor(box, { select, colour }) {
-    Object.assign(this, { box, select: select, colour });
+  /**
+   * `box`: the `#real-groups` (or `#log-groups`) element; `select(k)`:
+   * shows group `k`; `colour(map)`: a map's colour; `label(map)`: how a
+   * map is called (a robot's name in "Your log").
+   */
+  constructor(box, { select, colour, label = (m) => m }) {
+    Object.assign(this, { box, select, colour, label });
     this.selected = -1;
     this.box.addEventListener('keydown', (e) => this.key(e));
   }
@@ -43,7 +48,7 @@ export class MapGroupsView {
 
   /** A map's name in its colour. */
   name(n) {
-    const b = el('b', { class: 'real-group-map', text: n });
+    const b = el('b', { class: 'real-group-map', text: this.label(n) });
     b.style.color = this.colour(n);
     return b;
   }
