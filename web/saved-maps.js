@@ -160,6 +160,29 @@ export class SavedMaps {
   groupYaml(k, image) {
     return this.raw.groupYaml(k, image);
   }
+
+  /**
+   * Each group of `merge` (the report's `merge`) as files to download:
+   * `{pgm, png, yaml, stem}` for a group of two or more maps, null for a
+   * map alone. With one such group its files are `merged.*`, with several
+   * `merged-group-N.*` (N counting the groups of two or more); a group
+   * joined where a person placed a map adds `-not-verified` to its name and
+   * says so in its YAML.
+   */
+  groupFiles(merge) {
+    const groups = merge.groups ?? [];
+    const several = groups.filter((g) => g.maps.length > 1).length > 1;
+    let n = 0;
+    return groups.map((g, k) => {
+      if (g.maps.length < 2) return null;
+      n += 1;
+      const named = several ? `merged-group-${n}` : 'merged';
+      const stem = g.verified === false ? `${named}-not-verified` : named;
+      const f = { pgm: this.groupPgm(k), png: this.groupPng(k), yaml: this.groupYaml(k, `${stem}.pgm`), stem };
+      if (g.verified === false) f.yaml = `# Joined where a person placed a map by hand: not verified by the merge's tests.\n${f.yaml}`;
+      return f;
+    });
+  }
 }
 
 /** The `image` a map's YAML names (its path relative to the YAML's folder), so the caller knows what to read; throws on a bad YAML. */

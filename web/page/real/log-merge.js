@@ -56,24 +56,6 @@ export function robotMap({ name, report, replay }) {
 }
 
 /**
- * Each group's merged map (the report's `merge.groups[k]`, in the frame of
- * its first robot): `{pgm, png, yaml, stem}` for a group of two or more
- * robots, null for a robot alone. With one group its files are `merged.*`,
- * with several `merged-group-N.*` (N counting the groups of two or more).
- */
-export function groupFiles(savedMaps, merge) {
-  const groups = merge.groups ?? [];
-  const several = groups.filter((g) => g.maps.length > 1).length > 1;
-  let n = 0;
-  return groups.map((g, k) => {
-    if (g.maps.length < 2) return null;
-    n += 1;
-    const stem = several ? `merged-group-${n}` : 'merged';
-    return { pgm: savedMaps.groupPgm(k), png: savedMaps.groupPng(k), yaml: savedMaps.groupYaml(k, `${stem}.pgm`), stem };
-  });
-}
-
-/**
  * Merges the finished robots' maps as saved maps (web/saved-maps.js on the
  * wasm-bindgen module `wasm`); `progress(text)` after each pair. Returns
  * `{savedMaps, report, files, groupFiles}`: the maps merged (a SavedMaps),
@@ -92,7 +74,7 @@ export function mergeRobots(wasm, robots, progress = () => {}) {
     const t0 = performance.now();
     const report = savedMaps.mergeWithProgress(progress);
     report.timings_ms = { merge: performance.now() - t0 };
-    const files = groupFiles(savedMaps, report.merge);
+    const files = savedMaps.groupFiles(report.merge);
     return { savedMaps, report, files: files.find((f) => f) ?? null, groupFiles: files };
   } catch (e) {
     savedMaps.free();

@@ -167,13 +167,6 @@ function refine({ a, b, pose }) {
   return out;
 }
 
-/** The files of a group of two or more maps: PGM, PNG and YAML naming `stem`.pgm. */
-function filesOfGroup(k, stem) {
-  const pgm = savedMaps.groupPgm(k);
-  const png = savedMaps.groupPng(k);
-  return { pgm, png, yaml: savedMaps.groupYaml(k, `${stem}.pgm`), stem };
-}
-
 /**
  * The report with each group's merged map (`groups[k]`, null for a map
  * alone; `files` the first joined group's, as before groups) and the
@@ -182,18 +175,8 @@ function filesOfGroup(k, stem) {
 function withFiles(report, t0) {
   const t1 = performance.now();
   const transfer = [];
-  const groups = report.merge.groups ?? [];
-  const joined = groups.filter((g) => g.maps.length > 1).length;
-  let n = 0;
-  const files = groups.map((g, k) => {
-    if (g.maps.length < 2) return null;
-    n += 1;
-    const stem = joined > 1 ? `merged-group-${n}` : 'merged';
-    const f = filesOfGroup(k, g.verified === false ? `${stem}-not-verified` : stem);
-    if (g.verified === false) f.yaml = `# Joined where a person placed a map by hand: not verified by the merge's tests.\n${f.yaml}`;
-    transfer.push(f.pgm.buffer, f.png.buffer);
-    return f;
-  });
+  const files = savedMaps.groupFiles(report.merge);
+  for (const f of files) if (f) transfer.push(f.pgm.buffer, f.png.buffer);
   report.timings_ms = { merge: t1 - t0, write: performance.now() - t1 };
   lastReport = report;
   shownGroup = Math.max(0, files.findIndex((f) => f));
