@@ -428,15 +428,23 @@ test('your log: a bag dropped with its .relations file shows the relation errors
   assert.equal(await page.locator('#log-rel-key').isVisible(), true, 'the legend names the worst relations');
   const drawn = await magentaOnMap();
   assert.ok(drawn > 300, `${drawn} pixels of the worst relations on the map`);
-  // Pointing at the first row draws that one stronger and the others fainter.
-  await page.locator('#log-rel-worst tbody tr').first().hover();
+  // Pointing at the first row with the mouse marks it, and leaving it unmarks it.
+  const first = page.locator('#log-rel-worst tbody tr').first();
+  await first.hover();
+  await page.waitForFunction(() => document.querySelector('#log-rel-worst tbody tr.on'));
+  await page.mouse.move(5, 5);
+  await page.waitForFunction(() => !document.querySelector('#log-rel-worst tbody tr.on'));
+  // Pointed at (here focused: a screenshot of the map, which fills the
+  // screen, scrolls the page from under a mouse), that one is drawn
+  // stronger and the others fainter.
+  await first.focus();
   await page.waitForFunction(() => document.querySelector('#log-rel-worst tbody tr.on'));
   await page.waitForTimeout(300);
   const pointed = await magentaOnMap();
   assert.ok(Math.abs(pointed - drawn) > 50, `pointed at: ${pointed} magenta pixels, not ${drawn}`);
   await page.locator('#log-canvas').scrollIntoViewIfNeeded();
   await page.screenshot({ path: path.join(ARTIFACTS, 'page-bags-relations.png'), fullPage: true });
-  await page.mouse.move(5, 5);
+  await first.evaluate((tr) => tr.blur());
   await page.waitForFunction(() => !document.querySelector('#log-rel-worst tbody tr.on'));
   // Focused by the keyboard: the same.
   await page.locator('#log-rel-worst tbody tr').nth(1).focus();
