@@ -69,7 +69,7 @@ fn replay_drifted(bytes: &[u8], seed: u64) -> Result<(), Box<dyn std::error::Err
         s.odometry = *odom;
         slam.add_scan(&s);
     }
-    slam.finish()?;
+    slam.finish(&log.scans)?;
     print_poses(&slam.poses());
     print_slam(&slam)
 }

@@ -96,7 +96,7 @@ pub fn replay(
             None => slam.add_scan(scan),
         }
     }
-    slam.finish().expect("pose graph");
+    slam.finish(&log.scans).expect("pose graph");
     let seconds = t0.elapsed().as_secs_f64();
     (slam.poses(), slam, seconds)
 }
@@ -307,6 +307,8 @@ pub fn config_from_env() -> LogSlamConfig {
             "min_match_score" => cfg.min_match_score = v,
             "weak_match_score" => cfg.weak_match_score = v,
             "match_range_m" => cfg.match_range_m = v,
+            "smooth_keys" => cfg.smooth_keys = v as usize,
+            "smooth_iterations" => cfg.smooth_iterations = v as usize,
             "close_loops" => cfg.close_loops = v != 0.0,
             "manhattan" => cfg.manhattan = (v != 0.0).then(ManhattanConfig::for_logs),
             "manhattan_sigma_deg" => manhattan(&mut cfg).sigma_rad = v.to_radians(),

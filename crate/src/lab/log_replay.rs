@@ -381,7 +381,7 @@ impl LogReplay {
         if self.map.is_some() {
             return Ok(());
         }
-        self.slam.finish()?;
+        self.slam.finish(&self.scans[self.from..=self.to])?;
         self.keep_version();
         let scans = &self.scans[self.from..=self.to];
         self.map = Some(cropped(self.slam.build_map(scans)));
