@@ -221,6 +221,10 @@ pub struct LogSlamConfig {
     /// A scan the alignment would move further than this keeps its pose.
     pub smooth_max_move_m: f64,
     pub smooth_max_turn_rad: f64,
+    /// The scan aligned keeps a point every this far along it (the keys'
+    /// points stay as matched, `point_spacing_m`): more points average
+    /// more of the range noise.
+    pub smooth_spacing_m: f64,
     /// Whether the scans carry odometry. Without it (a hand-carried laser,
     /// a simulator's bag of scans alone) each scan is predicted from the
     /// last one by the motion the estimate made between the two before
@@ -278,6 +282,7 @@ impl Default for LogSlamConfig {
             smooth_radius_m: 0.2,
             smooth_max_move_m: 0.1,
             smooth_max_turn_rad: 2f64.to_radians(),
+            smooth_spacing_m: 0.05,
         }
     }
 }
@@ -392,19 +397,22 @@ fn local_match(
 /// `match_range_m`, through the laser's offset, thinned to one per
 /// `point_spacing_m` along the scan.
 pub fn scan_points(scan: &LogScan, cfg: &LogSlamConfig) -> Vec<DVec2> {
+    points_every(scan, cfg.match_range_m, cfg.point_spacing_m)
+}
+
+/// The returns of `scan` within `range_m`, in the robot frame, one per
+/// `spacing_m` along the scan.
+fn points_every(scan: &LogScan, range_m: f64, spacing_m: f64) -> Vec<DVec2> {
     let mut out: Vec<DVec2> = Vec::with_capacity(scan.ranges.len());
     let offset = scan.laser_offset.frame();
     for (i, &r) in scan.ranges.iter().enumerate() {
         let r = r as f64;
-        if scan.no_return(i) || r > cfg.match_range_m {
+        if scan.no_return(i) || r > range_m {
             continue;
         }
         let b = scan.bearing(i);
         let p = offset.to_parent(DVec2::new(b.cos(), b.sin()) * r);
-        if out
-            .last()
-            .is_none_or(|q| q.distance(p) >= cfg.point_spacing_m)
-        {
+        if out.last().is_none_or(|q| q.distance(p) >= spacing_m) {
             out.push(p);
         }
     }
@@ -805,7 +813,7 @@ impl LogSlam {
             let target = IcpTarget::new(&points, &normals, cfg.smooth_radius_m);
             let node = self.graph.nodes[key];
             for (entry, scan) in self.scans[start..end].iter_mut().zip(&scans[start..end]) {
-                let points = scan_points(scan, cfg);
+                let points = points_every(scan, cfg.match_range_m, cfg.smooth_spacing_m);
                 let now = node.compose(&entry.relative);
                 let fit = target.align(&points, &now, cfg.smooth_huber_m, cfg.smooth_iterations);
                 let d = now.between(&fit.pose);
