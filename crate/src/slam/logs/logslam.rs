@@ -108,13 +108,15 @@
 //!    a filter's estimate becomes a smoother's. The points themselves,
 //!    not a raster, take away the grain of the 5 cm cells, and keys ahead
 //!    of the scan balance the pull of those behind it towards where they
-//!    were taken (a key's marks lie densest near its own position). A
-//!    scan's own key scan is left out of its target, a scan that few
-//!    target points meet or that would move more than `smooth_max_move_m`
-//!    or `smooth_max_turn_rad` keeps its pose, and the graph's nodes and
-//!    closures are not changed: only where each scan sits relative to its
-//!    key. On the benchmark's raw logs it lowers every log's relation
-//!    error, whole and by halves (BENCHMARKS.md).
+//!    were taken (a key's marks lie densest near its own position). The
+//!    scan aligned keeps a point every `smooth_spacing_m` (5 cm, twice as
+//!    many as it was matched with); the scans of a key are aligned without
+//!    that key's own scan, which a key scan would otherwise find itself in.
+//!    A scan that few target points meet or that would move more than
+//!    `smooth_max_move_m` or `smooth_max_turn_rad` keeps its pose, and the
+//!    graph's nodes and closures are not changed: only where each scan
+//!    sits relative to its key. On the benchmark's raw logs it lowers
+//!    every log's relation error, whole and by halves (BENCHMARKS.md).
 //!
 //! Karto's scan-to-scan chain of recent keys, closures against several
 //! earlier passes, each edge weighted by its match's response, and a
