@@ -294,7 +294,7 @@ fn the_stage_bag_without_odometry_follows_its_ground_truth() {
     assert_eq!(truth.len(), 1727);
     assert_eq!(report.ate_scans, Some(1727));
     let ate = report.ate_m.expect("an ATE");
-    // Today's 0.255 m (BENCHMARKS.md): the front end shortens the path by
+    // Today's 0.253 m (BENCHMARKS.md): the front end shortens the path by
     // about 1 % on this 5 m, 90-beam laser (docs/history/issue-53-ros-bags.md).
     assert!(ate < 0.28, "ATE {ate:.3} m");
 }
