@@ -167,7 +167,8 @@ test('your log: a replay played in × real time, scrubbed back with the mouse to
     `${moment.toFixed(1)} s of 1 min 10 s · looking back (replayed to 1 min 10 s)`,
   );
   assert.equal(r.atClosures, 0, 'no loop was closed by then');
-  assert.ok(r.atWalls > 50 && r.atWalls * 2 < endWalls, `${r.atWalls} wall cells then, ${endWalls} at the end`);
+  // (The end's map is drawn at the smoothed poses, its walls thinner.)
+  assert.ok(r.atWalls > 50 && r.atWalls * 1.5 < endWalls, `${r.atWalls} wall cells then, ${endWalls} at the end`);
   const LIGHT = [0x9c, 0xc0, 0xe8]; // the track's replayed part after the moment shown
   assert.ok((await pixelsNear(page, '#log-time', LIGHT, 12)) > 200, 'the track shows what was replayed after the moment');
   const backOrange = await pixelsNear(page, '#log-canvas', ORANGE);
