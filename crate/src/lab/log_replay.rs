@@ -600,10 +600,16 @@ impl LogReplay {
 
     /// The key nodes as the SLAM had them once `k` scans were replayed.
     fn nodes_at(&self, k: usize) -> &[Pose2] {
-        match self.versions.iter().find(|v| v.until > k) {
+        match self.version_at(k) {
             Some(v) => &v.nodes,
             None => &self.slam.graph.nodes,
         }
+    }
+
+    /// The version of the key nodes in force once `k` scans were replayed
+    /// (`None`: the graph now, past its last move).
+    fn version_at(&self, k: usize) -> Option<&NodeVersion> {
+        self.versions.iter().find(|v| v.until > k)
     }
 
     /// Checks that `k` scans have been replayed (a moment to look back at).
@@ -623,7 +629,7 @@ impl LogReplay {
         let k = self.moment(k)?;
         let nodes = self.nodes_at(k);
         // Before the end, the scans sat where the replay placed them.
-        let before_end = self.versions.iter().any(|v| v.until > k);
+        let before_end = self.version_at(k).is_some();
         self.slam.scans[..k]
             .iter()
             .enumerate()

@@ -339,8 +339,6 @@ pub struct LogSlam {
     pub config: LogSlamConfig,
     pub graph: PoseGraph,
     key_points: Vec<Vec<DVec2>>,
-    /// Each key's surface normals (robot frame), for the smoothing's ICP.
-    key_normals: Vec<Vec<Option<DVec2>>>,
     key_scan: Vec<usize>,
     pub scans: Vec<ScanEntry>,
     local: Option<LikelihoodField>,
@@ -427,7 +425,6 @@ impl LogSlam {
             config,
             graph: PoseGraph::default(),
             key_points: Vec::new(),
-            key_normals: Vec::new(),
             key_scan: Vec::new(),
             scans: Vec::new(),
             local: None,
@@ -586,11 +583,6 @@ impl LogSlam {
             self.graph.edges.push(Edge::new(p, id, z, sm, sr));
         }
         self.unmatched_since_key = false;
-        self.key_normals.push(if self.config.smooth_keys > 0 {
-            scan_normals_within(&points, NORMAL_RADIUS_M)
-        } else {
-            Vec::new()
-        });
         self.key_points.push(points);
         self.weak_keys.push(weak);
         self.key_scan.push(scan.index);
@@ -792,6 +784,12 @@ impl LogSlam {
         }
         let cfg = &self.config;
         let n = self.graph.nodes.len();
+        // Each key's surface normals (robot frame), once.
+        let key_normals: Vec<Vec<Option<DVec2>>> = self
+            .key_points
+            .iter()
+            .map(|p| scan_normals_within(p, NORMAL_RADIUS_M))
+            .collect();
         // The scans of one key follow one another.
         let mut start = 0;
         while start < self.scans.len() {
@@ -802,7 +800,8 @@ impl LogSlam {
                     .take_while(|e| e.key == key)
                     .count();
             let (mut points, mut normals) = (Vec::new(), Vec::new());
-            for k in key.saturating_sub(half)..(key + half + 1).min(n) {
+            let (lo, hi) = (key.saturating_sub(half), (key + half + 1).min(n));
+            for (k, own_normals) in key_normals.iter().enumerate().take(hi).skip(lo) {
                 // Its own key's scan, and weakly matched keys (as for the
                 // local map), take no part.
                 if k == key || self.weak_keys[k] {
@@ -810,7 +809,7 @@ impl LogSlam {
                 }
                 let f = self.graph.nodes[k].frame();
                 points.extend(self.key_points[k].iter().map(|&p| f.to_parent(p)));
-                normals.extend(self.key_normals[k].iter().map(|n| n.map(|n| f.rotate(n))));
+                normals.extend(own_normals.iter().map(|n| n.map(|n| f.rotate(n))));
             }
             let target = IcpTarget::new(&points, &normals, cfg.smooth_radius_m);
             let node = self.graph.nodes[key];
