@@ -46,6 +46,9 @@ pub struct IcpFit {
     /// The larger eigenvalue, and the weakest direction (world frame).
     pub strong: f64,
     pub weak_direction: DVec2,
+    /// The normal equations' matrix of the last step (`Σ w JᵀJ`, world
+    /// frame `[x, y, θ]`): the fit's information in points' worth.
+    pub information: [[f64; 3]; 3],
 }
 
 impl IcpTarget {
@@ -121,6 +124,7 @@ impl IcpTarget {
         let mut pose = *start;
         let (mut weak, mut associated) = (0.0, 0);
         let (mut strong, mut weak_direction) = (0.0, DVec2::X);
+        let mut information = [[0.0; 3]; 3];
         for _ in 0..iterations {
             let mut h = [[0.0; 3]; 3];
             let mut g = [0.0; 3];
@@ -141,6 +145,7 @@ impl IcpTarget {
             }
             let (l1, l2, along) = symmetric_eigen2(h[0][0], h[0][1], h[1][1]);
             (strong, weak, weak_direction) = (l1, l2, along);
+            information = h;
             for (a, row) in h.iter_mut().enumerate() {
                 row[a] += 1e-6;
             }
@@ -158,6 +163,7 @@ impl IcpTarget {
             weak,
             strong,
             weak_direction,
+            information,
         }
     }
 }

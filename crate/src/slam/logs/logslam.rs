@@ -117,6 +117,15 @@
 //!    graph's nodes and closures are not changed: only where each scan
 //!    sits relative to its key. On the benchmark's raw logs it lowers
 //!    every log's relation error, whole and by halves (BENCHMARKS.md).
+//! 8. **Fusion with the odometry** ([`super::fusion`]): each smoothed scan
+//!    is a measurement of where it was; the wheel odometry between two
+//!    neighbouring scans is another of how far apart they were. A
+//!    smoother over the chain of scans weighs the two by their noises,
+//!    measured from the log itself (how their disagreement grows with the
+//!    number of scans between), so good wheels steady the scans where a
+//!    match is unsure (along a corridor) and poor wheels are ignored.
+//!    Only positions are fused, not the odometry's heading. A fused pose
+//!    may lie up to `fusion_max_move_m` from where the replay left it.
 //!
 //! Karto's scan-to-scan chain of recent keys, closures against several
 //! earlier passes, each edge weighted by its match's response, and a
@@ -127,6 +136,7 @@
 //! The poses are in the log's odometry frame: the first scan's pose is its
 //! odometry pose, and the graph's first node stays fixed there.
 
+use super::fusion::{fuse, measure_noise, FusionNoise, Placement};
 use super::scan::LogScan;
 use crate::geom::{wrap_angle, Pose2};
 use crate::slam::degeneracy::scan_normals_within;
@@ -227,6 +237,15 @@ pub struct LogSlamConfig {
     /// points stay as matched, `point_spacing_m`): more points average
     /// more of the range noise.
     pub smooth_spacing_m: f64,
+    /// Whether the smoothed scans are fused with the odometry between
+    /// them, each weighed by its noise measured from the log
+    /// ([`super::fusion`]); only where the scans carry odometry.
+    pub smooth_odometry: bool,
+    /// A scan the fusion would move further than this from where the
+    /// replay left it keeps that pose. Further than ICP alone may move it
+    /// (`smooth_max_move_m`): along a corridor, where ICP has no hold, the
+    /// odometry does, and the replay's matches slide there by decimetres.
+    pub fusion_max_move_m: f64,
     /// Whether the scans carry odometry. Without it (a hand-carried laser,
     /// a simulator's bag of scans alone) each scan is predicted from the
     /// last one by the motion the estimate made between the two before
@@ -285,6 +304,8 @@ impl Default for LogSlamConfig {
             smooth_max_move_m: 0.1,
             smooth_max_turn_rad: 2f64.to_radians(),
             smooth_spacing_m: 0.05,
+            smooth_odometry: true,
+            fusion_max_move_m: 0.5,
         }
     }
 }
@@ -331,6 +352,10 @@ pub struct LogSlamStats {
     pub closures_far_weak: usize,
     /// Keys given a square walls' heading prior ([`crate::slam::manhattan`]).
     pub square_keys: usize,
+    /// The odometry's and the smoothed scans' noise as measured for their
+    /// fusion ([`super::fusion`]), where they were fused.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fusion_noise: Option<FusionNoise>,
 }
 
 /// The SLAM state of one log replay.
@@ -790,6 +815,8 @@ impl LogSlam {
             .iter()
             .map(|p| scan_normals_within(p, NORMAL_RADIUS_M))
             .collect();
+        let before = self.poses();
+        let mut placements: Vec<Option<Placement>> = vec![None; self.scans.len()];
         // The scans of one key follow one another.
         let mut start = 0;
         while start < self.scans.len() {
@@ -813,19 +840,39 @@ impl LogSlam {
             }
             let target = IcpTarget::new(&points, &normals, cfg.smooth_radius_m);
             let node = self.graph.nodes[key];
-            for (entry, scan) in self.scans[start..end].iter_mut().zip(&scans[start..end]) {
+            for (k, (entry, scan)) in self.scans[start..end]
+                .iter_mut()
+                .zip(&scans[start..end])
+                .enumerate()
+            {
                 let points = points_every(scan, cfg.match_range_m, cfg.smooth_spacing_m);
                 let now = node.compose(&entry.relative);
                 let fit = target.align(&points, &now, cfg.smooth_huber_m, cfg.smooth_iterations);
-                let d = now.between(&fit.pose);
                 if fit.associated * 2 >= points.len()
-                    && d.position().length() <= cfg.smooth_max_move_m
-                    && d.theta.abs() <= cfg.smooth_max_turn_rad
+                    && within(&now, &fit.pose, cfg.smooth_max_move_m, cfg)
                 {
                     entry.relative = node.between(&fit.pose);
+                    placements[start + k] = Some(Placement {
+                        pose: fit.pose,
+                        information: fit.information,
+                    });
                 }
             }
             start = end;
+        }
+        if !(cfg.smooth_odometry && cfg.odometry) {
+            return;
+        }
+        let odometry: Vec<Pose2> = self.scans.iter().map(|e| e.odometry).collect();
+        let Some(noise) = measure_noise(&placements, &odometry) else {
+            return;
+        };
+        self.stats.fusion_noise = Some(noise);
+        let fused = fuse(&self.poses(), &placements, &odometry, &noise);
+        for ((entry, pose), was) in self.scans.iter_mut().zip(fused).zip(&before) {
+            if within(was, &pose, cfg.fusion_max_move_m, cfg) {
+                entry.relative = self.graph.nodes[entry.key].between(&pose);
+            }
         }
     }
 
@@ -889,6 +936,12 @@ impl LogSlam {
             }
         })
     }
+}
+
+/// Whether `to` lies within `max_move_m` and the smoothing's turn of `from`.
+fn within(from: &Pose2, to: &Pose2, max_move_m: f64, cfg: &LogSlamConfig) -> bool {
+    let d = from.between(to);
+    d.position().length() <= max_move_m && d.theta.abs() <= cfg.smooth_max_turn_rad
 }
 
 /// The neighbourhood of a key's point its surface normal is fitted over

@@ -8,7 +8,9 @@
 //! |---|---|---|
 //! | one scan of a log, its beams and poses | [`scan`] | — |
 //! | the replay: matching, key scans, loop closures | [`logslam`] | Karto / slam_toolbox, Cartographer |
+//! | the smoothed scans fused with the odometry, noises measured from the log | [`fusion`] | a fixed-interval smoother; the Allan variance's lag fit |
 
+pub mod fusion;
 pub mod logslam;
 pub mod scan;
 
