@@ -5,14 +5,29 @@
 //! formats of one log).
 //!
 //! `cargo run --release -p slamlab --example bag_replay -- BAG_OR_LOG [--poses] [--png MAP.png]
-//!  [--odom-none] [--odom-topic T] [--scan-topic T] [--truth-topic T] [--relations FILE] [--json REPORT.json]`
+//!  [--odom-none] [--odom-topic T] [--scan-topic T] [--truth-topic T] [--relations FILE [--check-relations]]
+//!  [--json REPORT.json]`
+//!
+//! `--check-relations`: each relation of the file checked
+//! against its two scans ([`slamlab::slam::eval::verified::check_pair`]):
+//! scan `t2` aligned onto scan `t1` by point-to-line ICP from the
+//! relation and from the replay's relative pose. Where both reach one pose
+//! that pins every direction, that pose is the scans' own relation; a
+//! relation more than 0.1 m or 1° from it, at which the scans fit worse
+//! (by 2 mm of mean misfit), is contradicted by its own scans. Prints the
+//! counts, the replay's error against the relations the scans do not
+//! contradict, and each contradicted relation.
 //! (settings to measure: `SLAMLAB_LOG_SLAM=key=value,...`)
 
 #[path = "../../tests/real_support/mod.rs"]
 mod support;
 
+use glam::DVec2;
+use slamlab::geom::Pose2;
 use slamlab::lab::bag_file::{BagFile, Picks};
-use slamlab::lab::log_replay::LogReplay;
+use slamlab::lab::log_replay::{LogReplay, LogReport};
+use slamlab::slam::eval::benchmark_relations::parse_relations;
+use slamlab::slam::eval::verified::{check_pair, VerifyConfig};
 use std::path::Path;
 use std::time::Instant;
 
@@ -144,6 +159,14 @@ fn main() -> Result<(), String> {
             q.matched, q.count, q.trans_m.mean, q.trans_m.sd, q.trans_m.max, q.rot_deg.mean, q.rot_deg.sd, q.rot_deg.max
         );
     }
+    if args.iter().any(|a| a == "--check-relations") {
+        let i = args.iter().position(|a| a == "--relations");
+        let file = i
+            .and_then(|i| args.get(i + 1))
+            .ok_or("--check-relations needs --relations FILE")?;
+        let text = std::fs::read_to_string(file).map_err(|e| e.to_string())?;
+        check_relations(&replay, &report, &text)?;
+    }
     if let Some(a) = report.ate_m {
         eprintln!(
             "ATE against the ground truth: {a:.4} m over {} scans",
@@ -166,6 +189,109 @@ fn main() -> Result<(), String> {
         for s in &report.scans {
             println!("{} {:?} {:?}", s.index, s.time, s.pose);
         }
+    }
+    Ok(())
+}
+
+/// A scan's returns within 20 m in its laser's frame.
+fn laser_points(scan: &slamlab::slam::logs::LogScan) -> Vec<DVec2> {
+    (0..scan.ranges.len())
+        .filter(|&i| !scan.no_return(i) && (scan.ranges[i] as f64) <= 20.0)
+        .map(|i| DVec2::from_angle(scan.bearing(i)) * scan.ranges[i] as f64)
+        .collect()
+}
+
+/// `--check-relations` (module doc).
+fn check_relations(replay: &LogReplay, report: &LogReport, text: &str) -> Result<(), String> {
+    let relations = parse_relations(text)?;
+    let q = report.relations.as_ref().ok_or("no relation score")?;
+    // The report's k-th scan is the log's scan of its index.
+    let position: std::collections::HashMap<usize, usize> = replay
+        .scans()
+        .iter()
+        .enumerate()
+        .map(|(k, s)| (s.index, k))
+        .collect();
+    let scan = |k: usize| &replay.scans()[position[&report.scans[k].index]];
+    let cfg = VerifyConfig::default();
+    let laser = |k: usize| {
+        let p = report.scans[k].pose;
+        Pose2::new(p[0], p[1], p[2]).compose(&scan(k).laser_offset)
+    };
+    let (mut settled, mut contradicted, mut largest) = (0, Vec::new(), Vec::new());
+    let (mut kept_t, mut kept_r) = (Vec::new(), Vec::new());
+    // The relations whose two scans were replayed, in the file's order
+    // as the score's errors are.
+    let scored = relations
+        .iter()
+        .filter(|r| q.errors.iter().any(|e| e.t1 == r.t1 && e.t2 == r.t2));
+    for (r, e) in scored.zip(&q.errors) {
+        let (a, b) = (scan(e.scan1), scan(e.scan2));
+        let ours = laser(e.scan1).between(&laser(e.scan2));
+        let c = check_pair(&laser_points(a), &laser_points(b), &r.pose, &ours, &cfg);
+        let against = |p: &Pose2| {
+            let d = ours.between(p);
+            (d.position().length(), d.theta.abs().to_degrees())
+        };
+        if e.trans_m > 0.2 || e.rot_deg > 2.0 {
+            largest.push((r, against(&r.pose), c.settled.map(|s| against(&s))));
+        }
+        if let Some(s) = c.settled {
+            settled += 1;
+            let off = r.pose.between(&s);
+            if (off.position().length() > 0.1 || off.theta.abs() > 1f64.to_radians())
+                && c.misfit_settled + 0.002 < c.misfit_given
+            {
+                contradicted.push((r, off, against(&r.pose), against(&s), c));
+                continue;
+            }
+        }
+        let (t, d) = against(&r.pose);
+        kept_t.push(t);
+        kept_r.push(d);
+    }
+    let spread = |v: &[f64]| {
+        let n = v.len().max(1) as f64;
+        let m = v.iter().sum::<f64>() / n;
+        (
+            m,
+            (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / n).sqrt(),
+        )
+    };
+    let ((mt, st), (mr, sr)) = (spread(&kept_t), spread(&kept_r));
+    eprintln!(
+        "checked against their scans: {} relations, {settled} settled by the scans, {} contradicted by them",
+        q.matched,
+        contradicted.len()
+    );
+    eprintln!(
+        "against the {} relations not contradicted: translation {mt:.4} ± {st:.4} m, rotation {mr:.3} ± {sr:.3} deg",
+        kept_t.len()
+    );
+    for (r, off, given, scans, c) in &contradicted {
+        eprintln!(
+            "  {:.3} -> {:.3}: the scans settle {:.3} m / {:.2} deg from the relation (misfit {:.1} mm there, {:.1} mm at the relation); ours errs {:.3} m / {:.2} deg against the relation, {:.3} m / {:.2} deg against the scans",
+            r.t1,
+            r.t2,
+            off.position().length(),
+            off.theta.to_degrees(),
+            c.misfit_settled * 1e3,
+            c.misfit_given * 1e3,
+            given.0,
+            given.1,
+            scans.0,
+            scans.1
+        );
+    }
+    eprintln!("relations the replay misses by over 0.2 m or 2°, and what their scans say:");
+    for (r, given, scans) in &largest {
+        let said = scans.map_or("the scans settle no pose".to_string(), |(t, d)| {
+            format!("ours errs {t:.3} m / {d:.2} deg against the pose the scans settle")
+        });
+        eprintln!(
+            "  {:.3} -> {:.3}: ours errs {:.3} m / {:.2} deg against the relation; {said}",
+            r.t1, r.t2, given.0, given.1
+        );
     }
     Ok(())
 }

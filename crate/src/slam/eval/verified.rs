@@ -205,6 +205,48 @@ pub fn verified_relations(
     out
 }
 
+/// What two scans say of a relation given between them (a benchmark's
+/// relation file, [`super::benchmark_relations`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PairCheck {
+    /// The pose that ICP reaches both from the given relation and from
+    /// `other` (within `same_m` and `same_rad`), where that fit pins every
+    /// direction and meets `min_share` of scan `j`'s points: the scans'
+    /// own relation. `None`: the scans do not settle one.
+    pub settled: Option<Pose2>,
+    /// Mean point-to-line misfit (m, each point clamped to 5 cm) of scan
+    /// `j`'s points at the given relation and at the settled pose.
+    pub misfit_given: f64,
+    pub misfit_settled: f64,
+}
+
+/// Checks the relation `given` (scan `j`'s pose in scan `i`'s frame; points
+/// in each scan's own frame) against the scans, as [`verified_relations`]
+/// checks a candidate: point-to-line ICP of scan `j` onto scan `i` from
+/// `given` and from `other` (another estimate of the same relation).
+pub fn check_pair(
+    points_i: &[DVec2],
+    points_j: &[DVec2],
+    given: &Pose2,
+    other: &Pose2,
+    cfg: &VerifyConfig,
+) -> PairCheck {
+    let t = IcpTarget::new(points_i, &scan_normals(points_i), cfg.radius_m);
+    let from_given = t.align(points_j, given, cfg.huber_m, cfg.iterations);
+    let from_other = t.align(points_j, other, cfg.huber_m, cfg.iterations);
+    let d = from_given.pose.between(&from_other.pose);
+    let settled = (d.position().length() <= cfg.same_m
+        && d.theta.abs() <= cfg.same_rad
+        && from_given.weak >= cfg.min_weak
+        && from_given.associated as f64 >= cfg.min_share * points_j.len() as f64)
+        .then_some(from_given.pose);
+    PairCheck {
+        settled,
+        misfit_given: misfit(&t, points_j, given),
+        misfit_settled: settled.map_or(f64::NAN, |p| misfit(&t, points_j, &p)),
+    }
+}
+
 /// An estimate's errors against the accepted relations of one gap class
 /// (or all of them).
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -302,5 +344,43 @@ mod tests {
         assert!((eb[4].rot_deg - 1.6 / 3.0).abs() < 0.01, "{eb:?}");
         assert!(eb[4].trans_m > 0.03 && eb[4].trans_m < 0.06, "{eb:?}");
         assert_eq!(eb[4].over, 0);
+    }
+
+    #[test]
+    fn a_relation_its_scans_contradict_is_found_and_a_right_one_is_not() {
+        let (p, q) = (Pose2::new(0.0, 0.0, 0.0), Pose2::new(0.5, 0.2, 0.3));
+        let (a, b) = (room_seen_from(&p), room_seen_from(&q));
+        let truth = p.between(&q);
+        let cfg = VerifyConfig::default();
+        // A relation 2° and 4 cm off, checked with an estimate near the truth.
+        let wrong = truth.compose(&Pose2::new(0.04, 0.0, 2f64.to_radians()));
+        let near = truth.compose(&Pose2::new(0.005, -0.005, 0.1f64.to_radians()));
+        let c = check_pair(&a, &b, &wrong, &near, &cfg);
+        let settled = c.settled.expect("a room pins every direction");
+        let off = settled.between(&truth);
+        assert!(
+            off.position().length() < 0.002 && off.theta.abs() < 0.001,
+            "{c:?}"
+        );
+        assert!(c.misfit_settled + 0.002 < c.misfit_given, "{c:?}");
+        // The right relation settles where it is, with the same misfit.
+        let c = check_pair(&a, &b, &truth, &near, &cfg);
+        let off = c.settled.expect("settles").between(&truth);
+        assert!(off.position().length() < 0.002, "{c:?}");
+        assert!((c.misfit_given - c.misfit_settled).abs() < 0.001, "{c:?}");
+        // A corridor, seen from two places along it, settles nothing.
+        let corridor = |x: f64| -> Vec<DVec2> {
+            let wall = |y: f64| (0..400).map(move |k| DVec2::new(-4.0 + 0.02 * k as f64 - x, y));
+            wall(-1.0).chain(wall(1.0)).collect()
+        };
+        let step = Pose2::new(0.3, 0.0, 0.0);
+        let c = check_pair(
+            &corridor(0.0),
+            &corridor(0.3),
+            &step,
+            &Pose2::new(0.5, 0.0, 0.0),
+            &cfg,
+        );
+        assert_eq!(c.settled, None, "{c:?}");
     }
 }
