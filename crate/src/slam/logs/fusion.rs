@@ -89,16 +89,13 @@ fn robust_variance(values: &mut [f64]) -> Option<f64> {
     if values.len() < 20 {
         return None;
     }
-    let median = median(values);
+    let median = median_of(values);
     let mut dev: Vec<f64> = values.iter().map(|v| (v - median).abs()).collect();
     let mad = median_of(&mut dev);
     Some((1.4826 * mad).powi(2))
 }
 
-fn median(values: &mut [f64]) -> f64 {
-    median_of(values)
-}
-
+/// The median of `values` (the upper one of an even count; reorders them).
 fn median_of(values: &mut [f64]) -> f64 {
     let mid = values.len() / 2;
     *values.select_nth_unstable_by(mid, f64::total_cmp).1
