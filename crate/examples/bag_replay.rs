@@ -28,6 +28,8 @@ use slamlab::lab::bag_file::{BagFile, Picks};
 use slamlab::lab::log_replay::{LogReplay, LogReport};
 use slamlab::slam::eval::benchmark_relations::parse_relations;
 use slamlab::slam::eval::verified::{check_pair, VerifyConfig};
+use slamlab::slam::logs::logslam::scan_points;
+use slamlab::slam::logs::{LogScan, LogSlamConfig};
 use std::path::Path;
 use std::time::Instant;
 
@@ -193,12 +195,17 @@ fn main() -> Result<(), String> {
     Ok(())
 }
 
-/// A scan's returns within 20 m in its laser's frame.
-fn laser_points(scan: &slamlab::slam::logs::LogScan) -> Vec<DVec2> {
-    (0..scan.ranges.len())
-        .filter(|&i| !scan.no_return(i) && (scan.ranges[i] as f64) <= 20.0)
-        .map(|i| DVec2::from_angle(scan.bearing(i)) * scan.ranges[i] as f64)
-        .collect()
+/// A scan's every return within the matching range, in its laser's frame.
+fn laser_points(scan: &LogScan) -> Vec<DVec2> {
+    let dense = LogSlamConfig {
+        point_spacing_m: 0.0,
+        ..LogSlamConfig::default()
+    };
+    let at_laser = LogScan {
+        laser_offset: Pose2::IDENTITY,
+        ..scan.clone()
+    };
+    scan_points(&at_laser, &dense)
 }
 
 /// `--check-relations` (module doc).

@@ -387,7 +387,9 @@ impl LogReplay {
         if self.map.is_some() {
             return Ok(());
         }
-        self.relatives_then = self.slam.scans.iter().map(|s| s.relative).collect();
+        if self.slam.config.smooth_keys > 0 {
+            self.relatives_then = self.slam.scans.iter().map(|s| s.relative).collect();
+        }
         self.slam.finish(&self.scans[self.from..=self.to])?;
         self.keep_version();
         let scans = &self.scans[self.from..=self.to];

@@ -49,6 +49,7 @@
 //! and the fusion leaves the placements as they are.
 
 use crate::geom::{wrap_angle, Pose2};
+use crate::slam::filter::{inverse3, mul, transpose};
 
 /// One scan's ICP placement and the information of its normal equations
 /// (point-to-line, unit weights; world-frame `[x, y, θ]`).
@@ -152,45 +153,8 @@ fn add(a: &mut M3, b: &M3) {
     }
 }
 
-fn mul(a: &M3, b: &M3) -> M3 {
-    let mut m = [[0.0; 3]; 3];
-    for r in 0..3 {
-        for c in 0..3 {
-            m[r][c] = (0..3).map(|k| a[r][k] * b[k][c]).sum();
-        }
-    }
-    m
-}
-
-fn transpose(a: &M3) -> M3 {
-    let mut m = [[0.0; 3]; 3];
-    for r in 0..3 {
-        for c in 0..3 {
-            m[r][c] = a[c][r];
-        }
-    }
-    m
-}
-
 fn mul_vec(a: &M3, v: &[f64; 3]) -> [f64; 3] {
     [0, 1, 2].map(|r| (0..3).map(|k| a[r][k] * v[k]).sum())
-}
-
-fn inverse(a: &M3) -> Option<M3> {
-    let det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
-        - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
-        + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
-    if det.abs() < 1e-300 || !det.is_finite() {
-        return None;
-    }
-    // The adjugate's entry (r, c) is the cofactor of (c, r).
-    Some([0, 1, 2].map(|r| {
-        [0, 1, 2].map(|c| {
-            let (r1, r2) = ((c + 1) % 3, (c + 2) % 3);
-            let (c1, c2) = ((r + 1) % 3, (r + 2) % 3);
-            (a[r1][c1] * a[r2][c2] - a[r1][c2] * a[r2][c1]) / det
-        })
-    }))
 }
 
 /// The placements' information scaled to the measured noise: the
@@ -199,7 +163,7 @@ fn inverse(a: &M3) -> Option<M3> {
 fn scaled_information(placements: &[Option<Placement>], noise: &FusionNoise) -> Vec<Option<M3>> {
     let covariances: Vec<Option<M3>> = placements
         .iter()
-        .map(|p| p.as_ref().and_then(|p| inverse(&p.information)))
+        .map(|p| p.as_ref().and_then(|p| inverse3(&p.information)))
         .collect();
     let mut t: Vec<f64> = covariances
         .iter()
@@ -351,7 +315,7 @@ fn solve_block_tridiagonal(
                 }
             }
         }
-        inv.push(inverse(&diag[i])?);
+        inv.push(inverse3(&diag[i])?);
     }
     let mut x = vec![[0.0; 3]; n];
     for i in (0..n).rev() {

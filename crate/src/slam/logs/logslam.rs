@@ -795,17 +795,21 @@ impl LogSlam {
                 g.optimise(20).map(|_| ())
             })?;
         }
-        self.smooth(scans);
+        let before = self.poses();
+        let placements = self.smooth(scans);
+        self.fuse_odometry(&placements, &before);
         Ok(())
     }
 
     /// Step 7 of the module doc: each scan aligned by ICP on the keys
     /// around its own, its pose relative to its key replaced where the
-    /// alignment holds.
-    fn smooth(&mut self, scans: &[LogScan]) {
+    /// alignment holds. Returns each scan's placement (`None`: kept its
+    /// pose; all `None` without smoothing).
+    fn smooth(&mut self, scans: &[LogScan]) -> Vec<Option<Placement>> {
+        let mut placements: Vec<Option<Placement>> = vec![None; self.scans.len()];
         let half = self.config.smooth_keys;
         if half == 0 || scans.len() != self.scans.len() {
-            return;
+            return placements;
         }
         let cfg = &self.config;
         let n = self.graph.nodes.len();
@@ -815,8 +819,6 @@ impl LogSlam {
             .iter()
             .map(|p| scan_normals_within(p, NORMAL_RADIUS_M))
             .collect();
-        let before = self.poses();
-        let mut placements: Vec<Option<Placement>> = vec![None; self.scans.len()];
         // The scans of one key follow one another.
         let mut start = 0;
         while start < self.scans.len() {
@@ -860,16 +862,25 @@ impl LogSlam {
             }
             start = end;
         }
-        if !(cfg.smooth_odometry && cfg.odometry) {
+        placements
+    }
+
+    /// Step 8 of the module doc: the placements fused with the odometry,
+    /// each scan's pose relative to its key replaced where the fused pose
+    /// lies within `fusion_max_move_m` of where the replay left it
+    /// (`before`).
+    fn fuse_odometry(&mut self, placements: &[Option<Placement>], before: &[Pose2]) {
+        let cfg = &self.config;
+        if !(cfg.smooth_odometry && cfg.odometry) || placements.iter().all(Option::is_none) {
             return;
         }
         let odometry: Vec<Pose2> = self.scans.iter().map(|e| e.odometry).collect();
-        let Some(noise) = measure_noise(&placements, &odometry) else {
+        let Some(noise) = measure_noise(placements, &odometry) else {
             return;
         };
         self.stats.fusion_noise = Some(noise);
-        let fused = fuse(&self.poses(), &placements, &odometry, &noise);
-        for ((entry, pose), was) in self.scans.iter_mut().zip(fused).zip(&before) {
+        let fused = fuse(&self.poses(), placements, &odometry, &noise);
+        for ((entry, pose), was) in self.scans.iter_mut().zip(fused).zip(before) {
             if within(was, &pose, cfg.fusion_max_move_m, cfg) {
                 entry.relative = self.graph.nodes[entry.key].between(&pose);
             }
