@@ -14,9 +14,12 @@
 //! relation and from the replay's relative pose. Where both reach one pose
 //! that pins every direction, that pose is the scans' own relation; a
 //! relation more than 0.1 m or 1° from it, at which the scans fit worse
-//! (by 2 mm of mean misfit), is contradicted by its own scans. Prints the
-//! counts, the replay's error against the relations the scans do not
-//! contradict, and each contradicted relation.
+//! (by 2 mm of mean misfit), is contradicted by its own scans. Where the
+//! scans settle no pose (a corridor), a relation over at most 16 scans is
+//! checked against the wheel odometry instead
+//! ([`slamlab::slam::eval::verified::odometry_contradicts`]). Prints the
+//! counts, the replay's error against the relations contradicted by
+//! neither, and each contradicted relation.
 //! (settings to measure: `SLAMLAB_LOG_SLAM=key=value,...`)
 
 #[path = "../../tests/real_support/mod.rs"]
@@ -27,7 +30,7 @@ use slamlab::geom::Pose2;
 use slamlab::lab::bag_file::{BagFile, Picks};
 use slamlab::lab::log_replay::{LogReplay, LogReport};
 use slamlab::slam::eval::benchmark_relations::parse_relations;
-use slamlab::slam::eval::verified::{check_pair, VerifyConfig};
+use slamlab::slam::eval::verified::{check_pair, odometry_contradicts, VerifyConfig};
 use slamlab::slam::logs::logslam::scan_points;
 use slamlab::slam::logs::{LogScan, LogSlamConfig};
 use std::path::Path;
@@ -225,7 +228,19 @@ fn check_relations(replay: &LogReplay, report: &LogReport, text: &str) -> Result
         let p = report.scans[k].pose;
         Pose2::new(p[0], p[1], p[2]).compose(&scan(k).laser_offset)
     };
+    // The wheels' relative pose of two scans (at the laser), and their
+    // noise per step as the fusion measured it.
+    let wheels = |k: usize| {
+        report.scans[k]
+            .odometry
+            .map(|o| Pose2::new(o[0], o[1], o[2]).compose(&scan(k).laser_offset))
+    };
+    let step_variance = report
+        .slam
+        .fusion_noise
+        .map(|n| [n.odometry_step[0], n.odometry_step[1]]);
     let (mut settled, mut contradicted, mut largest) = (0, Vec::new(), Vec::new());
+    let mut by_wheels = Vec::new();
     let (mut kept_t, mut kept_r) = (Vec::new(), Vec::new());
     // The relations whose two scans were replayed, in the file's order
     // as the score's errors are.
@@ -252,6 +267,15 @@ fn check_relations(replay: &LogReplay, report: &LogReport, text: &str) -> Result
                 contradicted.push((r, off, against(&r.pose), against(&s), c));
                 continue;
             }
+        } else if let (Some(wa), Some(wb), Some(q)) =
+            (wheels(e.scan1), wheels(e.scan2), step_variance)
+        {
+            let odometry = wa.between(&wb);
+            if odometry_contradicts(&r.pose, &odometry, e.scan2.abs_diff(e.scan1), q) {
+                let apart = r.pose.position().distance(odometry.position());
+                by_wheels.push((r, apart, against(&r.pose), against(&odometry)));
+                continue;
+            }
         }
         let (t, d) = against(&r.pose);
         kept_t.push(t);
@@ -272,9 +296,19 @@ fn check_relations(replay: &LogReplay, report: &LogReport, text: &str) -> Result
         contradicted.len()
     );
     eprintln!(
-        "against the {} relations not contradicted: translation {mt:.4} ± {st:.4} m, rotation {mr:.3} ± {sr:.3} deg",
+        "where the scans settle no pose, {} relations contradicted by the wheel odometry",
+        by_wheels.len()
+    );
+    eprintln!(
+        "against the {} relations contradicted by neither: translation {mt:.4} ± {st:.4} m, rotation {mr:.3} ± {sr:.3} deg",
         kept_t.len()
     );
+    for (r, apart, given, wheels) in &by_wheels {
+        eprintln!(
+            "  {:.3} -> {:.3}: the wheels say {apart:.3} m from the relation; ours errs {:.3} m / {:.2} deg against the relation, {:.3} m against the wheels",
+            r.t1, r.t2, given.0, given.1, wheels.0
+        );
+    }
     for (r, off, given, scans, c) in &contradicted {
         eprintln!(
             "  {:.3} -> {:.3}: the scans settle {:.3} m / {:.2} deg from the relation (misfit {:.1} mm there, {:.1} mm at the relation); ours errs {:.3} m / {:.2} deg against the relation, {:.3} m / {:.2} deg against the scans",

@@ -247,6 +247,40 @@ pub fn check_pair(
     }
 }
 
+/// Scans apart within which the wheel odometry can witness a relation
+/// ([`odometry_contradicts`]): over more, its drift is no longer a few
+/// steps' random walk.
+pub const ODOMETRY_WITNESS_SCANS: usize = 16;
+
+/// Whether the wheel odometry contradicts the translation of a relation
+/// `given` between two scans `steps` apart, where the scans settle no pose
+/// ([`check_pair`]; a corridor whose ends are out of sight fixes nothing
+/// along it, and there the relation says what no scan can). `odometry` is
+/// the odometry's relative pose of the same two scans, `step_variance` its
+/// measured variance per step along each axis (m², as the fusion of
+/// [`crate::slam::logs::fusion`] measures it from the log).
+///
+/// Contradicted when the two lie more than 0.1 m apart and more than five
+/// standard deviations of `steps` steps' random walk: a relation of 0.75 m
+/// over two scans of half a second, where the wheels say 0.34 m, is a
+/// robot moving 1.5 m/s in a log that never goes faster than 1 m/s. Only
+/// the translation is tested: a wheel's heading error comes in the turns,
+/// not as a random walk. The odometry is not the SLAM's estimate, so this
+/// is a second witness independent of the one being scored.
+pub fn odometry_contradicts(
+    given: &Pose2,
+    odometry: &Pose2,
+    steps: usize,
+    step_variance: [f64; 2],
+) -> bool {
+    if steps == 0 || steps > ODOMETRY_WITNESS_SCANS {
+        return false;
+    }
+    let sigma = (steps as f64 * (step_variance[0] + step_variance[1])).sqrt();
+    let apart = given.position().distance(odometry.position());
+    apart > 0.1 && apart > 5.0 * sigma
+}
+
 /// An estimate's errors against the accepted relations of one gap class
 /// (or all of them).
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -294,6 +328,28 @@ pub fn errors_by_gap(relations: &[Verified], estimate: &[Pose2]) -> Vec<GapError
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn odometry_witnesses_only_a_short_relation_it_is_sure_of() {
+        let given = Pose2::new(0.755, -0.036, 0.039);
+        let wheels = Pose2::new(0.342, 0.0, 0.04);
+        // σ 6 mm per step (ACES's wheels): 0.41 m over 2 steps is 48σ.
+        let ok = [3.6e-5 / 2.0, 3.6e-5 / 2.0];
+        assert!(odometry_contradicts(&given, &wheels, 2, ok));
+        // Under 0.1 m apart: not contradicted, however sure the wheels.
+        let near = Pose2::new(0.43, 0.0, 0.04);
+        assert!(!odometry_contradicts(&near, &wheels, 2, ok));
+        // Wheels of σ 0.1 m per step: 0.41 m over 2 steps is 2.9σ.
+        assert!(!odometry_contradicts(&given, &wheels, 2, [0.005, 0.005]));
+        // Too many steps apart for a random walk to speak.
+        assert!(!odometry_contradicts(
+            &given,
+            &wheels,
+            ODOMETRY_WITNESS_SCANS + 1,
+            ok
+        ));
+        assert!(!odometry_contradicts(&given, &wheels, 0, ok));
+    }
 
     /// A 6 × 4 m room's walls, a point every 2 cm, seen from `pose`: robot
     /// frame, in bearing order as a laser returns them.
