@@ -18,8 +18,10 @@
 //! scans settle no pose (a corridor), a relation over at most 16 scans is
 //! checked against the wheel odometry instead
 //! ([`slamlab::slam::eval::verified::odometry_contradicts`]). Prints the
-//! counts, the replay's error against the relations contradicted by
-//! neither, and each contradicted relation.
+//! counts; where the scans settle a pose, how far the relations and the
+//! replay each lie from it (the relation file's own noise beside ours);
+//! the replay's error against the relations contradicted by neither; and
+//! each contradicted relation.
 //! (settings to measure: `SLAMLAB_LOG_SLAM=key=value,...`)
 
 #[path = "../../tests/real_support/mod.rs"]
@@ -241,6 +243,8 @@ fn check_relations(replay: &LogReplay, report: &LogReport, text: &str) -> Result
         .map(|n| [n.odometry_step[0], n.odometry_step[1]]);
     let (mut settled, mut contradicted, mut largest) = (0, Vec::new(), Vec::new());
     let mut by_wheels = Vec::new();
+    // Where the scans settle a pose: the file's and ours, each against it.
+    let mut to_settled: Vec<[f64; 4]> = Vec::new();
     let (mut kept_t, mut kept_r) = (Vec::new(), Vec::new());
     // The relations whose two scans were replayed, in the file's order
     // as the score's errors are.
@@ -260,6 +264,13 @@ fn check_relations(replay: &LogReplay, report: &LogReport, text: &str) -> Result
         }
         if let Some(s) = c.settled {
             settled += 1;
+            let (file, mine) = (r.pose.between(&s), ours.between(&s));
+            to_settled.push([
+                file.position().length(),
+                file.theta.abs().to_degrees(),
+                mine.position().length(),
+                mine.theta.abs().to_degrees(),
+            ]);
             let off = r.pose.between(&s);
             if (off.position().length() > 0.1 || off.theta.abs() > 1f64.to_radians())
                 && c.misfit_settled + 0.002 < c.misfit_given
@@ -294,6 +305,15 @@ fn check_relations(replay: &LogReplay, report: &LogReport, text: &str) -> Result
         "checked against their scans: {} relations, {settled} settled by the scans, {} contradicted by them",
         q.matched,
         contradicted.len()
+    );
+    let mean =
+        |k: usize| to_settled.iter().map(|v| v[k]).sum::<f64>() / to_settled.len().max(1) as f64;
+    eprintln!(
+        "against the pose the scans settle: the relations err {:.4} m / {:.3} deg, ours {:.4} m / {:.3} deg",
+        mean(0),
+        mean(1),
+        mean(2),
+        mean(3)
     );
     eprintln!(
         "where the scans settle no pose, {} relations contradicted by the wheel odometry",
