@@ -49,6 +49,27 @@ test('bag-info lists every shared bag\'s topics, counts and what run-log would p
   assert.match(text, /run-log picks:\s+scans \/scan/);
 });
 
+test('run-log --check-relations checks each relation against its own scans and the wheels', () => {
+  const bag = path.join(bags, 'freiburg/mit-csail.bag');
+  const relations = path.join(bags, 'freiburg/mit-csail.relations');
+  const r = runCli('run-log', bag, '--json', '--relations', relations, '--check-relations');
+  assert.equal(r.code, 0, r.stderr);
+  const report = JSON.parse(r.stdout);
+  const c = report.relation_check;
+  assert.equal(c.checked, report.relations.matched);
+  assert.equal(c.uncontradicted + c.contradicted.length, c.checked);
+  assert.ok(c.settled > 950 && c.settled <= c.checked, `${c.settled} settled`);
+  assert.ok(c.by_scans >= 30 && c.by_scans <= 55, `${c.by_scans} contradicted by their scans`);
+  assert.ok(c.contradicted.every((x) => x.by === 'scans' || x.by === 'odometry'));
+  // Where the scans settle a pose, ours lies nearer it than the relations do.
+  assert.ok(c.ours_vs_scans.trans_m < 0.6 * c.relations_vs_scans.trans_m, JSON.stringify(c.ours_vs_scans));
+  assert.ok(c.trans_m.mean <= report.relations.trans_m.mean, `${c.trans_m.mean} against ${report.relations.trans_m.mean}`);
+  // Without --relations there is nothing to check: a usage error.
+  const bad = runCli('run-log', bag, '--check-relations');
+  assert.equal(bad.code, 2);
+  assert.match(bad.stderr, /--check-relations needs --relations FILE/);
+});
+
 test('run-log replays the bags without odometry by scan matching, and scores the one with ground truth', () => {
   const dir = tempDir();
   try {

@@ -118,6 +118,14 @@ export class LogReplay {
   }
 
   /**
+   * Whether the report also checks the relations against their own scans
+   * and the wheel odometry (its `relation_check`).
+   */
+  setCheckRelations(on) {
+    this.raw.setCheckRelations(on);
+  }
+
+  /**
    * The replay so far scored against the relations: `{count, matched,
    * trans_m: {mean, sd, max}, rot_deg: {mean, sd, max}, worst, errors}`,
    * each error `{t1, t2, scan1, scan2, trans_m, rot_deg}`.

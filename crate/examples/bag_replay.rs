@@ -27,14 +27,8 @@
 #[path = "../../tests/real_support/mod.rs"]
 mod support;
 
-use glam::DVec2;
-use slamlab::geom::Pose2;
 use slamlab::lab::bag_file::{BagFile, Picks};
-use slamlab::lab::log_replay::{LogReplay, LogReport};
-use slamlab::slam::eval::benchmark_relations::parse_relations;
-use slamlab::slam::eval::verified::{check_pair, odometry_contradicts, VerifyConfig};
-use slamlab::slam::logs::logslam::scan_points;
-use slamlab::slam::logs::{LogScan, LogSlamConfig};
+use slamlab::lab::log_replay::LogReplay;
 use std::path::Path;
 use std::time::Instant;
 
@@ -167,12 +161,7 @@ fn main() -> Result<(), String> {
         );
     }
     if args.iter().any(|a| a == "--check-relations") {
-        let i = args.iter().position(|a| a == "--relations");
-        let file = i
-            .and_then(|i| args.get(i + 1))
-            .ok_or("--check-relations needs --relations FILE")?;
-        let text = std::fs::read_to_string(file).map_err(|e| e.to_string())?;
-        check_relations(&replay, &report, &text)?;
+        print_check(&replay)?;
     }
     if let Some(a) = report.ate_m {
         eprintln!(
@@ -200,158 +189,48 @@ fn main() -> Result<(), String> {
     Ok(())
 }
 
-/// A scan's every return within the matching range, in its laser's frame.
-fn laser_points(scan: &LogScan) -> Vec<DVec2> {
-    let dense = LogSlamConfig {
-        point_spacing_m: 0.0,
-        ..LogSlamConfig::default()
-    };
-    let at_laser = LogScan {
-        laser_offset: Pose2::IDENTITY,
-        ..scan.clone()
-    };
-    scan_points(&at_laser, &dense)
-}
-
-/// `--check-relations` (module doc).
-fn check_relations(replay: &LogReplay, report: &LogReport, text: &str) -> Result<(), String> {
-    let relations = parse_relations(text)?;
-    let q = report.relations.as_ref().ok_or("no relation score")?;
-    // The report's k-th scan is the log's scan of its index.
-    let position: std::collections::HashMap<usize, usize> = replay
-        .scans()
-        .iter()
-        .enumerate()
-        .map(|(k, s)| (s.index, k))
-        .collect();
-    let scan = |k: usize| &replay.scans()[position[&report.scans[k].index]];
-    let cfg = VerifyConfig::default();
-    let laser = |k: usize| {
-        let p = report.scans[k].pose;
-        Pose2::new(p[0], p[1], p[2]).compose(&scan(k).laser_offset)
-    };
-    // The wheels' relative pose of two scans (at the laser), and their
-    // noise per step as the fusion measured it.
-    let wheels = |k: usize| {
-        report.scans[k]
-            .odometry
-            .map(|o| Pose2::new(o[0], o[1], o[2]).compose(&scan(k).laser_offset))
-    };
-    let step_variance = report
-        .slam
-        .fusion_noise
-        .map(|n| [n.odometry_step[0], n.odometry_step[1]]);
-    let (mut settled, mut contradicted, mut largest) = (0, Vec::new(), Vec::new());
-    let mut by_wheels = Vec::new();
-    // Where the scans settle a pose: the file's and ours, each against it.
-    let mut to_settled: Vec<[f64; 4]> = Vec::new();
-    let (mut kept_t, mut kept_r) = (Vec::new(), Vec::new());
-    // The relations whose two scans were replayed, in the file's order
-    // as the score's errors are.
-    let scored = relations
-        .iter()
-        .filter(|r| q.errors.iter().any(|e| e.t1 == r.t1 && e.t2 == r.t2));
-    for (r, e) in scored.zip(&q.errors) {
-        let (a, b) = (scan(e.scan1), scan(e.scan2));
-        let ours = laser(e.scan1).between(&laser(e.scan2));
-        let c = check_pair(&laser_points(a), &laser_points(b), &r.pose, &ours, &cfg);
-        let against = |p: &Pose2| {
-            let d = ours.between(p);
-            (d.position().length(), d.theta.abs().to_degrees())
-        };
-        if e.trans_m > 0.2 || e.rot_deg > 2.0 {
-            largest.push((r, against(&r.pose), c.settled.map(|s| against(&s))));
-        }
-        if let Some(s) = c.settled {
-            settled += 1;
-            let (file, mine) = (r.pose.between(&s), ours.between(&s));
-            to_settled.push([
-                file.position().length(),
-                file.theta.abs().to_degrees(),
-                mine.position().length(),
-                mine.theta.abs().to_degrees(),
-            ]);
-            let off = r.pose.between(&s);
-            if (off.position().length() > 0.1 || off.theta.abs() > 1f64.to_radians())
-                && c.misfit_settled + 0.002 < c.misfit_given
-            {
-                contradicted.push((r, off, against(&r.pose), against(&s), c));
-                continue;
-            }
-        } else if let (Some(wa), Some(wb), Some(q)) =
-            (wheels(e.scan1), wheels(e.scan2), step_variance)
-        {
-            let odometry = wa.between(&wb);
-            if odometry_contradicts(&r.pose, &odometry, e.scan2.abs_diff(e.scan1), q) {
-                let apart = r.pose.position().distance(odometry.position());
-                by_wheels.push((r, apart, against(&r.pose), against(&odometry)));
-                continue;
-            }
-        }
-        let (t, d) = against(&r.pose);
-        kept_t.push(t);
-        kept_r.push(d);
-    }
-    let spread = |v: &[f64]| {
-        let n = v.len().max(1) as f64;
-        let m = v.iter().sum::<f64>() / n;
-        (
-            m,
-            (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / n).sqrt(),
-        )
-    };
-    let ((mt, st), (mr, sr)) = (spread(&kept_t), spread(&kept_r));
+/// `--check-relations` (module doc): prints the replay's
+/// [`LogReplay::relation_check`].
+fn print_check(replay: &LogReplay) -> Result<(), String> {
+    let c = replay.relation_check().ok_or("no relations to check")?;
     eprintln!(
-        "checked against their scans: {} relations, {settled} settled by the scans, {} contradicted by them",
-        q.matched,
-        contradicted.len()
+        "checked against their scans: {} relations, {} settled by the scans, {} contradicted by them",
+        c.checked, c.settled, c.by_scans
     );
-    let mean =
-        |k: usize| to_settled.iter().map(|v| v[k]).sum::<f64>() / to_settled.len().max(1) as f64;
     eprintln!(
         "against the pose the scans settle: the relations err {:.4} m / {:.3} deg, ours {:.4} m / {:.3} deg",
-        mean(0),
-        mean(1),
-        mean(2),
-        mean(3)
+        c.relations_vs_scans.trans_m,
+        c.relations_vs_scans.rot_deg,
+        c.ours_vs_scans.trans_m,
+        c.ours_vs_scans.rot_deg
     );
     eprintln!(
         "where the scans settle no pose, {} relations contradicted by the wheel odometry",
-        by_wheels.len()
+        c.by_odometry
     );
     eprintln!(
-        "against the {} relations contradicted by neither: translation {mt:.4} ± {st:.4} m, rotation {mr:.3} ± {sr:.3} deg",
-        kept_t.len()
+        "against the {} relations contradicted by neither: translation {:.4} ± {:.4} m, rotation {:.3} ± {:.3} deg",
+        c.uncontradicted, c.trans_m.mean, c.trans_m.sd, c.rot_deg.mean, c.rot_deg.sd
     );
-    for (r, apart, given, wheels) in &by_wheels {
+    for x in &c.contradicted {
         eprintln!(
-            "  {:.3} -> {:.3}: the wheels say {apart:.3} m from the relation; ours errs {:.3} m / {:.2} deg against the relation, {:.3} m against the wheels",
-            r.t1, r.t2, given.0, given.1, wheels.0
-        );
-    }
-    for (r, off, given, scans, c) in &contradicted {
-        eprintln!(
-            "  {:.3} -> {:.3}: the scans settle {:.3} m / {:.2} deg from the relation (misfit {:.1} mm there, {:.1} mm at the relation); ours errs {:.3} m / {:.2} deg against the relation, {:.3} m / {:.2} deg against the scans",
-            r.t1,
-            r.t2,
-            off.position().length(),
-            off.theta.to_degrees(),
-            c.misfit_settled * 1e3,
-            c.misfit_given * 1e3,
-            given.0,
-            given.1,
-            scans.0,
-            scans.1
+            "  {:.3} -> {:.3}: the {} say {:.3} m / {:.2} deg from the relation; ours errs {:.3} m / {:.2} deg against the relation, {:.3} m against them",
+            x.t1, x.t2, x.by, x.off_m, x.off_deg, x.ours_m, x.ours_deg, x.ours_vs_witness_m
         );
     }
     eprintln!("relations the replay misses by over 0.2 m or 2°, and what their scans say:");
-    for (r, given, scans) in &largest {
-        let said = scans.map_or("the scans settle no pose".to_string(), |(t, d)| {
-            format!("ours errs {t:.3} m / {d:.2} deg against the pose the scans settle")
-        });
+    for m in &c.misses {
+        let said = m
+            .settled
+            .map_or("the scans settle no pose".to_string(), |o| {
+                format!(
+                    "ours errs {:.3} m / {:.2} deg against the pose the scans settle",
+                    o.trans_m, o.rot_deg
+                )
+            });
         eprintln!(
             "  {:.3} -> {:.3}: ours errs {:.3} m / {:.2} deg against the relation; {said}",
-            r.t1, r.t2, given.0, given.1
+            m.t1, m.t2, m.trans_m, m.rot_deg
         );
     }
     Ok(())

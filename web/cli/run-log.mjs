@@ -12,7 +12,7 @@ import { LogReplay } from '../log-replay.js';
 import { isBag, readBag } from './bag-read.mjs';
 import { parseArgs, UsageError, wasmCall } from './args.mjs';
 
-export const usage = `  node web/cli.mjs run-log LOG [--json] [--out MAP.yaml] [--from N] [--to M] [--trajectory OUT.tum] [--relations FILE]
+export const usage = `  node web/cli.mjs run-log LOG [--json] [--out MAP.yaml] [--from N] [--to M] [--trajectory OUT.tum] [--relations FILE [--check-relations]]
                           [--scan-topic T] [--odom-topic T | --odom-frame NONE] [--truth-topic T]
       replay a CARMEN laser log (.log/.clf, gzip or not) or a ROS bag (.bag, .mcap,
       .db3, or a rosbag2 folder) through SLAM with loop closures; --from/--to pick
@@ -23,7 +23,9 @@ export const usage = `  node web/cli.mjs run-log LOG [--json] [--out MAP.yaml] [
       --truth-topic the ground truth (NONE: none; by default a pose topic named as
       ground truth or from motion capture); --relations
       scores the replay against a benchmark's relation file (Kümmerle et al. 2009: t1 t2 x y
-      z roll pitch yaw per line): the report's relations, mean, sd and max of the errors`;
+      z roll pitch yaw per line): the report's relations, mean, sd and max of the errors;
+      --check-relations also checks each relation against its own two scans and, where
+      they pin nothing, the wheel odometry: the report's relation_check`;
 
 /** The SLAM poses as a TUM trajectory: `time x y z qx qy qz qw` per scan. */
 function tum(report) {
@@ -83,7 +85,7 @@ function wholeNumber(name, v) {
 
 async function runLog(argv, wasm) {
   const { positional, options } = parseArgs(argv, {
-    json: 'flag', out: 'value', from: 'value', to: 'value', trajectory: 'value', relations: 'value',
+    json: 'flag', out: 'value', from: 'value', to: 'value', trajectory: 'value', relations: 'value', 'check-relations': 'flag',
     'scan-topic': 'value', 'odom-topic': 'value', 'odom-frame': 'value', 'truth-topic': 'value',
   });
   if (positional.length !== 1) throw new UsageError('run-log: expected exactly one LOG file');
@@ -103,6 +105,10 @@ async function runLog(argv, wasm) {
       throw new UsageError(`--relations: cannot read '${options.relations}': ${e.code ?? e.message}`);
     }
     wasmCall(() => replay.setRelations(text));
+  }
+  if (options['check-relations']) {
+    if (options.relations === undefined) throw new UsageError('--check-relations needs --relations FILE');
+    replay.setCheckRelations(true);
   }
   const tParsed = performance.now();
   wasmCall(() => replay.setRange(from, to));
@@ -154,6 +160,15 @@ async function runLog(argv, wasm) {
       const q = r.relations;
       console.log(`  relations: ${q.matched} of ${q.count} matched; translation ${q.trans_m.mean.toFixed(4)} ± ${q.trans_m.sd.toFixed(4)} m (max ${q.trans_m.max.toFixed(3)}), ` +
         `rotation ${q.rot_deg.mean.toFixed(3)} ± ${q.rot_deg.sd.toFixed(3)} deg (max ${q.rot_deg.max.toFixed(2)})`);
+    }
+    if (r.relation_check) {
+      const c = r.relation_check;
+      console.log(`  checked: the scans settle ${c.settled} of ${c.checked} relations and contradict ${c.by_scans}; ` +
+        `the wheels contradict ${c.by_odometry} where the scans settle none`);
+      console.log(`  where the scans settle a pose, the relations lie ${c.relations_vs_scans.trans_m.toFixed(4)} m / ` +
+        `${c.relations_vs_scans.rot_deg.toFixed(3)} deg from it, ours ${c.ours_vs_scans.trans_m.toFixed(4)} m / ${c.ours_vs_scans.rot_deg.toFixed(3)} deg`);
+      console.log(`  against the ${c.uncontradicted} relations contradicted by neither: translation ${c.trans_m.mean.toFixed(4)} ± ` +
+        `${c.trans_m.sd.toFixed(4)} m, rotation ${c.rot_deg.mean.toFixed(3)} ± ${c.rot_deg.sd.toFixed(3)} deg`);
     }
     const m = r.map;
     console.log(`${file}: ${r.scans.length} of ${r.laser_records} laser records replayed (${r.from}..${r.to}), ` +

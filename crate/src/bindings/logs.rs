@@ -115,6 +115,14 @@ impl LogReplay {
         Ok(self.inner.set_relations(text).map_err(err)? as u32)
     }
 
+    /// Whether the report also checks the relations against their own
+    /// scans and the wheel odometry (its `relation_check`; `run-log
+    /// --check-relations`).
+    #[wasm_bindgen(js_name = setCheckRelations)]
+    pub fn set_check_relations(&mut self, on: bool) {
+        self.inner.set_check_relations(on);
+    }
+
     /// The replay so far scored against the relations set (JSON `{count,
     /// matched, trans_m: {mean, sd, max}, rot_deg: {…}, worst: […],
     /// errors: […]}`).

@@ -41,10 +41,12 @@ use crate::geom::{wrap_angle, Pose2};
 use crate::slam::eval::benchmark_relations::{
     parse_relations, score_relations, Relation, RelationScore,
 };
+use crate::slam::eval::relation_check::{check_relations, RelationCheck, Witnesses};
 use crate::slam::eval::scoring::{ate_aligned_m, best_fit};
+use crate::slam::eval::verified::VerifyConfig;
 use crate::slam::export::{self, MapInfo};
 use crate::slam::grid::OccupancyGrid;
-use crate::slam::logs::logslam::{ClosureInfo, LogSlam, LogSlamConfig, LogSlamStats};
+use crate::slam::logs::logslam::{scan_points, ClosureInfo, LogSlam, LogSlamConfig, LogSlamStats};
 use crate::slam::logs::LogScan;
 use serde::Serialize;
 
@@ -79,6 +81,9 @@ pub struct LogReplay {
     /// A benchmark's relations to score against (`run-log --relations`),
     /// never given to the SLAM.
     relations: Vec<Relation>,
+    /// Whether the report checks the relations against their own scans
+    /// and the wheels (`run-log --check-relations`).
+    check_relations: bool,
     pub slam: LogSlam,
     from: usize,
     to: usize,
@@ -209,6 +214,10 @@ pub struct LogReport {
     /// every relation's error and the worst ones.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub relations: Option<RelationScore>,
+    /// Those relations checked against their own scans and the wheel
+    /// odometry (`--check-relations`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub relation_check: Option<RelationCheck>,
     pub timings_ms: serde_json::Value,
 }
 
@@ -264,6 +273,7 @@ impl LogReplay {
             source,
             truth,
             relations: Vec::new(),
+            check_relations: false,
             slam: LogSlam::new(config),
             from: 0,
             next: 0,
@@ -462,6 +472,10 @@ impl LogReplay {
             ate_m: ate.map(|a| a.0),
             ate_scans: ate.map(|a| a.1),
             relations: (!self.relations.is_empty()).then(|| self.relation_score()),
+            relation_check: self
+                .check_relations
+                .then(|| self.relation_check())
+                .flatten(),
             timings_ms,
         })
     }
@@ -473,20 +487,79 @@ impl LogReplay {
         Ok(self.relations.len())
     }
 
+    /// Whether the report checks the relations against their own scans
+    /// and the wheels ([`crate::slam::eval::relation_check`]; it aligns
+    /// two scans per relation, a few seconds for a benchmark log).
+    pub fn set_check_relations(&mut self, on: bool) {
+        self.check_relations = on;
+    }
+
+    /// The relations set checked against their own scans and the wheel
+    /// odometry ([`crate::slam::eval::relation_check`]); `None` without
+    /// relations.
+    pub fn relation_check(&self) -> Option<RelationCheck> {
+        if self.relations.is_empty() {
+            return None;
+        }
+        let score = self.relation_score();
+        let scans = &self.scans[self.from..];
+        let lasers = self.laser_poses();
+        let wheels: Vec<Pose2> = self
+            .slam
+            .scans
+            .iter()
+            .zip(scans)
+            .map(|(e, s)| e.odometry.compose(&s.laser_offset))
+            .collect();
+        let noise = self.slam.stats.fusion_noise;
+        let seen = Witnesses {
+            lasers: &lasers,
+            wheels: match noise {
+                Some(n) if self.has_odometry() => {
+                    Some((&wheels[..], [n.odometry_step[0], n.odometry_step[1]]))
+                }
+                _ => None,
+            },
+        };
+        // Every return within the matching range, in the laser's frame.
+        let dense = LogSlamConfig {
+            point_spacing_m: 0.0,
+            ..self.slam.config.clone()
+        };
+        let points = |k: usize| {
+            let at_laser = LogScan {
+                laser_offset: Pose2::IDENTITY,
+                ..scans[k].clone()
+            };
+            scan_points(&at_laser, &dense)
+        };
+        Some(check_relations(
+            &self.relations,
+            &score,
+            &seen,
+            points,
+            &VerifyConfig::default(),
+        ))
+    }
+
+    /// Each replayed scan's laser pose: the robot's pose composed with the
+    /// laser's offset on it.
+    fn laser_poses(&self) -> Vec<Pose2> {
+        self.slam
+            .poses()
+            .iter()
+            .zip(&self.scans[self.from..])
+            .map(|(p, s)| p.compose(&s.laser_offset))
+            .collect()
+    }
+
     /// The replay so far scored against the relations set (empty score
     /// without). A relation relates two scans, so a scan's pose is the
     /// laser's when it took the scan: the robot's pose composed with the
     /// laser's offset on the robot.
     pub fn relation_score(&self) -> RelationScore {
         let times: Vec<f64> = self.slam.scans.iter().map(|s| s.time).collect();
-        let lasers: Vec<Pose2> = self
-            .slam
-            .poses()
-            .iter()
-            .zip(&self.scans[self.from..])
-            .map(|(p, s)| p.compose(&s.laser_offset))
-            .collect();
-        score_relations(&times, &lasers, &self.relations)
+        score_relations(&times, &self.laser_poses(), &self.relations)
     }
 
     /// The ground truth beside the SLAM path so far (`None` without one,
