@@ -326,7 +326,7 @@ pub fn errors_by_gap(relations: &[Verified], estimate: &[Pose2]) -> Vec<GapError
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     #[test]
@@ -353,7 +353,7 @@ mod tests {
 
     /// A 6 × 4 m room's walls, a point every 2 cm, seen from `pose`: robot
     /// frame, in bearing order as a laser returns them.
-    fn room_seen_from(pose: &Pose2) -> Vec<DVec2> {
+    pub(crate) fn room_seen_from(pose: &Pose2) -> Vec<DVec2> {
         let mut world = Vec::new();
         for k in 0..300 {
             let x = -3.0 + 0.02 * k as f64;
