@@ -349,14 +349,22 @@ function colourPixels(page, png, hex, tol = 40) {
   }, { b64: png.toString('base64'), hex, tol });
 }
 
-/** The relation figures the page shows, one a robot: its text and data attributes. */
+/**
+ * The relation figures the page shows, one a robot: its text and data
+ * attributes, and apart (`check`: text and data attributes, or null) the
+ * relations checked against their scans, shown once a replay is finished.
+ */
 const relationFigures = (page) =>
-  page.locator('#log-rel-figures li').evaluateAll((lis) => lis.map((li) => ({ text: li.textContent, ...li.dataset })));
+  page.locator('#log-rel-figures li').evaluateAll((lis) => lis.map((li) => {
+    const c = li.querySelector('.rel-check');
+    const text = [...li.childNodes].filter((n) => n !== c && n.nodeName !== 'BR').map((n) => n.textContent).join('');
+    return { text, ...li.dataset, check: c ? { text: c.textContent, ...c.dataset } : null };
+  }));
 
 test('your log: a bag dropped with its .relations file shows the relation errors run-log reports, plots them and draws the worst on the map; a malformed file is named with its line', { timeout: 600000 }, async () => {
   const bag = path.join(BAGS, 'freiburg/mit-csail.bag');
   const relations = path.join(BAGS, 'freiburg/mit-csail.relations');
-  const report = JSON.parse(execFileSync('node', [path.join(ROOT, 'web/cli.mjs'), 'run-log', bag, '--relations', relations, '--json'], { maxBuffer: 1 << 28 }).toString());
+  const report = JSON.parse(execFileSync('node', [path.join(ROOT, 'web/cli.mjs'), 'run-log', bag, '--relations', relations, '--check-relations', '--json'], { maxBuffer: 1 << 28 }).toString());
   const cli = report.relations;
   const t0 = report.scans[0].time; // the bag's first scan: the plot's time starts there
   assert.deepEqual([cli.matched, cli.count], [1172, 1172]);
@@ -400,6 +408,20 @@ test('your log: a bag dropped with its .relations file shows the relation errors
   );
   assert.equal(Number(fig.transMean).toFixed(4), t.mean.toFixed(4));
   assert.deepEqual([fig.matched, fig.count], ['1172', '1172']);
+  // Finished: the relations checked against their own scans and the wheels, as run-log --check-relations.
+  const c = report.relation_check;
+  assert.ok(fig.check, 'the check is shown once the replay is finished');
+  assert.deepEqual([fig.check.settled, fig.check.byScans, fig.check.byOdometry], [c.settled, c.by_scans, c.by_odometry].map(String));
+  assert.equal(
+    fig.check.text,
+    `Checked against their own scans: the scans settle ${c.settled.toLocaleString('en')} of 1,172 relations and contradict ${c.by_scans}. ` +
+      `Where the scans settle a pose, the relations lie ${c.relations_vs_scans.trans_m.toFixed(4)} m and ${c.relations_vs_scans.rot_deg.toFixed(2)}° from it, ` +
+      `this robot ${c.ours_vs_scans.trans_m.toFixed(4)} m and ${c.ours_vs_scans.rot_deg.toFixed(2)}°. ` +
+      `Against the ${c.uncontradicted.toLocaleString('en')} relations neither contradicts: translation ${c.trans_m.mean.toFixed(4)} ± ${c.trans_m.sd.toFixed(4)} m, ` +
+      `rotation ${c.rot_deg.mean.toFixed(2)} ± ${c.rot_deg.sd.toFixed(2)}°.`,
+  );
+  assert.ok(Number(fig.check.oursRot) < Number(fig.check.relationsRot), 'nearer the scans than the relations are');
+  await page.locator('#log-relations').screenshot({ path: path.join(ARTIFACTS, 'page-bags-relation-check.png') });
   const page5 = await page.evaluate(() => {
     const q = window.slamlab.logView.snapshot().robots[0].relations;
     return { trans: q.trans_m, rot: q.rot_deg, worst: q.worst, errors: [...q.errors] };

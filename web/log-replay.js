@@ -126,6 +126,15 @@ export class LogReplay {
   }
 
   /**
+   * The relations checked against their own scans and the wheel odometry
+   * (`run-log --check-relations`'s `relation_check`), or null without
+   * relations.
+   */
+  relationCheck() {
+    return JSON.parse(this.raw.relationCheckJson());
+  }
+
+  /**
    * The replay so far scored against the relations: `{count, matched,
    * trans_m: {mean, sd, max}, rot_deg: {mean, sd, max}, worst, errors}`,
    * each error `{t1, t2, scan1, scan2, trans_m, rot_deg}`.

@@ -20,7 +20,10 @@
 // replayed (the others count as unmatched). What goes to the page is what
 // it shows: the counts and spreads, the worst relations with the scans
 // they join, and each relation's error as a flat `[time, metres, …]`
-// list, the time that of its later scan since the log's first scan.
+// list, the time that of its later scan since the log's first scan. Once
+// a replay is finished, its relations are also checked against their own
+// scans and the wheels (`relationCheckFigures`, as `run-log
+// --check-relations` does).
 
 import { LogReplay } from '../../log-replay.js';
 
@@ -136,4 +139,17 @@ export function relationFigures(replay, file, t0) {
   });
   const worst = s.worst.slice(0, WORST_SHOWN).map(({ t1, t2, scan1, scan2, trans_m, rot_deg }) => ({ t1, t2, scan1, scan2, trans_m, rot_deg, at: at({ t1, t2 }) }));
   return { file, count: s.count, matched: s.matched, trans_m: s.trans_m, rot_deg: s.rot_deg, worst, errors };
+}
+
+/**
+ * A finished replay's relations checked against their own scans and the
+ * wheels (`run-log --check-relations`), as the page shows it: the counts,
+ * how far the relations and the replay each lie from what the scans
+ * settle, and the errors against the relations no witness contradicts.
+ */
+export function relationCheckFigures(replay) {
+  const c = replay.relationCheck();
+  if (!c) return null;
+  const { checked, settled, by_scans, by_odometry, relations_vs_scans, ours_vs_scans, uncontradicted, trans_m, rot_deg } = c;
+  return { checked, settled, by_scans, by_odometry, relations_vs_scans, ours_vs_scans, uncontradicted, trans_m, rot_deg };
 }

@@ -51,7 +51,7 @@ import { MAX_SAVED_MAPS } from '../../saved-maps.js';
 import { readBag, sortFiles } from './bag-read.js';
 import { drawMergedPaths, drawReplays, mapPicture } from './log-draw.js';
 import { mergedPaths, mergeRobots, placedMaps, stretches } from './log-merge.js';
-import { firstScanTime, matchRelations, relationFigures, relationsText, setRelations, splitRelations } from './log-relations.js';
+import { firstScanTime, matchRelations, relationCheckFigures, relationFigures, relationsText, setRelations, splitRelations } from './log-relations.js';
 import { drawPlaced, fitView } from './overlay.js';
 
 const ready = init();
@@ -274,6 +274,13 @@ function scoreRelations(robot, force) {
     log.firstTime = null; // the plot's time then starts at the earliest relation's stamp
   }
   robot.relations = relationFigures(robot.replay, log.relations.name, t0);
+  // Checked against the scans and wheels once the poses are settled, once
+  // per relations file (it aligns two scans a relation).
+  if (robot.finished && robot.checkedWith !== log.relations) {
+    robot.check = relationCheckFigures(robot.replay);
+    robot.checkedWith = log.relations;
+  }
+  robot.relations.check = robot.finished ? robot.check : null;
   robot.relationsAt = now;
 }
 
@@ -425,9 +432,9 @@ function finish() {
       r.summary = { scans: r.report.scans.length, closures: r.report.loop_closures.length, map: r.report.map };
       r.view = r.replay.view();
       r.truth = r.showTruth ? r.replay.truth() : null;
-      scoreRelations(r, true);
       r.drawnDone = -1; // the settled poses draw a new map
       r.finished = true;
+      scoreRelations(r, true);
     }
     const pgm = r.replay.mapPgm();
     const png = r.replay.mapPng();

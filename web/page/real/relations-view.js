@@ -11,7 +11,11 @@
 // at the end:
 //   - per robot, how many relations were matched (both scans replayed) of
 //     those in the file, and the mean ± standard deviation (largest) of
-//     both errors, as `run-log --relations` reports them;
+//     both errors, as `run-log --relations` reports them; once finished,
+//     the relations checked against their own scans and the wheels, as
+//     `run-log --check-relations` reports them (a reference has errors
+//     too: on FR079 the relations lie further from their scans than the
+//     SLAM does);
 //   - a plot of each relation's translational error over the run (x: the
 //     time of its later scan since the log's first scan), a point a
 //     relation in its robot's colour, the mean dashed, the worst ringed
@@ -74,6 +78,32 @@ function figures(r) {
     el('span', { class: 'rel-trans', text: `translation ${fmt(t.mean, 4)} ± ${fmt(t.sd, 4)} m (max ${fmt(t.max, 4)} m)` }),
     ', ',
     el('span', { class: 'rel-rot', text: `rotation ${fmt(a.mean, 2)} ± ${fmt(a.sd, 2)}° (max ${fmt(a.max, 2)}°)` }),
+    ...(q.check ? [el('br'), checked(q.check)] : []),
+  );
+}
+
+/**
+ * The relations checked against their own scans and the wheels (a
+ * finished replay): whom the witnesses contradict, how far the relations
+ * and this robot each lie from what the scans settle, and the errors
+ * against the relations neither contradicts.
+ */
+function checked(c) {
+  const wheels = c.by_odometry ? `; where they pin nothing, the wheel odometry contradicts ${count(c.by_odometry)} more` : '';
+  const v = c.relations_vs_scans, o = c.ours_vs_scans;
+  return el(
+    'span',
+    {
+      class: 'rel-check',
+      'data-settled': c.settled,
+      'data-by-scans': c.by_scans,
+      'data-by-odometry': c.by_odometry,
+      'data-relations-rot': v.rot_deg,
+      'data-ours-rot': o.rot_deg,
+    },
+    `Checked against their own scans: the scans settle ${count(c.settled)} of ${count(c.checked)} relations and contradict ${count(c.by_scans)}${wheels}. ` +
+      `Where the scans settle a pose, the relations lie ${fmt(v.trans_m, 4)} m and ${fmt(v.rot_deg, 2)}° from it, this robot ${fmt(o.trans_m, 4)} m and ${fmt(o.rot_deg, 2)}°. ` +
+      `Against the ${count(c.uncontradicted)} relations neither contradicts: translation ${fmt(c.trans_m.mean, 4)} ± ${fmt(c.trans_m.sd, 4)} m, rotation ${fmt(c.rot_deg.mean, 2)} ± ${fmt(c.rot_deg.sd, 2)}°.`,
   );
 }
 
@@ -105,7 +135,7 @@ export class RelationsView {
       return;
     }
     const scored = some.map((r) => [r.name, r.colour, r.relations.file, r.relations.matched, r.relations.count, r.relations.trans_m, r.relations.rot_deg]);
-    const listKey = JSON.stringify([scored, some.map((r) => [r.done, r.total, r.finished])]);
+    const listKey = JSON.stringify([scored, some.map((r) => [r.done, r.total, r.finished, r.relations.check?.checked ?? null])]);
     if (listKey !== this.listKey) this.list.replaceChildren(...some.map(figures));
     this.listKey = listKey;
     this.table(some);
