@@ -455,6 +455,11 @@ impl LogReplay {
                 .collect();
             (Some(rows), self.ate(&poses))
         };
+        let relations = (!self.relations.is_empty()).then(|| self.relation_score());
+        let relation_check = match &relations {
+            Some(score) if self.check_relations => Some(self.check_against(score)),
+            _ => None,
+        };
         Ok(LogReport {
             frame: FRAME,
             laser_records: self.scans.len(),
@@ -471,11 +476,8 @@ impl LogReplay {
             ground_truth,
             ate_m: ate.map(|a| a.0),
             ate_scans: ate.map(|a| a.1),
-            relations: (!self.relations.is_empty()).then(|| self.relation_score()),
-            relation_check: self
-                .check_relations
-                .then(|| self.relation_check())
-                .flatten(),
+            relations,
+            relation_check,
             timings_ms,
         })
     }
@@ -498,10 +500,11 @@ impl LogReplay {
     /// odometry ([`crate::slam::eval::relation_check`]); `None` without
     /// relations.
     pub fn relation_check(&self) -> Option<RelationCheck> {
-        if self.relations.is_empty() {
-            return None;
-        }
-        let score = self.relation_score();
+        (!self.relations.is_empty()).then(|| self.check_against(&self.relation_score()))
+    }
+
+    /// [`LogReplay::relation_check`] of the relations `score` matched.
+    fn check_against(&self, score: &RelationScore) -> RelationCheck {
         let scans = &self.scans[self.from..];
         let lasers = self.laser_poses();
         let wheels: Vec<Pose2> = self
@@ -533,13 +536,13 @@ impl LogReplay {
             };
             scan_points(&at_laser, &dense)
         };
-        Some(check_relations(
+        check_relations(
             &self.relations,
-            &score,
+            score,
             &seen,
             points,
             &VerifyConfig::default(),
-        ))
+        )
     }
 
     /// Each replayed scan's laser pose: the robot's pose composed with the

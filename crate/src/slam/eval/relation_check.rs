@@ -129,13 +129,23 @@ pub fn check_relations(
     let mut out = RelationCheck::default();
     let (mut kept_t, mut kept_r) = (Vec::new(), Vec::new());
     let (mut file, mut ours_s) = (Vec::new(), Vec::new());
-    let scored = relations
-        .iter()
-        .filter(|r| score.errors.iter().any(|e| e.t1 == r.t1 && e.t2 == r.t2));
-    for (r, e) in scored.zip(&score.errors) {
+    // Each scan's points, made once however many relations it is in.
+    let mut made: Vec<Option<Vec<DVec2>>> = vec![None; seen.lasers.len()];
+    // The score's errors are the matched relations', in the file's order.
+    let mut errors = score.errors.iter().peekable();
+    for r in relations {
+        let Some(e) = errors.next_if(|e| e.t1 == r.t1 && e.t2 == r.t2) else {
+            continue;
+        };
         out.checked += 1;
         let ours = seen.lasers[e.scan1].between(&seen.lasers[e.scan2]);
-        let c = check_pair(&points(e.scan1), &points(e.scan2), &r.pose, &ours, cfg);
+        for k in [e.scan1, e.scan2] {
+            if made[k].is_none() {
+                made[k] = Some(points(k));
+            }
+        }
+        let scan = |k: usize| made[k].as_deref().unwrap_or(&[]);
+        let c = check_pair(scan(e.scan1), scan(e.scan2), &r.pose, &ours, cfg);
         let (given_m, given_deg) = offset(&ours, &r.pose);
         if e.trans_m > MISS_M || e.rot_deg > MISS_DEG {
             out.misses.push(Miss {
