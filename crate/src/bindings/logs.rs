@@ -126,7 +126,7 @@ impl LogReplay {
     /// The relations set checked against their own scans and the wheel
     /// odometry (JSON, as `run-log --check-relations` reports
     /// `relation_check`), or `null` without relations. Aligns two scans per
-    /// relation: about a second for a benchmark log.
+    /// relation: a few seconds for a benchmark log.
     #[wasm_bindgen(js_name = relationCheckJson)]
     pub fn relation_check_json(&self) -> Result<String, JsError> {
         to_json(&self.inner.relation_check())
