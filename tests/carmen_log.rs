@@ -394,3 +394,53 @@ fn smoothing_makes_nearby_scans_agree() {
         "before {before:?}, after {after:?} (m, rad)"
     );
 }
+
+/// A key edge's information (`key_edge_information`, the log SLAM's key
+/// edges without odometry): from a corridor's scan, whose surface normals
+/// all point across it, the variance along the corridor is
+/// `key_loosen_ratio` times that across, in the frame of the key however
+/// it is turned; a box room's scan pins both directions alike.
+#[wasm_bindgen_test(unsupported = test)]
+fn a_corridor_key_edge_is_loose_along_the_corridor() {
+    use glam::DVec2;
+    use slamlab::geom::Pose2;
+    use slamlab::slam::logs::logslam::{key_edge_information, LogSlamConfig};
+    let cfg = LogSlamConfig::default();
+    let (sm, sr, ratio) = (cfg.key_sigma_m, cfg.key_sigma_rad, cfg.key_loosen_ratio);
+    // Walls at y = −1.2 and y = 1 (robot frame), a point every 0.1 m, in
+    // the order a laser sweeps them.
+    let corridor: Vec<DVec2> = (-60..=60)
+        .map(|k| DVec2::new(0.1 * k as f64, -1.2))
+        .chain((-60..=60).rev().map(|k| DVec2::new(0.1 * k as f64, 1.0)))
+        .collect();
+    for theta in [0.0, 0.7, -2.0] {
+        let pose = Pose2::new(3.0, -1.0, theta);
+        let info = key_edge_information(&corridor, &pose, sm, sr, ratio).expect("loosened");
+        // Along the key's x (the corridor) and across it (y).
+        assert!(
+            (info[0][0] * ratio * sm * sm - 1.0).abs() < 1e-3,
+            "{theta}: {info:?}"
+        );
+        assert!(
+            (info[1][1] * sm * sm - 1.0).abs() < 1e-6,
+            "{theta}: {info:?}"
+        );
+        assert!(info[0][1].abs() < 1e-6 && (info[2][2] * sr * sr - 1.0).abs() < 1e-6);
+    }
+    // The box room x ∈ [−3, 5], y ∈ [−2, 3] seen from the origin.
+    let scan = room_scan(0, Pose2::IDENTITY, Pose2::IDENTITY, |_| false);
+    let room: Vec<DVec2> = scan
+        .ranges
+        .iter()
+        .enumerate()
+        .map(|(i, &r)| {
+            let a = scan.start_angle + i as f64 * scan.angle_step;
+            DVec2::new(a.cos(), a.sin()) * r as f64
+        })
+        .collect();
+    let info = key_edge_information(&room, &Pose2::IDENTITY, sm, sr, ratio);
+    let (along, across) = info.map_or((1.0, 1.0), |m| (m[0][0].min(m[1][1]), m[0][0].max(m[1][1])));
+    assert!(along * 4.0 >= across, "{info:?}");
+    // One σ for all when the ratio is off.
+    assert!(key_edge_information(&corridor, &Pose2::IDENTITY, sm, sr, 1.0).is_none());
+}

@@ -300,6 +300,7 @@ pub fn config_from_env() -> LogSlamConfig {
             "wide_m" => cfg.wide.linear_m = v,
             "wide_deg" => cfg.wide.angular_rad = v.to_radians(),
             "loop_loosen_ratio" => cfg.loop_loosen_ratio = v,
+            "key_loosen_ratio" => cfg.key_loosen_ratio = v,
             "local_keys" => cfg.local_keys = v as usize,
             "key_distance_m" => cfg.key_distance_m = v,
             "key_angle_deg" => cfg.key_angle_rad = v.to_radians(),

@@ -392,15 +392,29 @@ pub fn loosened_along_weak(
     max_ratio: f64,
 ) -> Option<[[f64; 3]; 3]> {
     let ratio = (fit.strong / fit.weak.max(1e-9)).clamp(1.0, max_ratio);
-    let (v, s2) = (fit.weak_direction, sigma_m * sigma_m);
-    let k = s2 * (ratio - 1.0);
+    let found = nodes[c.edge.from].compose(&c.edge.measurement);
+    loose_along(fit.weak_direction, ratio, sigma_m, sigma_rad, found.theta)
+}
+
+/// The information of an edge ending at a node with heading `theta_rad`
+/// whose position is `ratio` times as unsure (in variance) along the
+/// world-frame unit vector `v` as across it: the variance `sigma_m²`
+/// across, `sigma_m² · ratio` along, heading `sigma_rad²`.
+pub fn loose_along(
+    v: DVec2,
+    ratio: f64,
+    sigma_m: f64,
+    sigma_rad: f64,
+    theta_rad: f64,
+) -> Option<[[f64; 3]; 3]> {
+    let s2 = sigma_m * sigma_m;
+    let k = s2 * (ratio.max(1.0) - 1.0);
     let cov = [
         [s2 + k * v.x * v.x, k * v.x * v.y, 0.0],
         [k * v.x * v.y, s2 + k * v.y * v.y, 0.0],
         [0.0, 0.0, sigma_rad * sigma_rad],
     ];
-    let found = nodes[c.edge.from].compose(&c.edge.measurement);
-    edge_information(&cov, found.theta)
+    edge_information(&cov, theta_rad)
 }
 
 /// Pairwise consistency of two closures `a` and `b` (Olson, "Recognizing

@@ -49,6 +49,20 @@
 //!    each edge by its own match instead, but on these logs which closures
 //!    are found decides the result, not the key edges' weights
 //!    (BENCHMARKS.md).
+//!
+//!    Without odometry it is otherwise: in a corridor whose ends are out
+//!    of range the match along it is a guess, and nothing else in the log
+//!    says how far the robot went. A key edge there is made as loose along
+//!    the new key's scan's weakest direction as the scan's surface normals
+//!    pin it less there than across (`Σ n nᵀ`, [`crate::slam::degeneracy`];
+//!    the ratio of its eigenvalues, up to `key_loosen_ratio`), so a loop's
+//!    closure puts the error where the corridor lost it instead of bending
+//!    the whole loop. On the Stage bag (a 5 m, 90-beam laser) a stretch
+//!    whose normals give a weak/strong ratio of 0.0003 lost 0.87 m; with
+//!    one σ for all edges the closure spread it over the loop (ATE 0.253
+//!    m), loosened 0.114 m. With odometry the edges keep one σ: loosened,
+//!    a wrong closure bends the raw ACES log by metres (the chain along a
+//!    corridor is then held by nothing but the closures).
 //! 4. **Loop closures** ([`crate::slam::loop_closure`]): every `loop_every`
 //!    keys the new key is matched against the older keys of the nearest
 //!    earlier pass near its estimate.
@@ -139,13 +153,13 @@
 use super::fusion::{fuse, measure_noise, FusionNoise, Placement};
 use super::scan::LogScan;
 use crate::geom::{wrap_angle, Pose2};
-use crate::slam::degeneracy::scan_normals_within;
+use crate::slam::degeneracy::{constraint_of, scan_normals_within};
 use crate::slam::grid::{GridConfig, OccupancyGrid, GROW_STEP_CELLS};
 use crate::slam::icp::IcpTarget;
 use crate::slam::likelihood::LikelihoodField;
 use crate::slam::loop_closure::{
-    closure_fit, closures_agree, find_closure_among, loosened_along_weak, on_window_edge, Closure,
-    LoopConfig,
+    closure_fit, closures_agree, find_closure_among, loose_along, loosened_along_weak,
+    on_window_edge, Closure, LoopConfig,
 };
 use crate::slam::manhattan::{scan_direction, settle_priors, ManhattanConfig};
 use crate::slam::multires::{field_from_points, match_scan, ScanMatch, Window};
@@ -218,6 +232,12 @@ pub struct LogSlamConfig {
     /// ([`crate::slam::loop_closure::loosened_along_weak`]; 0 or 1: one σ for
     /// all). A corridor's closure is right across it and unsure along it.
     pub loop_loosen_ratio: f64,
+    /// Without odometry (`odometry` false), a key edge is as loose along
+    /// the new key's scan's weakest direction as that scan's surface
+    /// normals pin it less there than across ([`crate::slam::degeneracy`]),
+    /// up to this many times the variance (module doc, step 3; 0 or 1:
+    /// one σ for all). With odometry the edges keep one σ.
+    pub key_loosen_ratio: f64,
     /// Square walls' heading prior after the replay ([`crate::slam::manhattan`];
     /// `None`: off). On: a building whose walls are not square gets no
     /// prior.
@@ -295,6 +315,7 @@ impl Default for LogSlamConfig {
             grown_every: 4,
             far_min_score: 0.7,
             loop_loosen_ratio: 10.0,
+            key_loosen_ratio: 10_000.0,
             manhattan: Some(ManhattanConfig::for_logs()),
             odometry: true,
             smooth_keys: 10,
@@ -442,6 +463,32 @@ fn points_every(scan: &LogScan, range_m: f64, spacing_m: f64) -> Vec<DVec2> {
         }
     }
     out
+}
+
+/// The information of a key edge ending at `pose` whose scan's `points`
+/// (robot frame) pin its position less along one direction than across:
+/// the variance `sigma_m²` across, `sigma_m²` times the ratio of the
+/// strong to the weak eigenvalue of the points' surface normals' `Σ n nᵀ`
+/// ([`crate::slam::degeneracy`]) along, at most `max_ratio` times;
+/// heading `sigma_rad²`. `None` where that ratio is 1 (or `max_ratio` is
+/// at most 1): the edge keeps one σ.
+pub fn key_edge_information(
+    points: &[DVec2],
+    pose: &Pose2,
+    sigma_m: f64,
+    sigma_rad: f64,
+    max_ratio: f64,
+) -> Option<[[f64; 3]; 3]> {
+    if max_ratio <= 1.0 {
+        return None;
+    }
+    let normals = scan_normals_within(points, NORMAL_RADIUS_M);
+    let c = constraint_of(&normals, &vec![true; normals.len()]);
+    let ratio = (c.strong / c.weak.max(1e-9)).clamp(1.0, max_ratio);
+    let along = pose.frame().rotate(c.weak_direction);
+    (ratio > 1.0)
+        .then(|| loose_along(along, ratio, sigma_m, sigma_rad, pose.theta))
+        .flatten()
 }
 
 impl LogSlam {
@@ -605,7 +652,13 @@ impl LogSlam {
             } else {
                 (self.config.key_sigma_m, self.config.key_sigma_rad)
             };
-            self.graph.edges.push(Edge::new(p, id, z, sm, sr));
+            let mut edge = Edge::new(p, id, z, sm, sr);
+            if !self.unmatched_since_key {
+                if let Some(info) = self.key_edge_along_corridor(&pose, &points, sm, sr) {
+                    edge.information = info;
+                }
+            }
+            self.graph.edges.push(edge);
         }
         self.unmatched_since_key = false;
         self.key_points.push(points);
@@ -623,6 +676,28 @@ impl LogSlam {
             self.try_close(id);
         }
         self.rebuild_local();
+    }
+
+    /// Without odometry, the information of a matched key edge ending at
+    /// `pose` made loose along the weakest direction of the new key's
+    /// `points` ([`key_edge_information`]); `None` with odometry.
+    fn key_edge_along_corridor(
+        &self,
+        pose: &Pose2,
+        points: &[DVec2],
+        sigma_m: f64,
+        sigma_rad: f64,
+    ) -> Option<[[f64; 3]; 3]> {
+        if self.config.odometry {
+            return None;
+        }
+        key_edge_information(
+            points,
+            pose,
+            sigma_m,
+            sigma_rad,
+            self.config.key_loosen_ratio,
+        )
     }
 
     /// Rasterises the last `local_keys` key scans into the local map, but
