@@ -200,7 +200,10 @@ fn every_shared_bag_opens_and_picks_what_it_holds() {
 fn a_log_without_odometry_replays_by_scan_matching_alone() {
     // The MIT CSAIL bag with its odometry ignored: scan matching from a
     // constant-velocity prediction still follows the tour, and its report
-    // says there was no odometry.
+    // says there was no odometry. Its corridors hold it: today 0.036 m ±
+    // 0.070 against the relations, 0.132 m ± 0.363 (a 17° bend) with key
+    // edges of one σ instead of loose along the walls
+    // (docs/history/issue-53-ros-bags.md).
     let picks = Picks {
         odom_none: true,
         ..Picks::default()
@@ -222,9 +225,10 @@ fn a_log_without_odometry_replays_by_scan_matching_alone() {
     let score = replay.relation_score();
     assert_eq!(score.matched, 1172);
     assert!(
-        score.trans_m.mean < 0.15,
-        "without odometry: {:.3} m",
-        score.trans_m.mean
+        score.trans_m.mean < 0.045 && score.trans_m.max < 1.2 && score.rot_deg.max < 4.0,
+        "without odometry: {:?}, {:?}",
+        score.trans_m,
+        score.rot_deg
     );
 }
 
