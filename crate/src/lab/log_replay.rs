@@ -46,7 +46,7 @@ use crate::slam::eval::scoring::{ate_aligned_m, best_fit};
 use crate::slam::eval::verified::VerifyConfig;
 use crate::slam::export::{self, MapInfo};
 use crate::slam::grid::OccupancyGrid;
-use crate::slam::logs::logslam::{scan_points, ClosureInfo, LogSlam, LogSlamConfig, LogSlamStats};
+use crate::slam::logs::logslam::{laser_points, ClosureInfo, LogSlam, LogSlamConfig, LogSlamStats};
 use crate::slam::logs::LogScan;
 use serde::Serialize;
 
@@ -525,17 +525,8 @@ impl LogReplay {
             },
         };
         // Every return within the matching range, in the laser's frame.
-        let dense = LogSlamConfig {
-            point_spacing_m: 0.0,
-            ..self.slam.config.clone()
-        };
-        let points = |k: usize| {
-            let at_laser = LogScan {
-                laser_offset: Pose2::IDENTITY,
-                ..scans[k].clone()
-            };
-            scan_points(&at_laser, &dense)
-        };
+        let range_m = self.slam.config.match_range_m;
+        let points = |k: usize| laser_points(&scans[k], range_m);
         check_relations(
             &self.relations,
             score,

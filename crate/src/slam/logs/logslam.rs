@@ -446,11 +446,23 @@ pub fn scan_points(scan: &LogScan, cfg: &LogSlamConfig) -> Vec<DVec2> {
     points_every(scan, cfg.match_range_m, cfg.point_spacing_m)
 }
 
+/// Every return of `scan` within `range_m`, in the laser's own frame (not
+/// through its offset on the robot), unthinned.
+pub fn laser_points(scan: &LogScan, range_m: f64) -> Vec<DVec2> {
+    points_from(scan, &Pose2::IDENTITY, range_m, 0.0)
+}
+
 /// The returns of `scan` within `range_m`, in the robot frame, one per
 /// `spacing_m` along the scan.
 fn points_every(scan: &LogScan, range_m: f64, spacing_m: f64) -> Vec<DVec2> {
+    points_from(scan, &scan.laser_offset, range_m, spacing_m)
+}
+
+/// The returns of `scan` within `range_m` through the laser's pose
+/// `offset`, one per `spacing_m` along the scan.
+fn points_from(scan: &LogScan, offset: &Pose2, range_m: f64, spacing_m: f64) -> Vec<DVec2> {
     let mut out: Vec<DVec2> = Vec::with_capacity(scan.ranges.len());
-    let offset = scan.laser_offset.frame();
+    let offset = offset.frame();
     for (i, &r) in scan.ranges.iter().enumerate() {
         let r = r as f64;
         if scan.no_return(i) || r > range_m {
